@@ -1,0 +1,13 @@
+#pragma once
+// Each subcommand adds itself to the CLI and, when parsed, sets the action to run.
+#include <CLI/CLI.hpp>
+#include <functional>
+
+namespace saresgs::apps {
+
+using Action = std::function<int()>;
+
+void addInfoCommand(CLI::App& app, Action& action);   // apps/cmd_info.cpp
+void addSceneCommand(CLI::App& app, Action& action);  // apps/cmd_scene.cpp
+
+}  // namespace saresgs::apps

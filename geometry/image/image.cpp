@@ -1,0 +1,89 @@
+#include "geometry/image/image.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "geometry/error.h"
+#include "geometry/io/atomic_file.h"
+
+namespace saresgs {
+
+ImageF toFloat(const Image8& img) {
+  ImageF out(img.width, img.height, img.channels);
+  for (size_t i = 0; i < img.data.size(); ++i) out.data[i] = img.data[i] * (1.0f / 255.0f);
+  return out;
+}
+
+Image8 toByte(const ImageF& img) {
+  Image8 out(img.width, img.height, img.channels);
+  for (size_t i = 0; i < img.data.size(); ++i) {
+    float v = img.data[i];
+    if (!(v > 0.0f)) v = 0.0f;  // also maps NaN to 0
+    if (v > 1.0f) v = 1.0f;
+    out.data[i] = static_cast<std::uint8_t>(std::lround(v * 255.0f));
+  }
+  return out;
+}
+
+Image8 readImage(const std::string& path, bool keep_alpha) {
+  if (!std::filesystem::exists(path)) throw InputError(path, "file", "image does not exist");
+  cv::Mat m = cv::imread(path, keep_alpha ? cv::IMREAD_UNCHANGED : cv::IMREAD_COLOR);
+  if (m.empty()) throw InputError(path, "file", "not a readable PNG/JPEG image");
+  if (m.depth() == CV_16U) m.convertTo(m, CV_8U, 1.0 / 257.0);
+  if (m.depth() != CV_8U) throw InputError(path, "pixel type", "expected 8 or 16-bit channels");
+  if (m.channels() == 1) cv::cvtColor(m, m, cv::COLOR_GRAY2BGR);
+  if (m.channels() == 4) {
+    cv::cvtColor(m, m, cv::COLOR_BGRA2RGBA);
+  } else {
+    cv::cvtColor(m, m, cv::COLOR_BGR2RGB);
+  }
+  Image8 out(m.cols, m.rows, m.channels());
+  for (int y = 0; y < m.rows; ++y)
+    std::memcpy(&out.data[out.index(0, y)], m.ptr(y), static_cast<size_t>(m.cols) * m.channels());
+  return out;
+}
+
+void writeImage(const std::string& path, const Image8& img) {
+  const int type = CV_8UC(img.channels);
+  cv::Mat m(img.height, img.width, type, const_cast<std::uint8_t*>(img.data.data()));
+  cv::Mat bgr;
+  if (img.channels == 3) cv::cvtColor(m, bgr, cv::COLOR_RGB2BGR);
+  else if (img.channels == 4) cv::cvtColor(m, bgr, cv::COLOR_RGBA2BGRA);
+  else bgr = m;
+  const std::string ext = std::filesystem::path(path).extension().string();
+  std::vector<std::uint8_t> bytes;
+  if (!cv::imencode(ext, bgr, bytes))
+    throw InputError(path, "extension", "expected .png or .jpg to encode the image");
+  writeFileAtomic(path, std::string(bytes.begin(), bytes.end()));
+}
+
+Image8 resizeImage(const Image8& img, int width, int height) {
+  if (width == img.width && height == img.height) return img;
+  cv::Mat m(img.height, img.width, CV_8UC(img.channels), const_cast<std::uint8_t*>(img.data.data()));
+  cv::Mat r;
+  cv::resize(m, r, cv::Size(width, height), 0, 0, cv::INTER_AREA);
+  Image8 out(width, height, img.channels);
+  for (int y = 0; y < height; ++y)
+    std::memcpy(&out.data[out.index(0, y)], r.ptr(y), static_cast<size_t>(width) * img.channels);
+  return out;
+}
+
+Image8 compositeOnBackground(const Image8& rgba, const float background[3]) {
+  if (rgba.channels == 3) return rgba;
+  Image8 out(rgba.width, rgba.height, 3);
+  for (int y = 0; y < rgba.height; ++y)
+    for (int x = 0; x < rgba.width; ++x) {
+      const float a = rgba.at(x, y, 3) / 255.0f;
+      for (int c = 0; c < 3; ++c) {
+        const float v = rgba.at(x, y, c) / 255.0f * a + background[c] * (1.0f - a);
+        out.at(x, y, c) = static_cast<std::uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
+      }
+    }
+  return out;
+}
+
+}  // namespace saresgs

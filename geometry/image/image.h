@@ -1,0 +1,45 @@
+#pragma once
+// Small image value types. Images live in memory as 8-bit (Image8) and are
+// converted to float linear RGB in [0,1] (ImageF) per use; depth maps are float.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace saresgs {
+
+template <typename T>
+struct ImageT {
+  int width = 0;
+  int height = 0;
+  int channels = 0;
+  std::vector<T> data;  // row-major, interleaved channels
+
+  ImageT() = default;
+  ImageT(int w, int h, int c, T fill = T{})
+      : width(w), height(h), channels(c), data(static_cast<size_t>(w) * h * c, fill) {}
+  bool empty() const { return data.empty(); }
+  size_t index(int x, int y, int ch = 0) const {
+    return (static_cast<size_t>(y) * width + x) * channels + ch;
+  }
+  T& at(int x, int y, int ch = 0) { return data[index(x, y, ch)]; }
+  const T& at(int x, int y, int ch = 0) const { return data[index(x, y, ch)]; }
+};
+
+using Image8 = ImageT<std::uint8_t>;  // 8-bit, 1 (grey), 3 (RGB) or 4 (RGBA) channels
+using ImageF = ImageT<float>;         // float, RGB in [0,1] or 1-channel depth
+
+// 8-bit <-> float in [0,1]; values are clamped and rounded on the way back.
+ImageF toFloat(const Image8& img);
+Image8 toByte(const ImageF& img);
+
+// Reads a PNG/JPEG as RGB or RGBA (alpha kept when `keep_alpha` and present).
+// Throws InputError naming the file when it is missing or unreadable.
+Image8 readImage(const std::string& path, bool keep_alpha = false);
+// Writes PNG/JPEG by extension, to a temporary name first, then renames.
+void writeImage(const std::string& path, const Image8& img);
+// Area-averaging resize to an exact size (used for downscaled loading).
+Image8 resizeImage(const Image8& img, int width, int height);
+// Composites RGBA on a background colour (components in [0,1]) and returns RGB.
+Image8 compositeOnBackground(const Image8& rgba, const float background[3]);
+
+}  // namespace saresgs

@@ -1,0 +1,47 @@
+#include "geometry/io/atomic_file.h"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <unistd.h>
+
+#include "geometry/error.h"
+
+namespace saresgs {
+
+namespace fs = std::filesystem;
+
+void writeStreamAtomic(const std::string& path, const std::function<void(std::ostream&)>& write,
+                       bool binary) {
+  const fs::path target(path);
+  if (target.has_parent_path()) fs::create_directories(target.parent_path());
+  const fs::path tmp = target.string() + ".tmp." + std::to_string(::getpid());
+  {
+    std::ofstream out(tmp, binary ? std::ios::binary | std::ios::trunc : std::ios::trunc);
+    if (!out) throw std::runtime_error(tmp.string() + ": cannot open for writing");
+    write(out);
+    out.flush();
+    if (!out) {
+      out.close();
+      fs::remove(tmp);
+      throw std::runtime_error(path + ": write failed (disk full?)");
+    }
+  }
+  fs::rename(tmp, target);
+}
+
+void writeFileAtomic(const std::string& path, const std::string& bytes) {
+  writeStreamAtomic(path, [&](std::ostream& o) { o.write(bytes.data(), static_cast<std::streamsize>(bytes.size())); },
+                    true);
+}
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, "file", "does not exist or cannot be read");
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+}  // namespace saresgs

@@ -1,0 +1,95 @@
+#pragma once
+// The Scene value that every later room consumes: cameras, lazily loaded images,
+// the train/test split, sparse points with colours, AABB, extent, optional
+// ground-truth depth maps.
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "geometry/camera/camera.h"
+#include "geometry/image/image.h"
+
+namespace saresgs {
+
+struct SceneView {
+  std::string name;        // image name as in the dataset (e.g. "000123.png")
+  Camera camera;           // intrinsics already scaled to the loaded image size
+  std::string image_path;  // absolute or relative to the working directory
+  std::string depth_path;  // ground-truth depth (PFM, z along the camera axis), or empty
+};
+
+struct SparsePoint {
+  Eigen::Vector3d xyz = Eigen::Vector3d::Zero();
+  std::array<std::uint8_t, 3> rgb{0, 0, 0};
+};
+
+struct AABB {
+  Eigen::Vector3d min = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d max = Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity());
+  bool empty() const { return !(min.array() <= max.array()).all(); }
+  void extend(const Eigen::Vector3d& p) {
+    min = min.cwiseMin(p);
+    max = max.cwiseMax(p);
+  }
+  Eigen::Vector3d center() const { return 0.5 * (min + max); }
+  Eigen::Vector3d size() const { return empty() ? Eigen::Vector3d::Zero() : Eigen::Vector3d(max - min); }
+};
+
+// How images are read: from `images/` (factor 1), from `images_<f>` when that folder
+// exists, or resized on load by 1/f. Background is used for RGBA (Blender) images.
+struct ImageLoadOptions {
+  int downscale = 1;  // 1, 2, 4, 8, ...
+  std::array<float, 3> background{1.0f, 1.0f, 1.0f};
+};
+
+class ImageCache;  // defined in scene.cpp; shared by copies of a Scene
+
+class Scene {
+ public:
+  std::string source;  // dataset path, for messages
+  std::vector<SceneView> views;
+  std::vector<int> train;  // indices into views
+  std::vector<int> test;
+  std::vector<SparsePoint> points;
+  AABB aabb;             // of the sparse points (of the cameras when there are none)
+  double extent = 0.0;   // 3DGS scene scale from the train cameras
+  ImageLoadOptions load;
+
+  Scene();
+  // The 8-bit RGB image of view i, read on first use and kept. Thread-safe.
+  const Image8& image(int i) const;
+  // The same as float RGB in [0,1], converted on each call.
+  ImageF imageFloat(int i) const { return toFloat(image(i)); }
+  bool hasDepth(int i) const { return !views.at(i).depth_path.empty(); }
+  // Ground-truth depth of view i (1 channel, z along the camera axis); throws if none.
+  ImageF depth(int i) const;
+  std::vector<Camera> cameras(const std::vector<int>& which) const;
+  // Recomputes aabb and extent from points and the train cameras.
+  void finalize();
+  // Drops every cached image (memory back).
+  void releaseImages() const;
+
+ private:
+  std::shared_ptr<ImageCache> cache_;
+};
+
+struct DatasetOptions {
+  ImageLoadOptions load;
+  int test_every = 8;     // COLMAP: sorted by name, index % test_every == 0 is a test view
+                          // (0 puts every view in train)
+  std::string model_dir;  // COLMAP: sparse model folder; empty searches sparse/0, sparse, .
+};
+
+// Loads a dataset folder: a NeRF-synthetic/Blender folder (transforms_train.json), a
+// COLMAP folder (sparse model + images/), or a synthetic scene written by `saresgs scene`
+// (a COLMAP folder with depth/). Throws InputError with file and field on bad input.
+Scene loadDataset(const std::string& path, const DatasetOptions& opts = {});
+Scene loadColmapDataset(const std::string& path, const DatasetOptions& opts = {});
+Scene loadBlenderDataset(const std::string& path, const DatasetOptions& opts = {});
+
+}  // namespace saresgs

@@ -1,0 +1,13 @@
+#pragma once
+// Image quality metrics as FisherRF and 3DGS define them (DESIGN.md): PSNR on images
+// clamped to [0,1]; SSIM with an 11x11 Gaussian window, sigma 1.5, C1 = 0.01^2,
+// C2 = 0.03^2, averaged over channels and over the "valid" window positions' outputs
+// computed with zero padding, as 3DGS's reference implementation does.
+#include "geometry/image/image.h"
+
+namespace saresgs {
+
+double psnr(const ImageF& a, const ImageF& b);
+double ssim(const ImageF& a, const ImageF& b);
+
+}  // namespace saresgs
