@@ -1,0 +1,49 @@
+// saresgs info: reads a dataset and prints what saresgs sees in it.
+#include <iostream>
+
+#include "apps/commands.h"
+#include "geometry/scene/scene.h"
+
+namespace saresgs::apps {
+
+namespace {
+
+struct InfoArgs {
+  std::string dataset;
+  DatasetOptions opts;
+};
+
+int runInfo(const InfoArgs& a) {
+  const Scene s = loadDataset(a.dataset, a.opts);
+  const Intrinsics& K = s.views.front().camera.K;
+  int with_depth = 0;
+  for (size_t i = 0; i < s.views.size(); ++i) with_depth += s.hasDepth(static_cast<int>(i));
+  std::cout << "dataset " << s.source << "\n"
+            << "  views:   " << s.views.size() << " (" << s.train.size() << " train, " << s.test.size()
+            << " test), " << with_depth << " with ground-truth depth\n"
+            << "  camera:  " << K.width << "x" << K.height << ", fx " << K.fx << ", fy " << K.fy
+            << ", fov " << K.fovX() * 180 / M_PI << " x " << K.fovY() * 180 / M_PI << " deg\n"
+            << "  points:  " << s.points.size() << "\n"
+            << "  aabb:    [" << s.aabb.min.transpose() << "] .. [" << s.aabb.max.transpose() << "]\n"
+            << "  extent:  " << s.extent << "\n";
+  // Reading one image proves the images are there and of the right size.
+  const Image8& img = s.image(s.train.front());
+  std::cout << "  image " << s.views[s.train.front()].name << ": " << img.width << "x" << img.height
+            << " read\n";
+  return 0;
+}
+
+}  // namespace
+
+void addInfoCommand(CLI::App& app, Action& action) {
+  auto args = std::make_shared<InfoArgs>();
+  CLI::App* sub = app.add_subcommand("info", "Read a dataset (COLMAP, Blender, synthetic) and summarise it");
+  sub->add_option("--dataset", args->dataset, "Dataset folder")->required();
+  sub->add_option("--downscale", args->opts.load.downscale, "Image downscale factor (uses images_N if present)")
+      ->check(CLI::Range(1, 64));
+  sub->add_option("--test-every", args->opts.test_every, "COLMAP: every N-th view (sorted by name) is a test view")
+      ->capture_default_str();
+  sub->callback([&action, args] { action = [args] { return runInfo(*args); }; });
+}
+
+}  // namespace saresgs::apps

@@ -1,0 +1,28 @@
+#include "apps/progress.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+
+namespace saresgs::apps {
+
+void Progress::update(const std::string& stage, int done, int total) {
+  const auto now = std::chrono::steady_clock::now();
+  if (stage != stage_) {
+    stage_ = stage;
+    start_ = now;
+    last_decile_ = -1;
+  }
+  const double elapsed = std::chrono::duration<double>(now - start_).count();
+  const double rate = elapsed > 0 ? done / elapsed : 0.0;
+  const double eta = (rate > 0 && total > done) ? (total - done) / rate : 0.0;
+  const bool tty = ::isatty(STDERR_FILENO);
+  const int decile = total > 0 ? 10 * done / total : 10;
+  if (!tty && decile == last_decile_ && done != total) return;
+  last_decile_ = decile;
+  std::fprintf(stderr, "%s[%s] %d/%d  %.1f/s  ETA %.0fs%s", tty ? "\r" : "", stage.c_str(), done,
+               total, rate, eta, (tty && done < total) ? "   " : "\n");
+  std::fflush(stderr);
+}
+
+}  // namespace saresgs::apps

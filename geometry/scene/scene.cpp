@@ -1,0 +1,102 @@
+#include "geometry/scene/scene.h"
+
+#include <cmath>
+#include <filesystem>
+#include <mutex>
+
+#include "geometry/error.h"
+#include "geometry/io/pfm.h"
+
+namespace saresgs {
+
+namespace fs = std::filesystem;
+
+// Images are read on first use and kept as 8-bit; the mutex guards the slots, and a
+// slot once filled is never replaced, so returned references stay valid.
+class ImageCache {
+ public:
+  std::mutex mutex;
+  std::vector<std::unique_ptr<Image8>> slots;
+};
+
+Scene::Scene() : cache_(std::make_shared<ImageCache>()) {}
+
+namespace {
+
+// Reads view `v`'s image at the size its camera expects. A folder such as images_4 is
+// already downscaled (Scene loaders point image_path at it); otherwise the image is
+// resized on load. A size that matches neither is an error naming the file.
+Image8 loadViewImage(const SceneView& v, const ImageLoadOptions& load) {
+  Image8 img = readImage(v.image_path, /*keep_alpha=*/true);
+  if (img.channels == 4) img = compositeOnBackground(img, load.background.data());
+  const int w = v.camera.K.width, h = v.camera.K.height;
+  if (img.width == w && img.height == h) return img;
+  // Accept a source that is `downscale` times larger (rounding either way).
+  const int f = std::max(1, load.downscale);
+  if (std::abs(img.width - w * f) <= f && std::abs(img.height - h * f) <= f && f > 1)
+    return resizeImage(img, w, h);
+  throw InputError(v.image_path, "image size",
+                   "expected " + std::to_string(w * f) + "x" + std::to_string(h * f) +
+                       " (the camera's size) but the file is " + std::to_string(img.width) +
+                       "x" + std::to_string(img.height));
+}
+
+}  // namespace
+
+const Image8& Scene::image(int i) const {
+  std::lock_guard<std::mutex> lock(cache_->mutex);
+  if (cache_->slots.size() < views.size()) cache_->slots.resize(views.size());
+  auto& slot = cache_->slots.at(static_cast<size_t>(i));
+  if (!slot) slot = std::make_unique<Image8>(loadViewImage(views.at(i), load));
+  return *slot;
+}
+
+void Scene::releaseImages() const {
+  std::lock_guard<std::mutex> lock(cache_->mutex);
+  cache_->slots.clear();
+}
+
+ImageF Scene::depth(int i) const {
+  const SceneView& v = views.at(i);
+  if (v.depth_path.empty()) throw InputError(source, "view " + v.name, "has no ground-truth depth");
+  ImageF d = readPfm(v.depth_path);
+  if (d.channels != 1) throw InputError(v.depth_path, "channels", "expected a 1-channel depth map");
+  const int w = v.camera.K.width, h = v.camera.K.height;
+  if (d.width == w && d.height == h) return d;
+  // Downscaled view: sample the depth at the new pixel centres (nearest). Averaging
+  // depths would invent surfaces across occlusion edges.
+  if (d.width < w || d.height < h)
+    throw InputError(v.depth_path, "size", "depth map is smaller than the view");
+  ImageF out(w, h, 1);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const int sx = std::min(d.width - 1, static_cast<int>((x + 0.5) * d.width / w));
+      const int sy = std::min(d.height - 1, static_cast<int>((y + 0.5) * d.height / h));
+      out.at(x, y) = d.at(sx, sy);
+    }
+  return out;
+}
+
+std::vector<Camera> Scene::cameras(const std::vector<int>& which) const {
+  std::vector<Camera> out;
+  out.reserve(which.size());
+  for (int i : which) out.push_back(views.at(i).camera);
+  return out;
+}
+
+void Scene::finalize() {
+  aabb = AABB{};
+  for (const auto& p : points) aabb.extend(p.xyz);
+  if (points.empty())
+    for (int i : train) aabb.extend(views[i].camera.center());
+  extent = sceneExtent(cameras(train));
+}
+
+Scene loadDataset(const std::string& path, const DatasetOptions& opts) {
+  const fs::path p(path);
+  if (!fs::exists(p)) throw InputError(path, "dataset", "folder does not exist");
+  if (fs::exists(p / "transforms_train.json")) return loadBlenderDataset(path, opts);
+  return loadColmapDataset(path, opts);
+}
+
+}  // namespace saresgs

@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Installs every Debian 12 package saresgs needs. Idempotent: installs only what is
+# missing, runs as root or through sudo. Usage: bash scripts/install_deps.sh
+set -euo pipefail
+
+packages=(
+  # toolchain
+  g++ cmake ninja-build pkg-config
+  # libraries (STACK_NOTES.md); OpenVDB's find module needs boost-iostreams too
+  libembree-dev libopenvdb-dev libboost-iostreams-dev libtbb-dev libeigen3-dev
+  libopencv-dev libcgal-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev libcli11-dev
+  # COLMAP: the tests convert our models with `colmap model_converter`; `--sfm colmap`
+  colmap libsqlite3-dev
+  # CC0 meshes (/usr/share/doc/libcgal-dev/data.tar.gz) and photographs for textures
+  libcgal-demo opencv-doc
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install_deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+sudo_cmd=()
+if [ "$(id -u)" -ne 0 ]; then
+  command -v sudo >/dev/null || { echo "install_deps: need root or sudo to install: ${missing[*]}" >&2; exit 1; }
+  sudo_cmd=(sudo)
+fi
+echo "install_deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+"${sudo_cmd[@]}" apt-get update -qq
+"${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
