@@ -1,0 +1,67 @@
+// Runs the real `saresgs` binary as a user would: exit codes, messages, outputs.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <sys/wait.h>
+
+#include "common/temp_dir.h"
+#include "geometry/scene/scene.h"
+
+using saresgs::testing::TempDir;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int code;
+  std::string output;  // stdout and stderr together
+};
+
+Result run(const std::string& args) {
+  const std::string cmd = std::string(SARESGS_CLI) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return {-1, "popen failed"};
+  std::string out;
+  std::array<char, 4096> buf;
+  while (size_t n = fread(buf.data(), 1, buf.size(), p)) out.append(buf.data(), n);
+  const int status = pclose(p);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+}  // namespace
+
+TEST(Cli, SceneWritesADatasetThatInfoReads) {
+  TempDir d;
+  const Result r = run("scene --layout room360 --views 16 --width 64 --height 48 --out " + d.str("s"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("16 views"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::exists(d.path() / "s" / "contact_sheet.png"));
+  const Result i = run("info --dataset " + d.str("s"));
+  ASSERT_EQ(i.code, 0) << i.output;
+  EXPECT_NE(i.output.find("16 with ground-truth depth"), std::string::npos) << i.output;
+  // The summary's numbers are the library's.
+  const saresgs::Scene s = saresgs::loadDataset(d.str("s"));
+  EXPECT_NE(i.output.find("points:  " + std::to_string(s.points.size())), std::string::npos) << i.output;
+}
+
+TEST(Cli, BadInputGivesAClearErrorAndNonZeroExit) {
+  TempDir d;
+  Result r = run("info --dataset " + d.str("missing"));
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.output.find(d.str("missing")), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("does not exist"), std::string::npos) << r.output;
+
+  r = run("scene --layout nowhere --out " + d.str("x"));
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.output.find("--layout"), std::string::npos) << r.output;
+
+  r = run("scene --layout object --mesh " + d.str("no_such.off") + " --out " + d.str("x"));
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.output.find("no_such.off"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(d.path() / "x"));  // nothing half-written in place
+
+  r = run("");
+  EXPECT_NE(r.code, 0);
+}

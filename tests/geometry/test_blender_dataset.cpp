@@ -1,0 +1,131 @@
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "common/temp_dir.h"
+#include "geometry/error.h"
+#include "geometry/scene/scene.h"
+
+using namespace saresgs;
+using saresgs::testing::TempDir;
+using nlohmann::json;
+
+namespace {
+
+// A camera-to-world matrix in OpenGL axes: camera at `eye` looking at the origin.
+json glPose(const Eigen::Vector3d& eye) {
+  const Eigen::Vector3d back = eye.normalized();  // OpenGL +z points away from the view
+  const Eigen::Vector3d right = Eigen::Vector3d::UnitZ().cross(back).normalized();
+  const Eigen::Vector3d up = back.cross(right);
+  json m = json::array();
+  for (int r = 0; r < 3; ++r) m.push_back({right[r], up[r], back[r], eye[r]});
+  m.push_back({0, 0, 0, 1});
+  return m;
+}
+
+void writeRgba(const std::string& path, int w, int h, std::uint8_t alpha) {
+  Image8 img(w, h, 4);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      img.at(x, y, 0) = 200;
+      img.at(x, y, 1) = 100;
+      img.at(x, y, 2) = 0;
+      img.at(x, y, 3) = alpha;
+    }
+  writeImage(path, img);
+}
+
+void writeSplit(const TempDir& d, const std::string& name, const std::string& sub, int n,
+                double angle = 0.6911112070083618) {
+  json j;
+  j["camera_angle_x"] = angle;
+  j["frames"] = json::array();
+  std::filesystem::create_directories(d.path() / sub);
+  for (int i = 0; i < n; ++i) {
+    const double a = 0.7 * i;
+    j["frames"].push_back({{"file_path", "./" + sub + "/r_" + std::to_string(i)},
+                           {"transform_matrix", glPose(Eigen::Vector3d(4 * std::cos(a), 4 * std::sin(a), 1.5))}});
+    writeRgba(d.str(sub + "/r_" + std::to_string(i) + ".png"), 40, 30, 128);
+  }
+  std::ofstream(d.str(name)) << j.dump(2);
+}
+
+}  // namespace
+
+TEST(BlenderDataset, ConvertsOpenGLPosesToOpenCV) {
+  TempDir d;
+  writeSplit(d, "transforms_train.json", "train", 5);
+  writeSplit(d, "transforms_test.json", "test", 2);
+  DatasetOptions opts;
+  opts.load.background = {0.0f, 0.0f, 1.0f};
+  const Scene s = loadDataset(d.str(), opts);
+  ASSERT_EQ(s.views.size(), 7u);
+  EXPECT_EQ(s.train.size(), 5u);
+  EXPECT_EQ(s.test.size(), 2u);
+  for (const auto& v : s.views) {
+    // OpenCV +z looks at the origin, image y points down (world z up).
+    EXPECT_NEAR(v.camera.viewDirection().dot(-v.camera.center().normalized()), 1.0, 1e-9);
+    const auto uv = v.camera.project(Eigen::Vector3d(0, 0, 0));
+    ASSERT_TRUE(uv);
+    EXPECT_NEAR(uv->x(), 20.0, 1e-9);
+    EXPECT_NEAR(uv->y(), 15.0, 1e-9);
+    const auto above = v.camera.project(Eigen::Vector3d(0, 0, 0.5));
+    EXPECT_LT(above->y(), uv->y());
+    EXPECT_NEAR(v.camera.K.fx, 0.5 * 40 / std::tan(0.5 * 0.6911112070083618), 1e-9);
+  }
+  // RGBA composited on the background: alpha 128 of (200,100,0) over (0,0,255).
+  const Image8& img = s.image(0);
+  ASSERT_EQ(img.channels, 3);
+  EXPECT_NEAR(img.at(3, 3, 0), 200 * 128 / 255.0, 1.0);
+  EXPECT_NEAR(img.at(3, 3, 2), 255 * (1 - 128 / 255.0), 1.0);
+  EXPECT_GT(s.extent, 0.0);
+}
+
+TEST(BlenderDataset, DownscaleResizesOnLoad) {
+  TempDir d;
+  writeSplit(d, "transforms_train.json", "train", 2);
+  DatasetOptions opts;
+  opts.load.downscale = 2;
+  const Scene s = loadDataset(d.str(), opts);
+  EXPECT_EQ(s.views[0].camera.K.width, 20);
+  EXPECT_EQ(s.image(0).width, 20);
+  EXPECT_EQ(s.image(0).height, 15);
+}
+
+TEST(BlenderDataset, ErrorsNameFileAndField) {
+  auto expectError = [](const std::string& dir, const std::string& file_part, const std::string& field) {
+    try {
+      loadDataset(dir);
+      FAIL() << "no error for " << field;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(file_part), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+    }
+  };
+  {
+    TempDir d;
+    writeSplit(d, "transforms_train.json", "train", 2);
+    std::filesystem::remove(d.str("train/r_1.png"));
+    expectError(d.str(), "r_1", "frames[1].file_path");
+  }
+  {
+    TempDir d;
+    writeSplit(d, "transforms_train.json", "train", 2, -1.0);
+    expectError(d.str(), "transforms_train.json", "camera_angle_x");
+  }
+  {
+    TempDir d;
+    writeSplit(d, "transforms_train.json", "train", 1);
+    std::ofstream(d.str("transforms_train.json")) << "{\"camera_angle_x\": 0.7, \"frames\": [";
+    expectError(d.str(), "transforms_train.json", "json");
+  }
+  {
+    TempDir d;
+    writeSplit(d, "transforms_train.json", "train", 1);
+    json j = json::parse(std::ifstream(d.str("transforms_train.json")));
+    j["frames"][0]["transform_matrix"][0][3] = std::nan("");  // json writes NaN as null
+    std::ofstream(d.str("transforms_train.json")) << j.dump();
+    expectError(d.str(), "transforms_train.json", "transform_matrix");
+  }
+}

@@ -1,0 +1,163 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "common/temp_dir.h"
+#include "geometry/error.h"
+#include "geometry/io/colmap.h"
+#include "geometry/scene/scene.h"
+
+using namespace saresgs;
+using saresgs::testing::TempDir;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A small COLMAP dataset: `n` images of 32x24 on a circle, a few points.
+ColmapModel writeDataset(const TempDir& d, int n, const std::string& model = "PINHOLE",
+                         bool binary = false) {
+  ColmapModel m;
+  ColmapCamera c;
+  c.id = 3;
+  c.model = model;
+  c.width = 32;
+  c.height = 24;
+  c.params = model == "SIMPLE_PINHOLE" ? std::vector<double>{30, 16, 12}
+             : model == "PINHOLE"      ? std::vector<double>{30, 31, 16, 12}
+                                       : std::vector<double>{30, 31, 16, 12, 0.1, 0.01, 0, 0};
+  m.cameras[c.id] = c;
+  fs::create_directories(d.path() / "images");
+  for (int i = 0; i < n; ++i) {
+    const double a = 2 * M_PI * i / n;
+    const Camera cam = Camera::lookAt(Intrinsics{32, 24, 30, 31, 16, 12},
+                                      Eigen::Vector3d(3 * std::cos(a), 3 * std::sin(a), 1), Eigen::Vector3d::Zero());
+    ColmapImage im;
+    im.id = 100 + (n - i);  // ids in the opposite order of names: sorting is by name
+    im.q = cam.quaternion();
+    im.t = cam.t;
+    im.camera_id = c.id;
+    im.name = "img_" + std::to_string(1000 + i) + ".png";
+    m.images[im.id] = im;
+    writeImage(d.str("images/" + im.name), Image8(32, 24, 3, static_cast<std::uint8_t>(i * 10)));
+  }
+  for (int k = 0; k < 5; ++k) {
+    ColmapPoint3D p;
+    p.id = 7 + k;
+    p.xyz = Eigen::Vector3d(0.1 * k, -0.2 * k, 0.05 * k);
+    p.rgb = {static_cast<std::uint8_t>(k), 2, 3};
+    m.points[p.id] = p;
+  }
+  if (binary) writeColmapBinary(d.str("sparse/0"), m);
+  else writeColmapText(d.str("sparse/0"), m);
+  return m;
+}
+
+void expectInputError(const std::function<void()>& f, const std::string& file_part,
+                      const std::string& field_part) {
+  try {
+    f();
+    FAIL() << "expected an InputError about " << field_part;
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(file_part), std::string::npos) << what;
+    EXPECT_NE(what.find(field_part), std::string::npos) << what;
+  }
+}
+
+}  // namespace
+
+TEST(ColmapDataset, LoadsCamerasSortedByNameWithEveryEighthATestView) {
+  for (bool binary : {false, true}) {
+    TempDir d;
+    const ColmapModel m = writeDataset(d, 17, "PINHOLE", binary);
+    const Scene s = loadDataset(d.str());
+    ASSERT_EQ(s.views.size(), 17u);
+    EXPECT_EQ(s.test, (std::vector<int>{0, 8, 16}));
+    EXPECT_EQ(s.train.size(), 14u);
+    for (size_t i = 0; i < s.views.size(); ++i) {
+      EXPECT_EQ(s.views[i].name, "img_" + std::to_string(1000 + i) + ".png");
+      const ColmapImage& im = m.images.at(static_cast<std::uint32_t>(100 + 17 - i));
+      EXPECT_EQ(s.views[i].camera.t, im.t);
+      EXPECT_NEAR((s.views[i].camera.R - im.q.toRotationMatrix()).norm(), 0, 1e-15);
+      EXPECT_EQ(s.views[i].camera.K.fy, 31);
+    }
+    EXPECT_EQ(s.points.size(), 5u);
+    EXPECT_EQ(s.points[2].xyz, Eigen::Vector3d(0.2, -0.4, 0.1));
+    EXPECT_EQ(s.aabb.max.x(), 0.4);
+    EXPECT_EQ(s.image(3).at(0, 0, 1), 30);  // the 4th name's image
+  }
+}
+
+TEST(ColmapDataset, TestEveryIsConfigurable) {
+  TempDir d;
+  writeDataset(d, 10);
+  DatasetOptions o;
+  o.test_every = 0;
+  EXPECT_TRUE(loadDataset(d.str(), o).test.empty());
+  o.test_every = 3;
+  EXPECT_EQ(loadDataset(d.str(), o).test, (std::vector<int>{0, 3, 6, 9}));
+}
+
+TEST(ColmapDataset, SimplePinholeHasEqualFocalLengths) {
+  TempDir d;
+  writeDataset(d, 3, "SIMPLE_PINHOLE");
+  const Scene s = loadDataset(d.str());
+  EXPECT_EQ(s.views[0].camera.K.fx, 30);
+  EXPECT_EQ(s.views[0].camera.K.fy, 30);
+}
+
+TEST(ColmapDataset, DistortedModelsAskForUndistortion) {
+  TempDir d;
+  writeDataset(d, 3, "OPENCV");
+  expectInputError([&] { loadDataset(d.str()); }, "cameras.txt", "image_undistorter");
+}
+
+TEST(ColmapDataset, DownscaledFolderIsPreferredAndResizingIsTheFallback) {
+  TempDir d;
+  writeDataset(d, 3);
+  DatasetOptions o;
+  o.load.downscale = 2;
+  {
+    const Scene s = loadDataset(d.str(), o);  // no images_2: resized on load
+    EXPECT_EQ(s.views[0].camera.K.width, 16);
+    EXPECT_EQ(s.views[0].camera.K.fx, 15);
+    EXPECT_EQ(s.image(1).width, 16);
+    EXPECT_EQ(s.image(1).at(0, 0, 0), 10);
+  }
+  fs::create_directories(d.path() / "images_2");
+  for (int i = 0; i < 3; ++i)
+    writeImage(d.str("images_2/img_" + std::to_string(1000 + i) + ".png"), Image8(16, 12, 3, 77));
+  const Scene s = loadDataset(d.str(), o);
+  EXPECT_NE(s.views[0].image_path.find("images_2"), std::string::npos);
+  EXPECT_EQ(s.image(1).at(0, 0, 0), 77);
+}
+
+TEST(ColmapDataset, MissingImageNamesTheFile) {
+  TempDir d;
+  writeDataset(d, 4);
+  fs::remove(d.path() / "images" / "img_1002.png");
+  expectInputError([&] { loadDataset(d.str()); }, "img_1002.png", "missing");
+}
+
+TEST(ColmapDataset, MismatchedImageSizeNamesTheFile) {
+  TempDir d;
+  writeDataset(d, 4);
+  writeImage(d.str("images/img_1001.png"), Image8(40, 24, 3, 0));
+  const Scene s = loadDataset(d.str());
+  expectInputError([&] { s.image(1); }, "img_1001.png", "image size");
+}
+
+TEST(ColmapDataset, NonPositiveFocalLengthIsRefused) {
+  TempDir d;
+  ColmapModel m = writeDataset(d, 3);
+  m.cameras.begin()->second.params[0] = 0;
+  writeColmapText(d.str("sparse/0"), m);
+  expectInputError([&] { loadDataset(d.str()); }, "cameras.txt", "camera 3");
+}
+
+TEST(ColmapDataset, MissingModelSaysWhatWasExpected) {
+  TempDir d;
+  fs::create_directories(d.path() / "images");
+  expectInputError([&] { loadDataset(d.str()); }, d.str(), "sparse model");
+  expectInputError([&] { loadDataset(d.str("nope")); }, "nope", "dataset");
+}
