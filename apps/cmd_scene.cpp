@@ -3,6 +3,7 @@
 
 #include "apps/commands.h"
 #include "apps/progress.h"
+#include "geometry/synth/assets.h"
 #include "geometry/synth/write_dataset.h"
 
 namespace saresgs::apps {
@@ -16,6 +17,8 @@ struct SceneArgs {
 };
 
 int runScene(SceneArgs& a) {
+  for (auto& m : a.scene.meshes) m = resolveAsset(m);
+  for (auto& t : a.scene.textures) t = resolveAsset(t);
   std::cerr << "building " << a.scene.layout << " scene (seed " << a.scene.seed << ")\n";
   const SyntheticScene scene = makeSyntheticScene(a.scene);
   Progress progress;
@@ -49,8 +52,8 @@ void addSceneCommand(CLI::App& app, Action& action) {
   sub->add_option("--height", args->scene.height, "Image height")->check(CLI::Range(16, 8192))->capture_default_str();
   sub->add_option("--seed", args->scene.seed, "Random seed")->capture_default_str();
   sub->add_option("--views", args->scene.num_views, "Number of views (0: the layout's default)");
-  sub->add_option("--mesh", args->scene.meshes, "Mesh files (OFF/PLY/OBJ) for the objects; default procedural");
-  sub->add_option("--texture", args->scene.textures, "Photographs (PNG/JPEG) for the objects; default procedural");
+  sub->add_option("--mesh", args->scene.meshes, "Mesh files (OFF/PLY/OBJ) or cgal:NAME; default procedural");
+  sub->add_option("--texture", args->scene.textures, "Photographs (PNG/JPEG) or opencv:FILE; default procedural");
   sub->add_option("--up", args->scene.up_axis, "Up axis of the mesh files")->check(CLI::IsMember({"x", "y", "z"}))->capture_default_str();
   sub->add_option("--projection", args->scene.projection, "Photograph mapping")
       ->check(CLI::IsMember({"triplanar", "spherical"}))->capture_default_str();

@@ -6,10 +6,10 @@
 #include <filesystem>
 #include <sys/wait.h>
 
-#include "common/temp_dir.h"
+#include "common/test_support.h"
 #include "geometry/scene/scene.h"
 
-using saresgs::testing::TempDir;
+using saresgs::test::TempDir;
 namespace fs = std::filesystem;
 
 namespace {
@@ -34,30 +34,30 @@ Result run(const std::string& args) {
 
 TEST(Cli, SceneWritesADatasetThatInfoReads) {
   TempDir d;
-  const Result r = run("scene --layout room360 --views 16 --width 64 --height 48 --out " + d.str("s"));
+  const Result r = run("scene --layout room360 --views 16 --width 64 --height 48 --out " + d.file("s"));
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("16 views"), std::string::npos) << r.output;
   EXPECT_TRUE(fs::exists(d.path() / "s" / "contact_sheet.png"));
-  const Result i = run("info --dataset " + d.str("s"));
+  const Result i = run("info --dataset " + d.file("s"));
   ASSERT_EQ(i.code, 0) << i.output;
   EXPECT_NE(i.output.find("16 with ground-truth depth"), std::string::npos) << i.output;
   // The summary's numbers are the library's.
-  const saresgs::Scene s = saresgs::loadDataset(d.str("s"));
+  const saresgs::Scene s = saresgs::loadDataset(d.file("s"));
   EXPECT_NE(i.output.find("points:  " + std::to_string(s.points.size())), std::string::npos) << i.output;
 }
 
 TEST(Cli, BadInputGivesAClearErrorAndNonZeroExit) {
   TempDir d;
-  Result r = run("info --dataset " + d.str("missing"));
+  Result r = run("info --dataset " + d.file("missing"));
   EXPECT_NE(r.code, 0);
-  EXPECT_NE(r.output.find(d.str("missing")), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(d.file("missing")), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("does not exist"), std::string::npos) << r.output;
 
-  r = run("scene --layout nowhere --out " + d.str("x"));
+  r = run("scene --layout nowhere --out " + d.file("x"));
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.output.find("--layout"), std::string::npos) << r.output;
 
-  r = run("scene --layout object --mesh " + d.str("no_such.off") + " --out " + d.str("x"));
+  r = run("scene --layout object --mesh " + d.file("no_such.off") + " --out " + d.file("x"));
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.output.find("no_such.off"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(d.path() / "x"));  // nothing half-written in place

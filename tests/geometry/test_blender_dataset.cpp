@@ -3,12 +3,12 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "common/temp_dir.h"
+#include "common/test_support.h"
 #include "geometry/error.h"
 #include "geometry/scene/scene.h"
 
 using namespace saresgs;
-using saresgs::testing::TempDir;
+using saresgs::test::TempDir;
 using nlohmann::json;
 
 namespace {
@@ -46,9 +46,9 @@ void writeSplit(const TempDir& d, const std::string& name, const std::string& su
     const double a = 0.7 * i;
     j["frames"].push_back({{"file_path", "./" + sub + "/r_" + std::to_string(i)},
                            {"transform_matrix", glPose(Eigen::Vector3d(4 * std::cos(a), 4 * std::sin(a), 1.5))}});
-    writeRgba(d.str(sub + "/r_" + std::to_string(i) + ".png"), 40, 30, 128);
+    writeRgba(d.file(sub + "/r_" + std::to_string(i) + ".png"), 40, 30, 128);
   }
-  std::ofstream(d.str(name)) << j.dump(2);
+  std::ofstream(d.file(name)) << j.dump(2);
 }
 
 }  // namespace
@@ -95,18 +95,12 @@ TEST(BlenderDataset, DownscaleResizesOnLoad) {
 
 TEST(BlenderDataset, ErrorsNameFileAndField) {
   auto expectError = [](const std::string& dir, const std::string& file_part, const std::string& field) {
-    try {
-      loadDataset(dir);
-      FAIL() << "no error for " << field;
-    } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find(file_part), std::string::npos) << e.what();
-      EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
-    }
+    EXPECT_TRUE(test::throwsInputError([&] { loadDataset(dir); }, file_part, field));
   };
   {
     TempDir d;
     writeSplit(d, "transforms_train.json", "train", 2);
-    std::filesystem::remove(d.str("train/r_1.png"));
+    std::filesystem::remove(d.file("train/r_1.png"));
     expectError(d.str(), "r_1", "frames[1].file_path");
   }
   {
@@ -117,15 +111,15 @@ TEST(BlenderDataset, ErrorsNameFileAndField) {
   {
     TempDir d;
     writeSplit(d, "transforms_train.json", "train", 1);
-    std::ofstream(d.str("transforms_train.json")) << "{\"camera_angle_x\": 0.7, \"frames\": [";
+    std::ofstream(d.file("transforms_train.json")) << "{\"camera_angle_x\": 0.7, \"frames\": [";
     expectError(d.str(), "transforms_train.json", "json");
   }
   {
     TempDir d;
     writeSplit(d, "transforms_train.json", "train", 1);
-    json j = json::parse(std::ifstream(d.str("transforms_train.json")));
+    json j = json::parse(std::ifstream(d.file("transforms_train.json")));
     j["frames"][0]["transform_matrix"][0][3] = std::nan("");  // json writes NaN as null
-    std::ofstream(d.str("transforms_train.json")) << j.dump();
+    std::ofstream(d.file("transforms_train.json")) << j.dump();
     expectError(d.str(), "transforms_train.json", "transform_matrix");
   }
 }

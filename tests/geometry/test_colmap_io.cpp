@@ -10,7 +10,7 @@
 
 #include "geometry/error.h"
 #include "geometry/io/colmap.h"
-#include "test_support.h"
+#include "common/test_support.h"
 
 using namespace saresgs;
 using saresgs::test::readBytes;

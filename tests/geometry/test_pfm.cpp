@@ -7,7 +7,7 @@
 
 #include "geometry/error.h"
 #include "geometry/io/pfm.h"
-#include "test_support.h"
+#include "common/test_support.h"
 
 using namespace saresgs;
 using saresgs::test::readBytes;
