@@ -17,16 +17,17 @@ void writeStreamAtomic(const std::string& path, const std::function<void(std::os
   const fs::path target(path);
   if (target.has_parent_path()) fs::create_directories(target.parent_path());
   const fs::path tmp = target.string() + ".tmp." + std::to_string(::getpid());
-  {
+  try {
     std::ofstream out(tmp, binary ? std::ios::binary | std::ios::trunc : std::ios::trunc);
     if (!out) throw std::runtime_error(tmp.string() + ": cannot open for writing");
     write(out);
     out.flush();
-    if (!out) {
-      out.close();
-      fs::remove(tmp);
-      throw std::runtime_error(path + ": write failed (disk full?)");
-    }
+    if (!out) throw std::runtime_error(path + ": write failed (disk full?)");
+  } catch (...) {
+    // Nothing half-written is left behind, whatever went wrong.
+    std::error_code ec;
+    fs::remove(tmp, ec);
+    throw;
   }
   fs::rename(tmp, target);
 }
