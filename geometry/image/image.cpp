@@ -56,8 +56,13 @@ void writeImage(const std::string& path, const Image8& img) {
   else bgr = m;
   const std::string ext = std::filesystem::path(path).extension().string();
   std::vector<std::uint8_t> bytes;
-  if (!cv::imencode(ext, bgr, bytes))
-    throw InputError(path, "extension", "expected .png or .jpg to encode the image");
+  bool encoded = false;
+  try {
+    encoded = cv::imencode(ext, bgr, bytes);
+  } catch (const cv::Exception&) {
+    encoded = false;  // OpenCV throws for an extension it has no encoder for
+  }
+  if (!encoded) throw InputError(path, "extension", "expected .png or .jpg to encode the image");
   writeFileAtomic(path, std::string(bytes.begin(), bytes.end()));
 }
 
