@@ -236,7 +236,7 @@ LayoutResult makeObjectLayout(const Assets& assets, int width, int height, std::
   }
   const int n = num_views > 0 ? num_views : 150;
   const int n_train = num_views > 0 ? static_cast<int>(std::lround(n * 2.0 / 3.0)) : 100;
-  const Intrinsics K = layoutIntrinsics(width, height, 40.0);
+  const Intrinsics K = layoutIntrinsics(width, height, 36.0);
   Rng rng(seed ^ 0x0B1EC7ull);
   const double s_lo = std::sin(10 * kPi / 180), s_hi = std::sin(80 * kPi / 180);
   for (int i = 0; i < n; ++i) {

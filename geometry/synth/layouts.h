@@ -1,7 +1,8 @@
 #pragma once
 // The three camera layouts of the synthetic scenes and the objects placed in each
 // (internal to geometry/synth; the public entry point is makeSyntheticScene).
-//   object     one object (procedural: a bumpy marble blob with a striped ring around it;
+//   object     one object (procedural: three parts, a bumpy marble blob, a striped ring around
+//              it and a dotted ball on top;
 //              or the first mesh file) at the origin, radius 1; 100 train + 50 test
 //              cameras at distance 4 on the upper hemisphere (elevation 10..80 degrees),
 //              drawn at random (area-uniform) from the seed: train = the first 100, test =
