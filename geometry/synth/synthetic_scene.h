@@ -9,6 +9,14 @@
 //              stretches, several objects and occluders, ~150 images, every 8th a test view.
 // With no mesh or texture files given, every layout uses procedural objects and
 // procedural textures (the built-in scene needs no files).
+// Splits: object: train = the first 100 views, test = the last 50 (drawn independently,
+// so test positions differ from train; with num_views = n: the first round(2n/3) train);
+// room360 and unbalanced: index % 8 == 0 is a test view, the rest train.
+// Files: mesh files replace the content objects (object layout: the first file only;
+// rooms: cycled over the objects), normalised to unit radius with opts.up_axis turned to
+// +z; photographs replace the content objects' textures (cycled). The room's faces,
+// pillars and partition always keep their procedural textures. Implementation:
+// procedural_meshes, texture, ray_tracer, layouts, synthetic_scene (.h/.cpp here).
 #include <Eigen/Core>
 #include <cstdint>
 #include <limits>

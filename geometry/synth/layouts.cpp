@@ -1,0 +1,403 @@
+#include "geometry/synth/layouts.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include "geometry/synth/noise.h"
+#include "geometry/synth/procedural_meshes.h"
+
+namespace saresgs::synth {
+
+namespace {
+
+using Eigen::Vector2f;
+using Eigen::Vector3d;
+using Eigen::Vector3f;
+constexpr double kPi = std::numbers::pi;
+
+// Uniform doubles from the raw 64-bit engine output: the same on every standard library.
+struct Rng {
+  std::mt19937_64 g;
+  explicit Rng(std::uint64_t seed) : g(mix64(seed)) {}
+  double uniform() { return static_cast<double>(g() >> 11) * 0x1.0p-53; }
+  double uniform(double a, double b) { return a + (b - a) * uniform(); }
+  // Uniform in the unit disc (rejection sampling).
+  Eigen::Vector2d disc() {
+    for (;;) {
+      const Eigen::Vector2d p(uniform(-1, 1), uniform(-1, 1));
+      if (p.squaredNorm() <= 1) return p;
+    }
+  }
+};
+
+// A procedural content object before placement: its mesh in a design frame (any size;
+// it is normalised to unit radius) and its texture in that normalised frame.
+struct ContentSpec {
+  std::string name;
+  std::string kind;  // "torus", "box", ...
+  TriangleMesh mesh;
+  std::shared_ptr<const Texture> texture;
+};
+
+// The mesh and texture for content slot `slot`: the user's files when given (cycled),
+// else the procedural ones. The mesh comes back normalised to unit radius.
+void resolveContent(const Assets& assets, int slot, ContentSpec& spec, std::string& mesh_source) {
+  if (!assets.meshes.empty()) {
+    const std::size_t k = static_cast<std::size_t>(slot) % assets.meshes.size();
+    spec.mesh = assets.meshes[k];
+    mesh_source = assets.mesh_paths[k];
+  } else {
+    normaliseMesh(spec.mesh, 1.0f);
+    mesh_source = "procedural:" + spec.kind;
+  }
+  if (!assets.photos.empty()) {
+    const std::size_t k = static_cast<std::size_t>(slot) % assets.photos.size();
+    spec.texture = makeImageTexture(assets.photos[k], assets.projection, 1.0f,
+                                    assets.photo_paths[k]);
+  }
+}
+
+// Places a content object on the floor: scaled to radius `size`, turned by `yaw` about
+// z, its lowest point on z = floor_z, its bounding-sphere centre above (x, y).
+SceneObject placeOnFloor(const Assets& assets, int slot, ContentSpec spec, const Vector2f& xy,
+                         float floor_z, float size, float yaw) {
+  std::string source;
+  resolveContent(assets, slot, spec, source);
+  const float min_z = boundingBox(spec.mesh).min().z();
+  Eigen::Affine3f T = Eigen::Affine3f::Identity();
+  T.translate(Vector3f(xy.x(), xy.y(), floor_z - size * min_z));
+  T.rotate(Eigen::AngleAxisf(yaw, Vector3f::UnitZ()));
+  T.scale(size);
+  SceneObject o;
+  o.name = spec.name;
+  o.mesh_source = source;
+  o.mesh = transformed(spec.mesh, T);
+  o.to_world = T;
+  o.texture = spec.texture;
+  return o;
+}
+
+// An object given directly in world coordinates (room faces, pillars): local = world.
+SceneObject fixedObject(std::string name, std::string kind, TriangleMesh mesh,
+                        std::shared_ptr<const Texture> texture, bool casts_shadow) {
+  SceneObject o;
+  o.name = std::move(name);
+  o.mesh_source = "procedural:" + kind;
+  o.mesh = std::move(mesh);
+  o.texture = std::move(texture);
+  o.casts_shadow = casts_shadow;
+  return o;
+}
+
+struct RoomTextures {
+  std::shared_ptr<const Texture> floor, ceiling, xlo, xhi, ylo, yhi;
+};
+
+void addRoom(LayoutResult& out, const Vector3f& lo, const Vector3f& hi, const RoomTextures& t) {
+  RoomFaces r = makeRoom(lo, hi, 1);
+  out.objects.push_back(fixedObject("room_floor", "room_floor", std::move(r.floor), t.floor, false));
+  out.objects.push_back(
+      fixedObject("room_ceiling", "room_ceiling", std::move(r.ceiling), t.ceiling, false));
+  out.objects.push_back(fixedObject("room_wall_xlo", "room_wall", std::move(r.wall_xlo), t.xlo, false));
+  out.objects.push_back(fixedObject("room_wall_xhi", "room_wall", std::move(r.wall_xhi), t.xhi, false));
+  out.objects.push_back(fixedObject("room_wall_ylo", "room_wall", std::move(r.wall_ylo), t.ylo, false));
+  out.objects.push_back(fixedObject("room_wall_yhi", "room_wall", std::move(r.wall_yhi), t.yhi, false));
+  out.room = Eigen::AlignedBox3f(lo, hi);
+}
+
+// The procedural content objects shared by the room layouts, in the order the
+// layouts place them. Texture parameters refer to the unit-radius frame.
+ContentSpec contentSpec(const std::string& kind, std::uint64_t seed) {
+  ContentSpec s;
+  s.kind = kind;
+  s.name = kind;
+  if (kind == "blob") {
+    s.mesh = makeBumpyBlob(1.0f, 0.22f, 1.6f, seed, 96, 48);
+    s.texture = makeMarble(1.2f, rgb(120, 190, 120), rgb(30, 70, 40), seed + 1);
+  } else if (kind == "crate") {
+    s.mesh = makeBox(Vector3f(-0.5f, -0.5f, -0.5f), Vector3f(0.5f, 0.5f, 0.5f), 1);
+    s.texture = makeChecker(0.29f, rgb(230, 200, 60), rgb(40, 60, 150), seed + 2);
+  } else if (kind == "ball") {
+    s.mesh = makeSphere(1.0f, 96, 48);
+    s.texture = makeDots(0.42f, 0.14f, rgb(235, 235, 225), rgb(200, 40, 40), seed + 3);
+  } else if (kind == "donut") {
+    // Standing upright: the ring axis is horizontal.
+    const TriangleMesh t = makeTorus(0.7f, 0.3f, 96, 48);
+    Eigen::Affine3f R(Eigen::AngleAxisf(static_cast<float>(kPi / 2), Vector3f::UnitX()));
+    s.mesh = transformed(t, R);
+    s.texture = makeStripes(Vector3f(1, 0.2f, 0), 0.14f, rgb(240, 150, 170), rgb(250, 240, 230),
+                            rgb(150, 90, 60), seed + 4);
+  } else if (kind == "column") {
+    s.mesh = makeCylinder(0.3f, 1.4f, 96);
+    s.texture = makeWood(Vector3f(0.05f, 0.0f, 1.0f), Vector3f(0.9f, 0.4f, 0.0f), 0.07f,
+                         rgb(215, 170, 110), rgb(120, 70, 35), seed + 5);
+  } else if (kind == "cone") {
+    s.mesh = makeCone(0.5f, 1.0f, 96);
+    s.texture = makeStripes(Vector3f(0, 0, 1), 0.16f, rgb(60, 160, 210), rgb(245, 245, 240),
+                            rgb(250, 170, 40), seed + 6);
+  } else {  // "superquadric"
+    s.mesh = makeSuperquadric(Vector3f(1.0f, 0.8f, 0.6f), 0.45f, 0.45f, 96, 48);
+    s.texture = makeTiles(0.3f, 0.03f, rgb(200, 90, 200), rgb(250, 230, 250), rgb(60, 50, 60),
+                          seed + 7);
+  }
+  return s;
+}
+
+std::vector<int> everyEighthTest(int n, std::vector<int>& train) {
+  std::vector<int> test;
+  for (int i = 0; i < n; ++i) (i % 8 == 0 ? test : train).push_back(i);
+  return test;
+}
+
+Camera lookAtf(const Intrinsics& K, const Vector3d& eye, const Vector3d& target) {
+  return Camera::lookAt(K, eye, target, Vector3d::UnitZ());
+}
+
+// Splits `total` into parts proportional to `weights` (largest remainders, each >= 0).
+std::vector<int> apportion(const std::vector<double>& weights, int total) {
+  double sum = 0;
+  for (double w : weights) sum += w;
+  std::vector<int> out(weights.size());
+  std::vector<std::pair<double, std::size_t>> rem;
+  int used = 0;
+  for (std::size_t i = 0; i < weights.size(); ++i) {
+    const double exact = weights[i] / sum * total;
+    out[i] = static_cast<int>(std::floor(exact));
+    used += out[i];
+    rem.emplace_back(exact - out[i], i);
+  }
+  std::stable_sort(rem.begin(), rem.end(), [](auto& a, auto& b) { return a.first > b.first; });
+  for (std::size_t k = 0; used < total; ++k, ++used) ++out[rem[k % rem.size()].second];
+  return out;
+}
+
+}  // namespace
+
+Intrinsics layoutIntrinsics(int width, int height, double fov_deg) {
+  Intrinsics K;
+  K.width = width;
+  K.height = height;
+  const double f = 0.5 * std::min(width, height) / std::tan(0.5 * fov_deg * kPi / 180.0);
+  K.fx = K.fy = f;
+  K.cx = 0.5 * width;
+  K.cy = 0.5 * height;
+  return K;
+}
+
+LayoutResult makeObjectLayout(const Assets& assets, int width, int height, std::uint64_t seed,
+                              int num_views) {
+  LayoutResult out;
+  if (!assets.meshes.empty()) {
+    ContentSpec spec;
+    spec.name = "object";
+    spec.kind = "mesh";
+    spec.texture = makeMarble(1.5f, rgb(235, 215, 180), rgb(110, 60, 35), mix64(seed) + 1);
+    std::string source;
+    resolveContent(assets, 0, spec, source);
+    out.objects.push_back(fixedObject("object", "", spec.mesh, spec.texture, true));
+    out.objects.back().mesh_source = source;
+  } else {
+    // A compound toy: a bumpy marble blob with a tilted striped ring around it and a
+    // small dotted ball on top, normalised together to radius 1 about the origin.
+    const std::uint64_t s = mix64(seed);
+    const TriangleMesh blob = makeBumpyBlob(0.62f, 0.2f, 1.8f, s, 128, 64);
+    Eigen::Affine3f ring_T = Eigen::Affine3f::Identity();
+    ring_T.rotate(Eigen::AngleAxisf(0.45f, Vector3f(1, 0.3f, 0).normalized()));
+    const TriangleMesh ring = transformed(makeTorus(0.82f, 0.1f, 128, 32), ring_T);
+    Eigen::Affine3f ball_T(Eigen::Translation3f(0.05f, -0.05f, 0.7f));
+    const TriangleMesh ball = transformed(makeSphere(0.2f, 64, 32), ball_T);
+    TriangleMesh all = blob;
+    appendMesh(all, ring);
+    appendMesh(all, ball);
+    TriangleMesh probe = all;
+    const Eigen::Affine3f N = normaliseMesh(probe, 1.0f);
+    auto part = [&](const char* name, const char* kind, const TriangleMesh& m,
+                    std::shared_ptr<const Texture> tex, const Eigen::Affine3f& local_to_design) {
+      SceneObject o = fixedObject(name, kind, transformed(m, N), std::move(tex), true);
+      // The texture frame is the part's own frame before it was moved into the compound.
+      o.to_world = N * local_to_design;
+      out.objects.push_back(std::move(o));
+    };
+    part("blob", "bumpy_blob", blob, makeMarble(1.6f, rgb(240, 200, 140), rgb(150, 50, 30), s + 1),
+         Eigen::Affine3f::Identity());
+    part("ring", "torus", ring,
+         makeStripes(Vector3f(1, 0.1f, 0.2f), 0.09f, rgb(40, 90, 200), rgb(245, 245, 245),
+                     rgb(220, 60, 50), s + 2),
+         ring_T);
+    part("cap", "sphere", ball, makeDots(0.11f, 0.035f, rgb(60, 170, 90), rgb(250, 240, 120), s + 3),
+         ball_T);
+    for (std::size_t k = 0; k < out.objects.size() && !assets.photos.empty(); ++k) {
+      const std::size_t p = k % assets.photos.size();
+      out.objects[k].texture =
+          makeImageTexture(assets.photos[p], assets.projection, 1.0f, assets.photo_paths[p]);
+    }
+  }
+  const int n = num_views > 0 ? num_views : 150;
+  const int n_train = num_views > 0 ? static_cast<int>(std::lround(n * 2.0 / 3.0)) : 100;
+  const Intrinsics K = layoutIntrinsics(width, height, 36.0);
+  Rng rng(seed ^ 0x0B1EC7ull);
+  const double s_lo = std::sin(10 * kPi / 180), s_hi = std::sin(80 * kPi / 180);
+  for (int i = 0; i < n; ++i) {
+    const double az = rng.uniform(0, 2 * kPi);
+    const double el = std::asin(rng.uniform(s_lo, s_hi));  // area-uniform in the band
+    const Vector3d eye = 4.0 * Vector3d(std::cos(el) * std::cos(az),
+                                        std::cos(el) * std::sin(az), std::sin(el));
+    out.cameras.push_back(lookAtf(K, eye, Vector3d::Zero()));
+    (i < n_train ? out.train : out.test).push_back(i);
+  }
+  return out;
+}
+
+LayoutResult makeRoom360Layout(const Assets& assets, int width, int height, std::uint64_t seed,
+                               int num_views) {
+  LayoutResult out;
+  const std::uint64_t s = mix64(seed + 360);
+  RoomTextures rt;
+  rt.floor = makePlanks(0.22f, 1.3f, rgb(205, 155, 100), rgb(120, 72, 38), s + 10);
+  rt.ceiling = makeSpeckle(1.5f, rgb(235, 232, 222), rgb(150, 150, 140), s + 11);
+  rt.xlo = makeBricks(0.26f, 0.11f, 0.018f, rgb(165, 72, 48), rgb(205, 200, 190), s + 12);
+  rt.xhi = makeStripes(Vector3f(0, 1, 0), 0.18f, rgb(110, 160, 100), rgb(238, 232, 200),
+                       rgb(70, 110, 70), s + 13);
+  rt.ylo = makeTiles(0.4f, 0.025f, rgb(70, 120, 190), rgb(235, 240, 245), rgb(90, 90, 95), s + 14);
+  rt.yhi = makeMarble(0.8f, rgb(228, 230, 238), rgb(70, 75, 105), s + 15);
+  addRoom(out, Vector3f(-4, -4, 0), Vector3f(4, 4, 4), rt);
+
+  Rng rng(seed ^ 0x360360ull);
+  // One object in the middle, five on a ring of radius 1.35 (sizes are bounding radii,
+  // so neighbours cannot touch: the smallest gap is kept positive by construction).
+  out.objects.push_back(placeOnFloor(assets, 0, contentSpec("blob", s), Vector2f(0, 0), 0.0f,
+                                     0.5f, static_cast<float>(rng.uniform(0, 2 * kPi))));
+  const char* kinds[5] = {"crate", "ball", "donut", "column", "cone"};
+  const float sizes[5] = {0.55f, 0.45f, 0.55f, 0.7f, 0.6f};
+  const double phase = rng.uniform(0, 2 * kPi);
+  for (int k = 0; k < 5; ++k) {
+    const double a = phase + 2 * kPi * k / 5 + rng.uniform(-1, 1) * 5 * kPi / 180;
+    const Vector2f xy(static_cast<float>(1.35 * std::cos(a)), static_cast<float>(1.35 * std::sin(a)));
+    out.objects.push_back(placeOnFloor(assets, k + 1, contentSpec(kinds[k], s + 100 * (k + 1)),
+                                       xy, 0.0f, sizes[k],
+                                       static_cast<float>(rng.uniform(0, 2 * kPi))));
+  }
+
+  const int n = num_views > 0 ? num_views : 150;
+  const Intrinsics K = layoutIntrinsics(width, height, 55.0);
+  const double pr = rng.uniform(0, 2 * kPi), ph = rng.uniform(0, 2 * kPi);
+  const double start = rng.uniform(0, 2 * kPi);
+  for (int i = 0; i < n; ++i) {
+    const double phi = start + 2 * kPi * (i + rng.uniform(-0.3, 0.3)) / n;
+    const double r = 3.0 * (1.0 + 0.2 * std::sin(3 * phi + pr));
+    const double h = 1.6 + 0.6 * std::sin(5 * phi + ph);
+    const Vector3d eye(r * std::cos(phi), r * std::sin(phi), h);
+    const Vector3d target(rng.uniform(-0.3, 0.3), rng.uniform(-0.3, 0.3), 0.5 + rng.uniform(-0.15, 0.15));
+    out.cameras.push_back(lookAtf(K, eye, target));
+  }
+  out.test = everyEighthTest(n, out.train);
+  return out;
+}
+
+LayoutResult makeUnbalancedLayout(const Assets& assets, int width, int height,
+                                  std::uint64_t seed, int num_views) {
+  LayoutResult out;
+  const std::uint64_t s = mix64(seed + 777);
+  RoomTextures rt;
+  rt.floor = makeTiles(0.5f, 0.03f, rgb(200, 195, 185), rgb(110, 105, 100), rgb(60, 55, 50), s + 10);
+  rt.ceiling = makeSpeckle(1.2f, rgb(240, 238, 230), rgb(170, 165, 155), s + 11);
+  rt.xlo = makeStripes(Vector3f(0, 1, 0.15f), 0.25f, rgb(210, 120, 80), rgb(245, 225, 190),
+                       rgb(160, 70, 60), s + 12);
+  rt.xhi = makePlanks(0.18f, 1.6f, rgb(190, 150, 105), rgb(100, 65, 40), s + 13);
+  rt.ylo = makeBricks(0.3f, 0.12f, 0.02f, rgb(200, 170, 100), rgb(90, 85, 80), s + 14);
+  rt.yhi = makeMarble(0.9f, rgb(190, 215, 210), rgb(40, 80, 80), s + 15);
+  addRoom(out, Vector3f(-5, -3.5f, 0), Vector3f(5, 3.5f, 3.2f), rt);
+
+  Rng rng(seed ^ 0xBADBA1ull);
+  struct Slot {
+    const char* kind;
+    Vector2f xy;
+    float size;
+  };
+  const Slot slots[5] = {{"ball", {-3.0f, -2.2f}, 0.45f},
+                         {"crate", {-3.0f, 2.1f}, 0.55f},
+                         {"donut", {0.2f, 0.9f}, 0.55f},
+                         {"cone", {3.3f, 2.2f}, 0.6f},
+                         {"superquadric", {3.3f, -2.2f}, 0.55f}};
+  std::vector<Vector3d> centres;  // look-at points of the objects
+  for (int k = 0; k < 5; ++k) {
+    out.objects.push_back(placeOnFloor(assets, k, contentSpec(slots[k].kind, s + 100 * (k + 1)),
+                                       slots[k].xy, 0.0f, slots[k].size,
+                                       static_cast<float>(rng.uniform(0, 2 * kPi))));
+    centres.push_back(boundingBox(out.objects.back().mesh).center().cast<double>());
+  }
+  // Occluders: two floor-to-ceiling pillars and a partition wall.
+  {
+    Eigen::Affine3f T(Eigen::Translation3f(-1.3f, 0.3f, 0.0f));
+    out.objects.push_back(fixedObject("pillar_round", "cylinder",
+                                      transformed(makeCylinder(0.3f, 3.2f, 64), T),
+                                      makeSpeckle(3.0f, rgb(175, 175, 170), rgb(90, 90, 95), s + 20), true));
+    out.objects.push_back(fixedObject(
+        "pillar_square", "box", makeBox(Vector3f(1.45f, 0.15f, 0.0f), Vector3f(1.95f, 0.65f, 3.2f), 1),
+        makeBricks(0.22f, 0.09f, 0.015f, rgb(150, 60, 45), rgb(215, 210, 200), s + 21), true));
+    out.objects.push_back(fixedObject(
+        "partition", "box", makeBox(Vector3f(-0.9f, -0.375f, 0.0f), Vector3f(0.5f, -0.225f, 1.8f), 1),
+        makeChecker(0.2f, rgb(240, 240, 235), rgb(50, 50, 55), s + 22), true));
+  }
+
+  // The walk: four clusters (dense, nearly similar views of one object each) joined by
+  // sparse stretches that look ahead along the way.
+  struct Cluster {
+    Vector3d centre;
+    int target;  // index into `centres`
+    double weight;
+  };
+  const Cluster clusters[4] = {{{-1.2, -1.4, 1.5}, 0, 36},
+                               {{1.2, -1.5, 1.4}, 4, 26},
+                               {{2.6, 2.0, 1.6}, 2, 34},
+                               {{-1.5, 2.2, 1.5}, 1, 30}};
+  // Stretch k runs from cluster k to cluster k+1 (the last one back towards the first)
+  // through the given via points, which keep it clear of the pillars.
+  const std::vector<std::vector<Vector3d>> stretches = {
+      {clusters[0].centre, clusters[1].centre},
+      {clusters[1].centre, {3.3, 0.0, 1.5}, clusters[2].centre},
+      {clusters[2].centre, clusters[3].centre},
+      {clusters[3].centre, {-2.4, 0.3, 1.5}, {-1.9, -0.7, 1.5}}};
+  const int n = num_views > 0 ? num_views : 150;
+  std::vector<double> weights;
+  for (int k = 0; k < 4; ++k) {
+    weights.push_back(clusters[k].weight);
+    weights.push_back(6);
+  }
+  const std::vector<int> counts = apportion(weights, n);
+  const Intrinsics K = layoutIntrinsics(width, height, 60.0);
+  for (int k = 0; k < 4; ++k) {
+    const Cluster& c = clusters[k];
+    for (int i = 0; i < counts[2 * k]; ++i) {
+      const Eigen::Vector2d d = rng.disc() * 0.18;
+      const Vector3d eye = c.centre + Vector3d(d.x(), d.y(), rng.uniform(-0.12, 0.12));
+      const Eigen::Vector2d e = rng.disc() * 0.25;
+      const Vector3d target = centres[c.target] + Vector3d(e.x(), e.y(), rng.uniform(-0.1, 0.1));
+      out.cameras.push_back(lookAtf(K, eye, target));
+    }
+    // The stretch: evenly spaced by arc length along its polyline, ends excluded.
+    const auto& poly = stretches[k];
+    std::vector<double> cum{0};
+    for (std::size_t j = 1; j < poly.size(); ++j)
+      cum.push_back(cum.back() + (poly[j] - poly[j - 1]).norm());
+    const int m = counts[2 * k + 1];
+    for (int i = 0; i < m; ++i) {
+      const double len = cum.back() * (i + 1) / (m + 1);
+      std::size_t j = 1;
+      while (j + 1 < poly.size() && cum[j] < len) ++j;
+      const double t = (len - cum[j - 1]) / (cum[j] - cum[j - 1]);
+      Vector3d eye = poly[j - 1] + t * (poly[j] - poly[j - 1]);
+      eye.z() += 0.15 * std::sin(3.0 * len) + rng.uniform(-0.05, 0.05);
+      Vector3d ahead = (poly[j] - poly[j - 1]).normalized();
+      ahead = Eigen::AngleAxisd(rng.uniform(-0.5, 0.5), Vector3d::UnitZ()) * ahead;
+      const Vector3d target = eye + 2.5 * ahead + Vector3d(0, 0, -0.8 + rng.uniform(-0.2, 0.2));
+      out.cameras.push_back(lookAtf(K, eye, target));
+    }
+  }
+  out.test = everyEighthTest(static_cast<int>(out.cameras.size()), out.train);
+  return out;
+}
+
+}  // namespace saresgs::synth
