@@ -316,11 +316,14 @@ void readPoints(const std::string& dir, ColmapModel& model) {
   file.checkCount(model.points.size());
 }
 
-// Shortest representation that reads back to the same double (std::to_chars
-// guarantees the round trip), so a text round trip is exact.
+// 17 significant digits: enough for any double to read back exactly, and close enough
+// to the double (within ~0.05 ulp) that COLMAP, which parses with std::stold and then
+// rounds to double, gets the same double too. The shortest round-trip form is not: it
+// can sit near a rounding midpoint, where that double rounding drifts by 1 ulp (seen
+// with `colmap model_converter`).
 void putDouble(std::ostream& o, double v) {
-  char buf[32];
-  const auto res = std::to_chars(buf, buf + sizeof(buf), v);
+  char buf[40];
+  const auto res = std::to_chars(buf, buf + sizeof(buf), v, std::chars_format::general, 17);
   o.write(buf, res.ptr - buf);
 }
 

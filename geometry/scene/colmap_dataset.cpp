@@ -1,8 +1,12 @@
 // A COLMAP folder as a Scene: sparse model + images/ (or images_<f>/) [+ depth/].
 #include <algorithm>
 #include <filesystem>
+#include <map>
+
+#include <nlohmann/json.hpp>
 
 #include "geometry/error.h"
+#include "geometry/io/atomic_file.h"
 #include "geometry/io/colmap.h"
 #include "geometry/scene/colmap_convert.h"
 #include "geometry/scene/scene.h"
@@ -28,6 +32,37 @@ std::string findModelDir(const fs::path& root, const std::string& requested) {
 std::string modelFile(const std::string& dir, const char* stem) {
   const fs::path bin = fs::path(dir) / (std::string(stem) + ".bin");
   return (fs::exists(bin) ? bin : fs::path(dir) / (std::string(stem) + ".txt")).string();
+}
+
+// A dataset written by `saresgs scene` names its split in manifest.json ("split":
+// {"train": [names], "test": [names]}); it wins over the every-N-th rule.
+bool readManifestSplit(const fs::path& manifest, Scene& scene) {
+  if (!fs::exists(manifest)) return false;
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(readFile(manifest.string()));
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(manifest.string(), "json", std::string("not valid JSON: ") + e.what());
+  }
+  if (!j.contains("split")) return false;
+  std::map<std::string, int> index;
+  for (int i = 0; i < static_cast<int>(scene.views.size()); ++i) index[scene.views[i].name] = i;
+  for (const char* part : {"train", "test"}) {
+    const auto& names = j["split"].value(part, nlohmann::json::array());
+    if (!names.is_array()) throw InputError(manifest.string(), std::string("split.") + part, "expected an array of image names");
+    auto& out = std::string(part) == "train" ? scene.train : scene.test;
+    for (const auto& n : names) {
+      const auto it = n.is_string() ? index.find(n.get<std::string>()) : index.end();
+      if (it == index.end())
+        throw InputError(manifest.string(), std::string("split.") + part,
+                         "names " + n.dump() + ", which is not an image of the model");
+      out.push_back(it->second);
+    }
+  }
+  std::sort(scene.train.begin(), scene.train.end());
+  std::sort(scene.test.begin(), scene.test.end());
+  if (scene.train.empty()) throw InputError(manifest.string(), "split.train", "expected at least one train image");
+  return true;
 }
 
 }  // namespace
@@ -109,9 +144,11 @@ Scene loadColmapDataset(const std::string& path, const DatasetOptions& opts) {
     if (fs::exists(depth)) v.depth_path = depth.string();
     scene.views.push_back(std::move(v));
   }
-  for (int i = 0; i < static_cast<int>(scene.views.size()); ++i)
-    ((opts.test_every > 0 && i % opts.test_every == 0) ? scene.test : scene.train).push_back(i);
-  if (scene.train.empty()) scene.train.swap(scene.test);  // a single view trains
+  if (!readManifestSplit(root / "manifest.json", scene)) {
+    for (int i = 0; i < static_cast<int>(scene.views.size()); ++i)
+      ((opts.test_every > 0 && i % opts.test_every == 0) ? scene.test : scene.train).push_back(i);
+    if (scene.train.empty()) scene.train.swap(scene.test);  // a single view trains
+  }
 
   scene.points.reserve(model.points.size());
   for (const auto& [id, p] : model.points) scene.points.push_back({p.xyz, p.rgb});

@@ -122,8 +122,11 @@ WriteDatasetReport writeSyntheticDataset(const SyntheticScene& scene, const std:
   }
 
   nlohmann::json manifest = scene.manifest;
-  manifest["train"] = scene.train;
-  manifest["test"] = scene.test;
+  // The split by image name: the loader honours it instead of its every-8th rule.
+  nlohmann::json split = {{"train", nlohmann::json::array()}, {"test", nlohmann::json::array()}};
+  for (int i : scene.train) split["train"].push_back(scene.names[i]);
+  for (int i : scene.test) split["test"].push_back(scene.names[i]);
+  manifest["split"] = split;
   manifest["depth"] = {{"format", "pfm"}, {"convention", "z along the camera axis; 0 where a ray misses"}};
   manifest["render"] = {{"samples_per_pixel", opts.render.samples_per_pixel},
                         {"specular", opts.render.specular}};

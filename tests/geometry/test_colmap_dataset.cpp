@@ -149,3 +149,15 @@ TEST(ColmapDataset, MissingModelSaysWhatWasExpected) {
   EXPECT_TRUE(test::throwsInputError([&] { loadDataset(d.str()); }, d.str(), "sparse model"));
   EXPECT_TRUE(test::throwsInputError([&] { loadDataset(d.file("nope")); }, "nope", "dataset"));
 }
+
+TEST(ColmapDataset, ManifestSplitWinsOverTheEveryEighthRule) {
+  TempDir d;
+  writeDataset(d, 6);
+  test::writeBytes(d.file("manifest.json"),
+                   R"({"split": {"train": ["img_1000.png", "img_1002.png", "img_1003.png", "img_1004.png", "img_1005.png"], "test": ["img_1001.png"]}})");
+  const Scene s = loadDataset(d.str());
+  EXPECT_EQ(s.test, (std::vector<int>{1}));
+  EXPECT_EQ(s.train, (std::vector<int>{0, 2, 3, 4, 5}));
+  test::writeBytes(d.file("manifest.json"), R"({"split": {"train": ["nope.png"], "test": []}})");
+  EXPECT_TRUE(test::throwsInputError([&] { loadDataset(d.str()); }, "manifest.json", "split.train"));
+}

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <unistd.h>
 #include <filesystem>
+#include <iomanip>
 
 #include "common/test_support.h"
 #include "geometry/io/colmap.h"
@@ -47,7 +48,8 @@ void expectSameModel(const ColmapModel& a, const ColmapModel& b) {
     EXPECT_EQ(im.q.coeffs(), jm.q.coeffs());
     EXPECT_EQ(im.t, jm.t);
     ASSERT_EQ(im.xys.size(), jm.xys.size());
-    for (size_t k = 0; k < im.xys.size(); ++k) EXPECT_EQ(im.xys[k], jm.xys[k]);
+    for (size_t k = 0; k < im.xys.size(); ++k)
+      EXPECT_EQ(im.xys[k], jm.xys[k]) << std::setprecision(17) << im.xys[k].transpose() << " vs " << jm.xys[k].transpose();
     EXPECT_EQ(im.point3d_ids, jm.point3d_ids);
   }
   ASSERT_EQ(a.points.size(), b.points.size());
@@ -122,7 +124,10 @@ TEST_P(SyntheticDataset, ReadsBackIdenticallyAndColmapAgrees) {
   sim.seed = o.seed;
   simulateSfm(scene, expected, sim);  // deterministic: the same points again
   const ColmapModel text = readColmapModel(d.file("ds/sparse/0"));
-  expectSameModel(expected, text);
+  {
+    SCOPED_TRACE("generated vs written text");
+    expectSameModel(expected, text);
+  }
   const Scene s = loadDataset(d.file("ds"));
   ASSERT_EQ(s.views.size(), scene.cameras.size());
   for (size_t i = 0; i < s.views.size(); ++i) {
@@ -141,6 +146,7 @@ TEST_P(SyntheticDataset, ReadsBackIdenticallyAndColmapAgrees) {
   ASSERT_EQ(std::system(cmd.c_str()), 0)
       << "colmap model_converter failed (is colmap installed? bash scripts/install_deps.sh)";
   ASSERT_TRUE(fs::exists(d.path() / "bin" / "points3D.bin"));
+  SCOPED_TRACE("text vs COLMAP binary");
   expectSameModel(text, readColmapBinary(d.file("bin")));
 
   // (c) Ground-truth depth agrees between each view and its nearest neighbour.

@@ -14,6 +14,7 @@
 #include "geometry/synth/procedural_meshes.h"
 #include "geometry/synth/ray_tracer.h"
 #include "geometry/synth/render_detail.h"
+#include "geometry/synth/assets.h"
 #include "geometry/synth/synthetic_scene.h"
 
 using namespace saresgs;
@@ -590,16 +591,10 @@ TEST(SyntheticFiles, MeshFileBecomesTheObjectWithItsUpAxis) {
 }
 
 TEST(SyntheticFiles, MeshFileCyclesThroughRoomObjects) {
-  // A real scanned mesh from CGAL's data, when the archive is installed; otherwise the
-  // generated mesh stands in, so the test always runs.
-  std::string mesh = writeTallOctahedron();
-  const std::string archive = "/usr/share/doc/libcgal-dev/data.tar.gz";
-  if (std::filesystem::exists(archive)) {
-    const std::string dir = tempPath("cgal");
-    const std::string cmd = "tar xzf " + archive + " -C " + dir + " data/meshes/bunny00.off 2>/dev/null";
-    if (std::system(cmd.c_str()) == 0 && std::filesystem::exists(dir + "/data/meshes/bunny00.off"))
-      mesh = dir + "/data/meshes/bunny00.off";
-  }
+  // A real scanned mesh: the Stanford bunny from libcgal-demo (install_deps.sh).
+  ::setenv("SARESGS_DATA_CACHE", tempPath("cgal").c_str(), 1);
+  const std::string mesh = resolveAsset("cgal:bunny00");
+  ::unsetenv("SARESGS_DATA_CACHE");
   SyntheticOptions o;
   o.layout = "room360";
   o.width = 64;
