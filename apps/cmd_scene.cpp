@@ -33,8 +33,8 @@ int runScene(SceneArgs& a) {
             << "  render: " << r.render_seconds << " s total, median " << r.median_view_ms
             << " ms per view at " << std::max(4, a.write.render.samples_per_pixel) << " spp\n"
             << "  sparse points (" << a.write.sfm << "): " << r.points << ", mean track "
-            << r.mean_track_length << ", mean reprojection error " << r.mean_reprojection_error
-            << " px, " << r.sfm_seconds << " s\n"
+            << r.mean_track_length << ", reprojection error median " << r.median_reprojection_error
+            << " px (mean " << r.mean_reprojection_error << " px with outliers), " << r.sfm_seconds << " s\n"
             << "  contact sheet: " << a.out << "/contact_sheet.png\n";
   return 0;
 }

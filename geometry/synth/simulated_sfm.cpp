@@ -73,8 +73,21 @@ void simulateSfm(const SyntheticScene& scene, ColmapModel& model, const Simulate
     const double sigma = opts.pixel_noise * mean_depth / (f * std::sqrt(M_PI / 2.0));
     const Eigen::Vector3d X = samples[k].point.cast<double>();
     Eigen::Vector3d noisy = X + sigma * Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng));
-    if (uni(rng) < opts.outlier_fraction)
-      noisy = box.min + (box.max - box.min).cwiseProduct(Eigen::Vector3d(uni(rng), uni(rng), uni(rng)));
+    if (uni(rng) < opts.outlier_fraction) {
+      // A wrong match: a random point in the box, but in front of every camera that
+      // observes it, as SfM's cheirality check guarantees. A few tries, else an inlier.
+      for (int attempt = 0; attempt < 16; ++attempt) {
+        const Eigen::Vector3d cand =
+            box.min + (box.max - box.min).cwiseProduct(Eigen::Vector3d(uni(rng), uni(rng), uni(rng)));
+        const bool in_front = std::all_of(obs.begin(), obs.end(), [&](const Observation& o) {
+          return scene.cameras[o.image_index].toCamera(cand).z() > 1e-6;
+        });
+        if (in_front) {
+          noisy = cand;
+          break;
+        }
+      }
+    }
     p.xyz = noisy;
 
     // Colour as the first observing camera sees the surface.
@@ -92,7 +105,7 @@ void simulateSfm(const SyntheticScene& scene, ColmapModel& model, const Simulate
     for (const auto& o : obs) {
       ColmapImage& im = model.images.at(o.image_index + 1);
       const auto proj = scene.cameras[o.image_index].project(noisy);
-      err += proj ? (*proj - o.uv).norm() : 0.0;
+      err += (*proj - o.uv).norm();  // in front of every observer by construction
       p.track.push_back({im.id, static_cast<std::uint32_t>(im.xys.size())});
       im.xys.push_back(o.uv);
       im.point3d_ids.push_back(p.id);

@@ -100,8 +100,8 @@ WriteDatasetReport writeSyntheticDataset(const SyntheticScene& scene, const std:
   const auto t_sfm = std::chrono::steady_clock::now();
   ColmapModel model = colmapModelOf(scene);
   if (opts.sfm == "simulated") {
-    progress("sfm (simulated)", 0, 1);
     simulateSfm(scene, model, opts.simulated);
+    progress("sfm (simulated)", 1, 1);
   } else if (opts.sfm == "colmap") {
     model = triangulateWithColmap(scene, tmp.string(), model);
   } else if (opts.sfm != "none") {
@@ -112,13 +112,17 @@ WriteDatasetReport writeSyntheticDataset(const SyntheticScene& scene, const std:
 
   report.points = model.points.size();
   double track = 0, err = 0;
+  std::vector<double> errors;
   for (const auto& [id, p] : model.points) {
     track += p.track.size();
     err += p.error;
+    errors.push_back(p.error);
   }
   if (report.points) {
     report.mean_track_length = track / report.points;
     report.mean_reprojection_error = err / report.points;
+    std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
+    report.median_reprojection_error = errors[errors.size() / 2];
   }
 
   nlohmann::json manifest = scene.manifest;
@@ -133,7 +137,8 @@ WriteDatasetReport writeSyntheticDataset(const SyntheticScene& scene, const std:
   manifest["sfm"] = {{"source", opts.sfm},
                      {"points", report.points},
                      {"mean_track_length", report.mean_track_length},
-                     {"mean_reprojection_error_px", report.mean_reprojection_error}};
+                     {"mean_reprojection_error_px", report.mean_reprojection_error},
+                     {"median_reprojection_error_px", report.median_reprojection_error}};
   writeFileAtomic((tmp / "manifest.json").string(), manifest.dump(2) + "\n");
 
   std::vector<ContactSheetItem> items;

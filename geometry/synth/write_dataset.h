@@ -25,7 +25,8 @@ struct WriteDatasetReport {
   int views = 0;
   std::size_t points = 0;
   double mean_track_length = 0;
-  double mean_reprojection_error = 0;  // px, as stored in points3D
+  double mean_reprojection_error = 0;    // px, as stored in points3D (outliers included)
+  double median_reprojection_error = 0;  // px; robust to the simulated outliers
   double render_seconds = 0;
   double median_view_ms = 0;           // colour render of one view
   double sfm_seconds = 0;
