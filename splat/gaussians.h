@@ -21,20 +21,42 @@ inline constexpr int shCoeffCount(int degree) { return (degree + 1) * (degree + 
 // SH degree-0 basis constant: colour = SH_C0 * dc + 0.5 at degree 0.
 inline constexpr double kShC0 = 0.28209479177387814;
 
-struct Gaussians {
+// Templated on the scalar so that gradient tests can run the same code in double.
+template <typename T>
+struct GaussiansT {
+  using Scalar = T;
   int max_sh_degree = 0;
-  std::vector<float> means;
-  std::vector<float> log_scales;
-  std::vector<float> rotations;
-  std::vector<float> opacities;
-  std::vector<float> sh;
+  std::vector<T> means;
+  std::vector<T> log_scales;
+  std::vector<T> rotations;
+  std::vector<T> opacities;
+  std::vector<T> sh;
 
   int shCoeffs() const { return shCoeffCount(max_sh_degree); }
   std::size_t size() const { return opacities.size(); }
   // Resizes every array for n Gaussians (new entries zero).
-  void resize(std::size_t n);
+  void resize(std::size_t n) {
+    forEachArray([n](std::vector<T>& a, std::size_t per) { a.resize(n * per, T(0)); });
+  }
   // A zero-filled model of the same shape (for gradients and moments).
-  Gaussians zerosLike() const;
+  GaussiansT zerosLike() const {
+    GaussiansT z;
+    z.max_sh_degree = max_sh_degree;
+    z.resize(size());
+    return z;
+  }
+  // The same model in another scalar type.
+  template <typename U>
+  GaussiansT<U> cast() const {
+    GaussiansT<U> out;
+    out.max_sh_degree = max_sh_degree;
+    out.means.assign(means.begin(), means.end());
+    out.log_scales.assign(log_scales.begin(), log_scales.end());
+    out.rotations.assign(rotations.begin(), rotations.end());
+    out.opacities.assign(opacities.begin(), opacities.end());
+    out.sh.assign(sh.begin(), sh.end());
+    return out;
+  }
   // Calls f(array, floats per Gaussian) for each of the five arrays, in a fixed order.
   template <typename F>
   void forEachArray(F&& f) {
@@ -53,5 +75,8 @@ struct Gaussians {
     f(sh, static_cast<std::size_t>(shCoeffs()) * 3);
   }
 };
+
+using Gaussians = GaussiansT<float>;
+using GaussiansD = GaussiansT<double>;
 
 }  // namespace saresgs

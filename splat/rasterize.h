@@ -58,7 +58,8 @@ inline constexpr float kMinTransmittance = 1e-4f;
 inline constexpr int kTileSize = 16;
 
 // Everything the forward pass knows that the backward pass needs (opaque to callers).
-struct RasterState;
+template <typename T>
+struct RasterStateT;
 
 struct RenderResult {
   ImageF rgb;     // 3 channels
@@ -67,7 +68,22 @@ struct RenderResult {
   std::vector<int> contributors;  // per pixel: Gaussians composited
   std::vector<float> radii;       // per Gaussian: max(hx, hy) in px, 0 when culled
   std::vector<std::uint8_t> visible;  // per Gaussian: survived culling (1) or not (0)
-  std::shared_ptr<const RasterState> state;
+  std::shared_ptr<const RasterStateT<float>> state;
 };
+
+// Renders `g` from `cam`. `mask` (one byte per Gaussian, 1 = render) selects a subset
+// without copying the model; empty renders all.
+RenderResult rasterize(const Gaussians& g, const Camera& cam, const RasterSettings& s,
+                       std::span<const std::uint8_t> mask = {});
+// Adds to `grad` the gradient of a loss whose gradient w.r.t. fwd.rgb is dL_drgb; adds
+// the 2D-mean gradient (pixels, 2 per Gaussian) to *grad_mean2d when given.
+void rasterizeBackward(const Gaussians& g, const Camera& cam, const RasterSettings& s,
+                       const RenderResult& fwd, const ImageF& dL_drgb, Gaussians& grad,
+                       std::vector<float>* grad_mean2d = nullptr);
+// Adds, per parameter, the sum over pixels of the squared per-pixel gradient of the
+// rendered colour (channels summed): FisherRF's diagonal information. Rotations are
+// excluded (left untouched), as in FisherRF.
+void rasterizeSquaredGradients(const Gaussians& g, const Camera& cam, const RasterSettings& s,
+                               const RenderResult& fwd, Gaussians& sq);
 
 }  // namespace saresgs

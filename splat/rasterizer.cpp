@@ -1,0 +1,508 @@
+// The fast tiled rasterizer: TBB-parallel over Gaussians for projection and over 16x16
+// tiles for compositing and backward. Every gradient contribution lands in a slot owned
+// by one (tile, Gaussian) pair and slots are reduced per Gaussian in a fixed order, so
+// results are bit-identical for the same inputs, whatever the thread count.
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <mutex>
+#include <stdexcept>
+
+#include "splat/projection.h"
+#include "splat/rasterize_detail.h"
+
+namespace saresgs {
+
+using projection::CameraT;
+using projection::Projected;
+using projection::ProjectedGrad;
+
+template <typename T>
+struct RasterStateT {
+  RasterSettings settings;
+  std::vector<Projected<T>> proj;  // per Gaussian
+  int tiles_x = 0, tiles_y = 0;
+  std::vector<std::uint32_t> gauss_start;  // N + 1: each Gaussian's pair slots
+  std::vector<std::uint32_t> tile_start;   // tiles + 1
+  std::vector<std::uint32_t> entry_gauss;  // per tile entry: the Gaussian
+  std::vector<std::uint32_t> entry_slot;   // per tile entry: its pair slot
+  std::vector<T> final_T;                  // per pixel
+  std::vector<std::uint32_t> n_walked;     // per pixel: tile entries walked (last contributor + 1)
+};
+
+namespace {
+
+std::atomic<int> g_threads{0};
+
+tbb::task_arena& arena() {
+  // One arena for the process, created on first use with the requested concurrency;
+  // TBB keeps its worker threads alive between calls.
+  static std::mutex mutex;
+  static std::unique_ptr<tbb::task_arena> a;
+  static int made_for = -1;
+  std::lock_guard<std::mutex> lock(mutex);
+  const int want = g_threads.load();
+  if (!a || made_for != want) {
+    const int concurrency = want > 0 ? want : static_cast<int>(tbb::task_arena::automatic);
+    a = std::make_unique<tbb::task_arena>(concurrency);
+    made_for = want;
+  }
+  return *a;
+}
+
+// Pixel range [lo, hi] whose centres (i + 0.5) lie within mean +- half, clipped to [0, n).
+template <typename T>
+void pixelRange(T mean, T half, int n, int& lo, int& hi) {
+  lo = std::max(0, static_cast<int>(std::ceil(mean - half - T(0.5))));
+  hi = std::min(n - 1, static_cast<int>(std::floor(mean + half - T(0.5))));
+}
+
+// One Gaussian's data gathered per tile, in the tile's order.
+template <typename T>
+struct TileGaussian {
+  T mx, my, a, b, c, o, hx, hy, depth;
+  T col[3];
+};
+
+template <typename T>
+void gatherTile(const RasterStateT<T>& st, int tile, std::vector<TileGaussian<T>>& out) {
+  out.clear();
+  for (std::uint32_t e = st.tile_start[tile]; e < st.tile_start[tile + 1]; ++e) {
+    const Projected<T>& P = st.proj[st.entry_gauss[e]];
+    out.push_back({P.mean2d[0], P.mean2d[1], P.conic[0], P.conic[1], P.conic[2], P.opacity, P.half[0],
+                   P.half[1], P.depth, {P.color[0], P.color[1], P.color[2]}});
+  }
+}
+
+// G and alpha of a Gaussian at a pixel centre; false when it does not touch the pixel
+// (outside its rectangle, or alpha below 1/255). `unclamped`: o G < 0.99.
+template <typename T>
+bool evalAlpha(const TileGaussian<T>& q, T px, T py, T& dx, T& dy, T& G, T& alpha, bool& unclamped) {
+  dx = px - q.mx;
+  dy = py - q.my;
+  if (std::abs(dx) > q.hx || std::abs(dy) > q.hy) return false;
+  const T power = T(-0.5) * (q.a * dx * dx + q.c * dy * dy) - q.b * dx * dy;
+  if (power > 0) return false;  // cannot happen for a valid conic; guards rounding
+  G = std::exp(power);
+  const T oG = q.o * G;
+  unclamped = oG < T(kMaxAlpha);
+  alpha = unclamped ? oG : T(kMaxAlpha);
+  return alpha >= T(kMinAlpha);
+}
+
+template <typename T>
+void tilePixels(const RasterStateT<T>& st, int tile, int width, int height, int& x0, int& y0, int& x1,
+                int& y1) {
+  const int tx = tile % st.tiles_x, ty = tile / st.tiles_x;
+  x0 = tx * kTileSize;
+  y0 = ty * kTileSize;
+  x1 = std::min(width, x0 + kTileSize);
+  y1 = std::min(height, y0 + kTileSize);
+}
+
+}  // namespace
+
+void setRasterThreads(int threads) { g_threads.store(std::max(0, threads)); }
+int rasterThreads() { return arena().max_concurrency(); }
+
+template <typename T>
+RenderOutputT<T> rasterizeT(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& s,
+                            std::span<const std::uint8_t> mask) {
+  const std::size_t n = g.size();
+  const int W = cam.K.width, H = cam.K.height;
+  auto st = std::make_shared<RasterStateT<T>>();
+  st->settings = s;
+  st->settings.sh_degree = std::clamp(s.sh_degree, 0, g.max_sh_degree);
+  const RasterSettings& rs = st->settings;
+  const CameraT<T> camT(cam, T(s.guard_band));
+  st->tiles_x = (W + kTileSize - 1) / kTileSize;
+  st->tiles_y = (H + kTileSize - 1) / kTileSize;
+  const int tiles = st->tiles_x * st->tiles_y;
+
+  RenderOutputT<T> out;
+  out.width = W;
+  out.height = H;
+  out.rgb.assign(static_cast<std::size_t>(W) * H * 3, T(0));
+  out.alpha.assign(static_cast<std::size_t>(W) * H, T(0));
+  out.depth.assign(static_cast<std::size_t>(W) * H, T(0));
+  out.contributors.assign(static_cast<std::size_t>(W) * H, 0);
+  out.radii.assign(n, T(0));
+  out.visible.assign(n, 0);
+  st->final_T.assign(static_cast<std::size_t>(W) * H, T(1));
+  st->n_walked.assign(static_cast<std::size_t>(W) * H, 0);
+  st->proj.resize(n);
+  std::vector<std::uint32_t> count(n, 0);
+
+  arena().execute([&] {
+    // Projection and the number of tiles each Gaussian touches.
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& r) {
+      for (std::size_t i = r.begin(); i < r.end(); ++i) {
+        if (!mask.empty() && !mask[i]) {
+          st->proj[i] = Projected<T>{};
+          continue;
+        }
+        Projected<T>& P = st->proj[i] = projection::project(g, i, camT, rs);
+        if (!P.visible) continue;
+        out.visible[i] = 1;
+        out.radii[i] = P.radius;
+        int px0, px1, py0, py1;
+        pixelRange(P.mean2d[0], P.half[0], W, px0, px1);
+        pixelRange(P.mean2d[1], P.half[1], H, py0, py1);
+        if (px0 > px1 || py0 > py1) continue;
+        count[i] = static_cast<std::uint32_t>((px1 / kTileSize - px0 / kTileSize + 1) *
+                                              (py1 / kTileSize - py0 / kTileSize + 1));
+      }
+    });
+  });
+
+  // Pair slots, Gaussian-major, then a stable counting sort by tile.
+  st->gauss_start.assign(n + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) st->gauss_start[i + 1] = st->gauss_start[i] + count[i];
+  const std::uint32_t pairs = st->gauss_start[n];
+  std::vector<std::uint32_t> slot_tile(pairs);
+  arena().execute([&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& r) {
+      for (std::size_t i = r.begin(); i < r.end(); ++i) {
+        if (!count[i]) continue;
+        const Projected<T>& P = st->proj[i];
+        int px0, px1, py0, py1;
+        pixelRange(P.mean2d[0], P.half[0], W, px0, px1);
+        pixelRange(P.mean2d[1], P.half[1], H, py0, py1);
+        std::uint32_t k = st->gauss_start[i];
+        for (int ty = py0 / kTileSize; ty <= py1 / kTileSize; ++ty)
+          for (int tx = px0 / kTileSize; tx <= px1 / kTileSize; ++tx)
+            slot_tile[k++] = static_cast<std::uint32_t>(ty * st->tiles_x + tx);
+      }
+    });
+  });
+  st->tile_start.assign(tiles + 1, 0);
+  for (std::uint32_t k = 0; k < pairs; ++k) ++st->tile_start[slot_tile[k] + 1];
+  for (int t = 0; t < tiles; ++t) st->tile_start[t + 1] += st->tile_start[t];
+  st->entry_gauss.resize(pairs);
+  st->entry_slot.resize(pairs);
+  {
+    std::vector<std::uint32_t> fill(st->tile_start.begin(), st->tile_start.end() - 1);
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::uint32_t k = st->gauss_start[i]; k < st->gauss_start[i + 1]; ++k) {
+        const std::uint32_t e = fill[slot_tile[k]]++;
+        st->entry_gauss[e] = static_cast<std::uint32_t>(i);
+        st->entry_slot[e] = k;
+      }
+  }
+
+  const T bg[3] = {T(s.background[0]), T(s.background[1]), T(s.background[2])};
+  arena().execute([&] {
+    tbb::parallel_for(0, tiles, [&](int tile) {
+      // Rule 6: by camera z, ties by index (entries arrive in index order; stable sort).
+      const std::uint32_t b = st->tile_start[tile], e = st->tile_start[tile + 1];
+      std::vector<std::pair<T, std::uint32_t>> order(e - b);
+      for (std::uint32_t k = b; k < e; ++k) order[k - b] = {st->proj[st->entry_gauss[k]].depth, st->entry_slot[k]};
+      std::vector<std::uint32_t> gs(e - b);
+      for (std::uint32_t k = b; k < e; ++k) gs[k - b] = st->entry_gauss[k];
+      std::vector<std::uint32_t> idx(e - b);
+      for (std::uint32_t k = 0; k < e - b; ++k) idx[k] = k;
+      std::stable_sort(idx.begin(), idx.end(),
+                       [&](std::uint32_t x, std::uint32_t y) { return order[x].first < order[y].first; });
+      for (std::uint32_t k = 0; k < e - b; ++k) {
+        st->entry_gauss[b + k] = gs[idx[k]];
+        st->entry_slot[b + k] = order[idx[k]].second;
+      }
+
+      std::vector<TileGaussian<T>> q;
+      gatherTile(*st, tile, q);
+      int x0, y0, x1, y1;
+      tilePixels(*st, tile, W, H, x0, y0, x1, y1);
+      for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+          const T px = T(x) + T(0.5), py = T(y) + T(0.5);
+          T Tr = 1, C[3] = {0, 0, 0}, D = 0;
+          std::uint32_t walked = 0;
+          int contrib = 0;
+          for (std::uint32_t j = 0; j < q.size(); ++j) {
+            T dx, dy, G, alpha;
+            bool unclamped;
+            if (!evalAlpha(q[j], px, py, dx, dy, G, alpha, unclamped)) continue;
+            const T next = Tr * (T(1) - alpha);
+            if (next < T(kMinTransmittance)) break;
+            const T w = alpha * Tr;
+            for (int c = 0; c < 3; ++c) C[c] += w * q[j].col[c];
+            D += w * q[j].depth;
+            Tr = next;
+            walked = j + 1;
+            ++contrib;
+          }
+          const std::size_t pix = static_cast<std::size_t>(y) * W + x;
+          for (int c = 0; c < 3; ++c) out.rgb[pix * 3 + c] = C[c] + Tr * bg[c];
+          out.alpha[pix] = T(1) - Tr;
+          out.depth[pix] = (T(1) - Tr) >= T(1e-6) ? D / (T(1) - Tr) : T(0);
+          out.contributors[pix] = contrib;
+          st->final_T[pix] = Tr;
+          st->n_walked[pix] = walked;
+        }
+    });
+  });
+  out.state = st;
+  return out;
+}
+
+namespace {
+
+// Walks one pixel's contributors back to front and calls
+// visit(entry, dx, dy, G, alpha, unclamped, dL_dalpha, dL_dcolor_weight) where dL_dalpha
+// is for the per-pixel objective sum_c w_c C_c and dL_dcolor_weight = alpha T.
+template <typename T, typename Visit>
+void walkBack(const std::vector<TileGaussian<T>>& q, std::uint32_t walked, T final_T, T px, T py,
+              const T w[3], const T bg[3], Visit&& visit) {
+  T Tr = final_T;
+  T accum[3] = {0, 0, 0}, last_alpha = 0, last_col[3] = {0, 0, 0};
+  const T bg_dot = bg[0] * w[0] + bg[1] * w[1] + bg[2] * w[2];
+  for (std::uint32_t jj = walked; jj-- > 0;) {
+    T dx, dy, G, alpha;
+    bool unclamped;
+    if (!evalAlpha(q[jj], px, py, dx, dy, G, alpha, unclamped)) continue;
+    Tr = Tr / (T(1) - alpha);  // transmittance in front of this Gaussian
+    T dL_dalpha = 0;
+    for (int c = 0; c < 3; ++c) {
+      accum[c] = last_alpha * last_col[c] + (T(1) - last_alpha) * accum[c];
+      dL_dalpha += (q[jj].col[c] - accum[c]) * w[c];
+    }
+    dL_dalpha = dL_dalpha * Tr - final_T / (T(1) - alpha) * bg_dot;
+    last_alpha = alpha;
+    for (int c = 0; c < 3; ++c) last_col[c] = q[jj].col[c];
+    visit(jj, dx, dy, G, alpha, unclamped, dL_dalpha, alpha * Tr);
+  }
+}
+
+// The 2D gradients of one contribution: through alpha = o G (when unclamped) to the
+// opacity, the 2D mean and the conic.
+template <typename T>
+void alphaToProjected(const TileGaussian<T>& q, T dx, T dy, T G, bool unclamped, T dL_dalpha, T* g2d) {
+  if (!unclamped) return;
+  g2d[0] += G * dL_dalpha;  // opacity
+  const T dG = q.o * dL_dalpha * G;  // dL/dpower
+  g2d[1] += dG * (q.a * dx + q.b * dy);  // mean2d x (d power / d mean = -d power / d dx)
+  g2d[2] += dG * (q.b * dx + q.c * dy);
+  g2d[3] += dG * T(-0.5) * dx * dx;  // conic a
+  g2d[4] += dG * (-dx * dy);         // conic b
+  g2d[5] += dG * T(-0.5) * dy * dy;  // conic c
+}
+
+}  // namespace
+
+template <typename T>
+void rasterizeBackwardT(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& s,
+                        const RenderOutputT<T>& fwd, const T* dL_drgb, GaussiansT<T>& grad,
+                        std::vector<T>* grad_mean2d) {
+  const RasterStateT<T>& st = *fwd.state;
+  const RasterSettings& rs = st.settings;
+  const int W = fwd.width, H = fwd.height, tiles = st.tiles_x * st.tiles_y;
+  const std::size_t n = g.size();
+  const std::uint32_t pairs = st.gauss_start[n];
+  // Per pair slot: opacity, mean2d (2), conic (3), colour (3).
+  constexpr int kSlot = 9;
+  std::vector<T> slots(static_cast<std::size_t>(pairs) * kSlot, T(0));
+  const T bg[3] = {T(rs.background[0]), T(rs.background[1]), T(rs.background[2])};
+
+  arena().execute([&] {
+    tbb::parallel_for(0, tiles, [&](int tile) {
+      std::vector<TileGaussian<T>> q;
+      gatherTile(st, tile, q);
+      const std::uint32_t base = st.tile_start[tile];
+      int x0, y0, x1, y1;
+      tilePixels(st, tile, W, H, x0, y0, x1, y1);
+      for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+          const std::size_t pix = static_cast<std::size_t>(y) * W + x;
+          const T* w = &dL_drgb[pix * 3];
+          walkBack(q, st.n_walked[pix], st.final_T[pix], T(x) + T(0.5), T(y) + T(0.5), w, bg,
+                   [&](std::uint32_t jj, T dx, T dy, T G, T, bool unclamped, T dL_dalpha, T wcol) {
+                     T* sl = &slots[static_cast<std::size_t>(st.entry_slot[base + jj]) * kSlot];
+                     alphaToProjected(q[jj], dx, dy, G, unclamped, dL_dalpha, sl);
+                     for (int c = 0; c < 3; ++c) sl[6 + c] += wcol * w[c];
+                   });
+        }
+    });
+    // Reduce each Gaussian's slots in slot order, then chain to its parameters.
+    const CameraT<T> camT(cam, T(rs.guard_band));
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& r) {
+      for (std::size_t i = r.begin(); i < r.end(); ++i) {
+        if (st.gauss_start[i] == st.gauss_start[i + 1]) continue;
+        ProjectedGrad<T> dP;
+        for (std::uint32_t k = st.gauss_start[i]; k < st.gauss_start[i + 1]; ++k) {
+          const T* sl = &slots[static_cast<std::size_t>(k) * kSlot];
+          dP.opacity += sl[0];
+          dP.mean2d[0] += sl[1];
+          dP.mean2d[1] += sl[2];
+          for (int c = 0; c < 3; ++c) dP.conic[c] += sl[3 + c];
+          for (int c = 0; c < 3; ++c) dP.color[c] += sl[6 + c];
+        }
+        if (grad_mean2d) {
+          (*grad_mean2d)[2 * i] += dP.mean2d[0];
+          (*grad_mean2d)[2 * i + 1] += dP.mean2d[1];
+        }
+        projection::projectBackward(g, i, camT, rs, st.proj[i], dP,
+                                    projection::ParamGradRef<T>::of(grad, i));
+      }
+    });
+  });
+}
+
+template <typename T>
+void rasterizeSquaredGradientsT(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& s,
+                                const RenderOutputT<T>& fwd, GaussiansT<T>& sq) {
+  const RasterStateT<T>& st = *fwd.state;
+  const RasterSettings& rs = st.settings;
+  const int W = fwd.width, H = fwd.height, tiles = st.tiles_x * st.tiles_y;
+  const std::size_t n = g.size();
+  const std::uint32_t pairs = st.gauss_start[n];
+  const CameraT<T> camT(cam, T(rs.guard_band));
+
+  // Per Gaussian, the linear maps from its projected quantities (opacity, mean2d, conic,
+  // colour: 9 inputs) to its means and log-scales, read off projectBackward with unit
+  // inputs; the per-pixel gradient is then a small product, squared before summing.
+  constexpr int kIn = 9;
+  std::vector<T> jac(n * kIn * 6, T(0));  // [i][input][mean 3 | log_scale 3]
+  std::vector<T> dlogit(n, T(0));         // d logit per d opacity
+  arena().execute([&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& r) {
+      for (std::size_t i = r.begin(); i < r.end(); ++i) {
+        if (st.gauss_start[i] == st.gauss_start[i + 1]) continue;
+        const Projected<T>& P = st.proj[i];
+        dlogit[i] = P.opacity * (T(1) - P.opacity);
+        for (int in = 1; in < kIn; ++in) {  // input 0 (opacity) touches only the logit
+          ProjectedGrad<T> dP;
+          if (in <= 2) dP.mean2d[in - 1] = 1;
+          else if (in <= 5) dP.conic[in - 3] = 1;
+          else dP.color[in - 6] = 1;
+          T* J = &jac[(i * kIn + in) * 6];
+          projection::ParamGradRef<T> ref;
+          ref.mean = J;
+          ref.log_scale = J + 3;
+          projection::projectBackward(g, i, camT, rs, P, dP, ref);
+        }
+      }
+    });
+  });
+
+  // Per pair slot: squared sums for mean (3), log_scale (3), opacity logit (1), and
+  // sum (alpha T)^2, which times Y_k^2 is the SH coefficients' information.
+  constexpr int kSlot = 8;
+  std::vector<T> slots(static_cast<std::size_t>(pairs) * kSlot, T(0));
+  const T bg[3] = {T(rs.background[0]), T(rs.background[1]), T(rs.background[2])};
+  const T ones[3] = {1, 1, 1};
+  arena().execute([&] {
+    tbb::parallel_for(0, tiles, [&](int tile) {
+      std::vector<TileGaussian<T>> q;
+      gatherTile(st, tile, q);
+      const std::uint32_t base = st.tile_start[tile];
+      int x0, y0, x1, y1;
+      tilePixels(st, tile, W, H, x0, y0, x1, y1);
+      for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+          const std::size_t pix = static_cast<std::size_t>(y) * W + x;
+          walkBack(q, st.n_walked[pix], st.final_T[pix], T(x) + T(0.5), T(y) + T(0.5), ones, bg,
+                   [&](std::uint32_t jj, T dx, T dy, T G, T, bool unclamped, T dL_dalpha, T wcol) {
+                     const std::uint32_t i = st.entry_gauss[base + jj];
+                     T in[kIn] = {0, 0, 0, 0, 0, 0, wcol, wcol, wcol};
+                     alphaToProjected(q[jj], dx, dy, G, unclamped, dL_dalpha, in);
+                     T* sl = &slots[static_cast<std::size_t>(st.entry_slot[base + jj]) * kSlot];
+                     const T* J = &jac[static_cast<std::size_t>(i) * kIn * 6];
+                     for (int p = 0; p < 6; ++p) {
+                       T v = 0;
+                       for (int k = 1; k < kIn; ++k) v += in[k] * J[k * 6 + p];
+                       sl[p] += v * v;
+                     }
+                     const T gl = in[0] * dlogit[i];
+                     sl[6] += gl * gl;
+                     sl[7] += wcol * wcol;
+                   });
+        }
+    });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& r) {
+      const int K = g.shCoeffs(), active = shCoeffCount(rs.sh_degree);
+      for (std::size_t i = r.begin(); i < r.end(); ++i) {
+        if (st.gauss_start[i] == st.gauss_start[i + 1]) continue;
+        T acc[kSlot] = {0, 0, 0, 0, 0, 0, 0, 0};
+        for (std::uint32_t k = st.gauss_start[i]; k < st.gauss_start[i + 1]; ++k)
+          for (int p = 0; p < kSlot; ++p) acc[p] += slots[static_cast<std::size_t>(k) * kSlot + p];
+        for (int p = 0; p < 3; ++p) sq.means[3 * i + p] += acc[p];
+        for (int p = 0; p < 3; ++p) sq.log_scales[3 * i + p] += acc[3 + p];
+        sq.opacities[i] += acc[6];
+        // SH: d C / d sh_kc = alpha T Y_k for unclamped channels.
+        const Projected<T>& P = st.proj[i];
+        const T* m = &g.means[3 * i];
+        T d[3] = {m[0] - camT.center[0], m[1] - camT.center[1], m[2] - camT.center[2]};
+        const T dn = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        for (T& v : d) v = dn > 0 ? v / dn : T(0);
+        T basis[16];
+        shBasis(rs.sh_degree, d[0], d[1], d[2], basis);
+        for (int k = 0; k < active; ++k)
+          for (int c = 0; c < 3; ++c)
+            if (!P.clamped[c]) sq.sh[(i * K + k) * 3 + c] += acc[7] * basis[k] * basis[k];
+      }
+    });
+  });
+}
+
+RenderResult rasterize(const Gaussians& g, const Camera& cam, const RasterSettings& s,
+                       std::span<const std::uint8_t> mask) {
+  RenderOutputT<float> o = rasterizeT(g, cam, s, mask);
+  RenderResult r;
+  r.rgb.width = r.alpha.width = r.depth.width = o.width;
+  r.rgb.height = r.alpha.height = r.depth.height = o.height;
+  r.rgb.channels = 3;
+  r.alpha.channels = r.depth.channels = 1;
+  r.rgb.data = std::move(o.rgb);
+  r.alpha.data = std::move(o.alpha);
+  r.depth.data = std::move(o.depth);
+  r.contributors = std::move(o.contributors);
+  r.radii = std::move(o.radii);
+  r.visible = std::move(o.visible);
+  r.state = std::move(o.state);
+  return r;
+}
+
+namespace {
+// The templated functions read only width, height and state from the forward output.
+RenderOutputT<float> view(const RenderResult& fwd) {
+  RenderOutputT<float> o;
+  o.width = fwd.rgb.width;
+  o.height = fwd.rgb.height;
+  o.state = fwd.state;
+  return o;
+}
+}  // namespace
+
+void rasterizeBackward(const Gaussians& g, const Camera& cam, const RasterSettings& s,
+                       const RenderResult& fwd, const ImageF& dL_drgb, Gaussians& grad,
+                       std::vector<float>* grad_mean2d) {
+  if (dL_drgb.width != fwd.rgb.width || dL_drgb.height != fwd.rgb.height || dL_drgb.channels != 3)
+    throw std::invalid_argument("rasterizeBackward: dL/drgb must match the render (3 channels)");
+  if (grad_mean2d && grad_mean2d->size() != 2 * g.size()) grad_mean2d->resize(2 * g.size(), 0.0f);
+  rasterizeBackwardT(g, cam, s, view(fwd), dL_drgb.data.data(), grad, grad_mean2d);
+}
+
+void rasterizeSquaredGradients(const Gaussians& g, const Camera& cam, const RasterSettings& s,
+                               const RenderResult& fwd, Gaussians& sq) {
+  rasterizeSquaredGradientsT(g, cam, s, view(fwd), sq);
+}
+
+template RenderOutputT<float> rasterizeT(const GaussiansT<float>&, const Camera&, const RasterSettings&,
+                                         std::span<const std::uint8_t>);
+template RenderOutputT<double> rasterizeT(const GaussiansT<double>&, const Camera&, const RasterSettings&,
+                                          std::span<const std::uint8_t>);
+template void rasterizeBackwardT(const GaussiansT<float>&, const Camera&, const RasterSettings&,
+                                 const RenderOutputT<float>&, const float*, GaussiansT<float>&,
+                                 std::vector<float>*);
+template void rasterizeBackwardT(const GaussiansT<double>&, const Camera&, const RasterSettings&,
+                                 const RenderOutputT<double>&, const double*, GaussiansT<double>&,
+                                 std::vector<double>*);
+template void rasterizeSquaredGradientsT(const GaussiansT<float>&, const Camera&, const RasterSettings&,
+                                         const RenderOutputT<float>&, GaussiansT<float>&);
+template void rasterizeSquaredGradientsT(const GaussiansT<double>&, const Camera&, const RasterSettings&,
+                                         const RenderOutputT<double>&, GaussiansT<double>&);
+
+}  // namespace saresgs

@@ -1,0 +1,43 @@
+#pragma once
+// Small random Gaussian scenes for the rasterizer tests.
+#include <cmath>
+#include <random>
+
+#include "geometry/camera/camera.h"
+#include "splat/gaussians.h"
+
+namespace saresgs::test {
+
+inline Camera smallCamera(int w = 24, int h = 20) {
+  Intrinsics K;
+  K.width = w;
+  K.height = h;
+  K.fx = K.fy = 0.9 * w;
+  K.cx = 0.5 * w + 0.3;
+  K.cy = 0.5 * h - 0.2;
+  return Camera::lookAt(K, Eigen::Vector3d(0.2, -3.0, 0.4), Eigen::Vector3d(0, 0, 0), Eigen::Vector3d::UnitZ());
+}
+
+// n Gaussians around the origin seen by smallCamera: overlapping, some partly off
+// screen, some thin (near-degenerate), random rotations and SH.
+template <typename T = double>
+GaussiansT<T> randomScene(int n, int sh_degree, std::uint64_t seed, double spread = 0.9) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> nd(0, 1);
+  std::uniform_real_distribution<double> u(0, 1);
+  GaussiansT<T> g;
+  g.max_sh_degree = sh_degree;
+  g.resize(n);
+  const int K = g.shCoeffs();
+  for (int i = 0; i < n; ++i) {
+    for (int k = 0; k < 3; ++k) g.means[3 * i + k] = T(spread * nd(rng) * (k == 1 ? 0.3 : 1.0));
+    for (int k = 0; k < 3; ++k) g.log_scales[3 * i + k] = T(std::log(0.08 + 0.25 * u(rng)));
+    if (i % 4 == 3) g.log_scales[3 * i + 2] = T(std::log(0.004));  // thin
+    for (int k = 0; k < 4; ++k) g.rotations[4 * i + k] = T(nd(rng));
+    g.opacities[i] = T(nd(rng));
+    for (int k = 0; k < K * 3; ++k) g.sh[i * K * 3 + k] = T((k < 3 ? 1.0 : 0.3) * nd(rng));
+  }
+  return g;
+}
+
+}  // namespace saresgs::test
