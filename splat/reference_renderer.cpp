@@ -60,17 +60,6 @@ void checkSize(const std::vector<double>& a, std::size_t expected, const char* n
 
 }  // namespace
 
-GaussiansD toDouble(const Gaussians& g) {
-  GaussiansD d;
-  d.max_sh_degree = g.max_sh_degree;
-  d.means.assign(g.means.begin(), g.means.end());
-  d.log_scales.assign(g.log_scales.begin(), g.log_scales.end());
-  d.rotations.assign(g.rotations.begin(), g.rotations.end());
-  d.opacities.assign(g.opacities.begin(), g.opacities.end());
-  d.sh.assign(g.sh.begin(), g.sh.end());
-  return d;
-}
-
 ReferenceImage referenceRender(const GaussiansD& g, const Camera& cam, const RasterSettings& s,
                                std::span<const std::uint8_t> mask) {
   const std::size_t n = g.size();

@@ -23,14 +23,9 @@ struct ReferenceImage {  // double precision outputs, row-major
   std::vector<std::uint8_t> visible;
 };
 
-// The model's parameters in double, in exactly the Gaussians layout.
-struct GaussiansD {
-  int max_sh_degree = 0;
-  std::vector<double> means, log_scales, rotations, opacities, sh;
-  std::size_t size() const { return opacities.size(); }
-};
-
-GaussiansD toDouble(const Gaussians& g);
+// The model in double (GaussiansD, splat/gaussians.h) so that tests can perturb one
+// parameter and re-render for finite differences.
+inline GaussiansD toDouble(const Gaussians& g) { return g.cast<double>(); }
 
 // Renders `g` from `cam` into a cam.K.width x cam.K.height image. `mask` is empty (all
 // rendered) or holds one entry per Gaussian (0 = rendered as if its opacity were 0).
