@@ -290,24 +290,15 @@ void alphaToProjected(const TileGaussian<T>& q, T dx, T dy, T G, bool unclamped,
   g2d[5] += dG * T(-0.5) * dy * dy;  // conic c
 }
 
-}  // namespace
-
-template <typename T>
-void rasterizeBackwardT(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& s,
-                        const RenderOutputT<T>& fwd, const T* dL_drgb, GaussiansT<T>& grad,
-                        std::vector<T>* grad_mean2d) {
-  const RasterStateT<T>& st = *fwd.state;
+// Walks every pixel's contributors back to front, tiles in parallel, for the per-pixel
+// objective sum_c w_c C_c with w = weights(pixel), and calls
+// visit(tile entry, its Gaussian's tile data, dx, dy, G, unclamped, dL/dalpha, alpha T, w).
+template <typename T, typename Weights, typename Visit>
+void walkAllPixels(const RasterStateT<T>& st, int W, int H, Weights&& weights, Visit&& visit) {
   const RasterSettings& rs = st.settings;
-  const int W = fwd.width, H = fwd.height, tiles = st.tiles_x * st.tiles_y;
-  const std::size_t n = g.size();
-  const std::uint32_t pairs = st.gauss_start[n];
-  // Per pair slot: opacity, mean2d (2), conic (3), colour (3).
-  constexpr int kSlot = 9;
-  std::vector<T> slots(static_cast<std::size_t>(pairs) * kSlot, T(0));
   const T bg[3] = {T(rs.background[0]), T(rs.background[1]), T(rs.background[2])};
-
   arena().execute([&] {
-    tbb::parallel_for(0, tiles, [&](int tile) {
+    tbb::parallel_for(0, st.tiles_x * st.tiles_y, [&](int tile) {
       std::vector<TileGaussian<T>> q;
       gatherTile(st, tile, q);
       const std::uint32_t base = st.tile_start[tile];
@@ -316,15 +307,40 @@ void rasterizeBackwardT(const GaussiansT<T>& g, const Camera& cam, const RasterS
       for (int y = y0; y < y1; ++y)
         for (int x = x0; x < x1; ++x) {
           const std::size_t pix = static_cast<std::size_t>(y) * W + x;
-          const T* w = &dL_drgb[pix * 3];
+          const T* w = weights(pix);
           walkBack(q, st.n_walked[pix], st.final_T[pix], T(x) + T(0.5), T(y) + T(0.5), w, bg,
                    [&](std::uint32_t jj, T dx, T dy, T G, T, bool unclamped, T dL_dalpha, T wcol) {
-                     T* sl = &slots[static_cast<std::size_t>(st.entry_slot[base + jj]) * kSlot];
-                     alphaToProjected(q[jj], dx, dy, G, unclamped, dL_dalpha, sl);
-                     for (int c = 0; c < 3; ++c) sl[6 + c] += wcol * w[c];
+                     visit(base + jj, q[jj], dx, dy, G, unclamped, dL_dalpha, wcol, w);
                    });
         }
     });
+  });
+}
+
+}  // namespace
+
+template <typename T>
+void rasterizeBackwardT(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& s,
+                        const RenderOutputT<T>& fwd, const T* dL_drgb, GaussiansT<T>& grad,
+                        std::vector<T>* grad_mean2d) {
+  const RasterStateT<T>& st = *fwd.state;
+  const RasterSettings& rs = st.settings;
+  const int W = fwd.width, H = fwd.height;
+  const std::size_t n = g.size();
+  const std::uint32_t pairs = st.gauss_start[n];
+  // Per pair slot: opacity, mean2d (2), conic (3), colour (3).
+  constexpr int kSlot = 9;
+  std::vector<T> slots(static_cast<std::size_t>(pairs) * kSlot, T(0));
+  walkAllPixels(
+      st, W, H, [&](std::size_t pix) { return &dL_drgb[pix * 3]; },
+      [&](std::uint32_t e, const TileGaussian<T>& q, T dx, T dy, T G, bool unclamped, T dL_dalpha, T wcol,
+          const T* w) {
+        T* sl = &slots[static_cast<std::size_t>(st.entry_slot[e]) * kSlot];
+        alphaToProjected(q, dx, dy, G, unclamped, dL_dalpha, sl);
+        for (int c = 0; c < 3; ++c) sl[6 + c] += wcol * w[c];
+      });
+
+  arena().execute([&] {
     // Reduce each Gaussian's slots in slot order, then chain to its parameters.
     const CameraT<T> camT(cam, T(rs.guard_band));
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& r) {
@@ -355,7 +371,7 @@ void rasterizeSquaredGradientsT(const GaussiansT<T>& g, const Camera& cam, const
                                 const RenderOutputT<T>& fwd, GaussiansT<T>& sq) {
   const RasterStateT<T>& st = *fwd.state;
   const RasterSettings& rs = st.settings;
-  const int W = fwd.width, H = fwd.height, tiles = st.tiles_x * st.tiles_y;
+  const int W = fwd.width, H = fwd.height;
   const std::size_t n = g.size();
   const std::uint32_t pairs = st.gauss_start[n];
   const CameraT<T> camT(cam, T(rs.guard_band));
@@ -391,36 +407,26 @@ void rasterizeSquaredGradientsT(const GaussiansT<T>& g, const Camera& cam, const
   // sum (alpha T)^2, which times Y_k^2 is the SH coefficients' information.
   constexpr int kSlot = 8;
   std::vector<T> slots(static_cast<std::size_t>(pairs) * kSlot, T(0));
-  const T bg[3] = {T(rs.background[0]), T(rs.background[1]), T(rs.background[2])};
   const T ones[3] = {1, 1, 1};
-  arena().execute([&] {
-    tbb::parallel_for(0, tiles, [&](int tile) {
-      std::vector<TileGaussian<T>> q;
-      gatherTile(st, tile, q);
-      const std::uint32_t base = st.tile_start[tile];
-      int x0, y0, x1, y1;
-      tilePixels(st, tile, W, H, x0, y0, x1, y1);
-      for (int y = y0; y < y1; ++y)
-        for (int x = x0; x < x1; ++x) {
-          const std::size_t pix = static_cast<std::size_t>(y) * W + x;
-          walkBack(q, st.n_walked[pix], st.final_T[pix], T(x) + T(0.5), T(y) + T(0.5), ones, bg,
-                   [&](std::uint32_t jj, T dx, T dy, T G, T, bool unclamped, T dL_dalpha, T wcol) {
-                     const std::uint32_t i = st.entry_gauss[base + jj];
-                     T in[kIn] = {0, 0, 0, 0, 0, 0, wcol, wcol, wcol};
-                     alphaToProjected(q[jj], dx, dy, G, unclamped, dL_dalpha, in);
-                     T* sl = &slots[static_cast<std::size_t>(st.entry_slot[base + jj]) * kSlot];
-                     const T* J = &jac[static_cast<std::size_t>(i) * kIn * 6];
-                     for (int p = 0; p < 6; ++p) {
-                       T v = 0;
-                       for (int k = 1; k < kIn; ++k) v += in[k] * J[k * 6 + p];
-                       sl[p] += v * v;
-                     }
-                     const T gl = in[0] * dlogit[i];
-                     sl[6] += gl * gl;
-                     sl[7] += wcol * wcol;
-                   });
+  walkAllPixels(
+      st, W, H, [&](std::size_t) { return ones; },
+      [&](std::uint32_t e, const TileGaussian<T>& q, T dx, T dy, T G, bool unclamped, T dL_dalpha, T wcol,
+          const T*) {
+        const std::uint32_t i = st.entry_gauss[e];
+        T in[kIn] = {0, 0, 0, 0, 0, 0, wcol, wcol, wcol};
+        alphaToProjected(q, dx, dy, G, unclamped, dL_dalpha, in);
+        T* sl = &slots[static_cast<std::size_t>(st.entry_slot[e]) * kSlot];
+        const T* J = &jac[static_cast<std::size_t>(i) * kIn * 6];
+        for (int p = 0; p < 6; ++p) {
+          T v = 0;
+          for (int k = 1; k < kIn; ++k) v += in[k] * J[k * 6 + p];
+          sl[p] += v * v;
         }
-    });
+        const T gl = in[0] * dlogit[i];
+        sl[6] += gl * gl;
+        sl[7] += wcol * wcol;
+      });
+  arena().execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& r) {
       const int K = g.shCoeffs(), active = shCoeffCount(rs.sh_degree);
       for (std::size_t i = r.begin(); i < r.end(); ++i) {

@@ -85,34 +85,14 @@ TEST(FastVsReference, AnalyticGradientsMatchFiniteDifferencesOfTheReference) {
       for (std::size_t k = 0; k < w.size(); ++k) l += w[k] * r.rgb[k];
       return l;
     };
-    int checked = 0, kinks = 0;
-    auto check = [&](std::vector<double>& p, const std::vector<double>& a, const char* name) {
-      for (std::size_t k = 0; k < p.size(); ++k) {
-        const double x0 = p[k];
-        auto q = [&](double h) {
-          p[k] = x0 + h;
-          const double lp = loss();
-          p[k] = x0 - h;
-          const double lm = loss();
-          p[k] = x0;
-          return (lp - lm) / (2 * h);
-        };
-        const double h = 1e-6 * std::max(1.0, std::abs(x0));
-        const double fd = q(h), fd4 = q(h / 4);
-        if (std::abs(fd - fd4) > 1e-5 * std::max(1.0, std::abs(fd))) {
-          ++kinks;  // a pixel crosses a threshold: not differentiable there
-          continue;
-        }
-        ++checked;
-        EXPECT_NEAR(a[k], fd, 1e-5 * std::max(1.0, std::abs(fd))) << name << "[" << k << "]";
-      }
-    };
-    check(g.means, grad.means, "means");
-    check(g.log_scales, grad.log_scales, "log_scales");
-    check(g.rotations, grad.rotations, "rotations");
-    check(g.opacities, grad.opacities, "opacities");
-    check(g.sh, grad.sh, "sh");
-    EXPECT_GT(checked, 80);
-    EXPECT_LE(kinks, checked / 20);
+    test::GradCheck gc;
+    test::checkGradientArray(g.means, grad.means, loss, "means", gc);
+    test::checkGradientArray(g.log_scales, grad.log_scales, loss, "log_scales", gc);
+    test::checkGradientArray(g.rotations, grad.rotations, loss, "rotations", gc);
+    test::checkGradientArray(g.opacities, grad.opacities, loss, "opacities", gc);
+    test::checkGradientArray(g.sh, grad.sh, loss, "sh", gc);
+    EXPECT_EQ(gc.bad, 0);
+    EXPECT_GT(gc.checked, 80);
+    EXPECT_LE(gc.kinks, gc.checked / 20);
   }
 }

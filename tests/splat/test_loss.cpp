@@ -1,4 +1,6 @@
 #include <gtest/gtest.h>
+
+#include "ssim_oracle.h"
 #include <tbb/task_arena.h>
 
 #include <cmath>
@@ -32,31 +34,6 @@ void separate(const ImageF& render, ImageF& target, float gap) {
       target.data[i] = render.data[i] + (render.data[i] < 0.5f ? 2 * gap : -2 * gap);
 }
 
-// An independent unclamped SSIM: OpenCV's Gaussian blur with zero padding, per channel.
-double ssimOracle(const ImageF& a, const ImageF& b) {
-  double total = 0;
-  for (int c = 0; c < 3; ++c) {
-    cv::Mat x(a.height, a.width, CV_64F), y(a.height, a.width, CV_64F);
-    for (int r = 0; r < a.height; ++r)
-      for (int k = 0; k < a.width; ++k) {
-        x.at<double>(r, k) = a.at(k, r, c);
-        y.at<double>(r, k) = b.at(k, r, c);
-      }
-    auto blur = [](const cv::Mat& m) {
-      cv::Mat o;
-      cv::GaussianBlur(m, o, cv::Size(11, 11), 1.5, 1.5, cv::BORDER_CONSTANT);
-      return o;
-    };
-    const cv::Mat mx = blur(x), my = blur(y);
-    const cv::Mat vx = blur(x.mul(x)) - mx.mul(mx), vy = blur(y.mul(y)) - my.mul(my);
-    const cv::Mat cxy = blur(x.mul(y)) - mx.mul(my);
-    const double C1 = 1e-4, C2 = 9e-4;
-    cv::Mat num = (2 * mx.mul(my) + C1).mul(2 * cxy + C2);
-    cv::Mat den = (mx.mul(mx) + my.mul(my) + C1).mul(vx + vy + C2);
-    total += cv::mean(num / den)[0];
-  }
-  return total / 3;
-}
 
 // Pixels to probe: the four corners, points on each border, a few interior ones.
 std::vector<std::pair<int, int>> probePixels(int w, int h, std::uint64_t seed) {
@@ -138,7 +115,7 @@ TEST(PhotometricLoss, GradientIsNotClampedOutsideTheUnitRange) {
   checkGradient(render, target, 0.2, 43);
   checkGradient(render, target, 1.0, 44);
   const LossResult r = photometricLoss(render, target, 1.0, false);
-  EXPECT_NEAR(r.ssim, ssimOracle(render, target), 1e-9);
+  EXPECT_NEAR(r.ssim, test::ssimOracle(render, target), 1e-9);
   EXPECT_GT(std::abs(r.ssim - ssim(render, target)), 1e-4) << "the loss's SSIM must not clamp";
 }
 
@@ -149,7 +126,7 @@ TEST(PhotometricLoss, SsimTermEqualsTheMetricForImagesInTheUnitRange) {
   const double metric = ssim(render, target);
   EXPECT_NEAR(r.ssim, metric, 1e-12);
   EXPECT_NEAR(r.loss, 1.0 - metric, 1e-12);
-  EXPECT_NEAR(r.ssim, ssimOracle(render, target), 1e-9);
+  EXPECT_NEAR(r.ssim, test::ssimOracle(render, target), 1e-9);
 }
 
 TEST(PhotometricLoss, L1TermAndMixing) {

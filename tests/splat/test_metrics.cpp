@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include "ssim_oracle.h"
+
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <random>
@@ -18,31 +20,6 @@ ImageF randomImage(int w, int h, std::uint64_t seed) {
   return img;
 }
 
-// An independent SSIM: OpenCV's Gaussian blur with zero padding, per channel.
-double ssimOracle(const ImageF& a, const ImageF& b) {
-  double total = 0;
-  for (int c = 0; c < 3; ++c) {
-    cv::Mat x(a.height, a.width, CV_64F), y(a.height, a.width, CV_64F);
-    for (int r = 0; r < a.height; ++r)
-      for (int k = 0; k < a.width; ++k) {
-        x.at<double>(r, k) = a.at(k, r, c);
-        y.at<double>(r, k) = b.at(k, r, c);
-      }
-    auto blur = [](const cv::Mat& m) {
-      cv::Mat o;
-      cv::GaussianBlur(m, o, cv::Size(11, 11), 1.5, 1.5, cv::BORDER_CONSTANT);
-      return o;
-    };
-    const cv::Mat mx = blur(x), my = blur(y);
-    const cv::Mat vx = blur(x.mul(x)) - mx.mul(mx), vy = blur(y.mul(y)) - my.mul(my);
-    const cv::Mat cxy = blur(x.mul(y)) - mx.mul(my);
-    const double C1 = 1e-4, C2 = 9e-4;
-    cv::Mat num = (2 * mx.mul(my) + C1).mul(2 * cxy + C2);
-    cv::Mat den = (mx.mul(mx) + my.mul(my) + C1).mul(vx + vy + C2);
-    total += cv::mean(num / den)[0];
-  }
-  return total / 3;
-}
 
 }  // namespace
 
@@ -65,7 +42,7 @@ TEST(Metrics, SsimMatchesAnIndependentImplementation) {
   std::mt19937_64 rng(2);
   std::normal_distribution<float> n(0, 0.1f);
   for (auto& v : b.data) v = std::clamp(v + n(rng), 0.0f, 1.0f);
-  EXPECT_NEAR(ssim(a, b), ssimOracle(a, b), 1e-6);
+  EXPECT_NEAR(ssim(a, b), test::ssimOracle(a, b), 1e-6);
   EXPECT_NEAR(ssim(a, a), 1.0, 1e-9);
   EXPECT_NEAR(ssim(a, b), ssim(b, a), 1e-12);
   EXPECT_LT(ssim(a, b), 0.99);  // noise is visible to SSIM

@@ -61,7 +61,9 @@ TEST(RasterStability, ScalesFromTinyToHuge) {
   for (double rel : {1e-6, 1e-4, 1e-2, 1.0, 1e2, 1e4}) {
     SCOPED_TRACE(rel);
     const auto r = renderChecked(oneGaussian(Eigen::Vector3d(0.1, 0.0, 0.05), rel * extent), cam);
-    if (rel >= 1.0) EXPECT_GT(r.alpha[12 * 32 + 16], 0.0f);  // a big Gaussian covers the centre
+    if (rel >= 1.0) {
+      EXPECT_GT(r.alpha[12 * 32 + 16], 0.0f);  // a big Gaussian covers the centre
+    }
   }
   // Anisotropic: one axis tiny, one huge.
   Gaussians g = oneGaussian(Eigen::Vector3d::Zero(), 1.0);

@@ -27,41 +27,6 @@ double linearLoss(const RenderOutputT<double>& r, const std::vector<double>& w) 
   return s;
 }
 
-struct GradCheck {
-  int checked = 0, kinks = 0, bad = 0;
-};
-
-// Central differences of `loss` for every entry of one parameter array, against the
-// analytic gradient. A parameter whose difference quotients at h and h/4 disagree sits
-// on a kink of the piecewise-smooth renderer (a pixel crossing an alpha threshold or a
-// rectangle edge) and is counted, not compared.
-void checkArray(std::vector<double>& param, const std::vector<double>& analytic,
-                const std::function<double()>& loss, const char* name, GradCheck& gc) {
-  for (std::size_t k = 0; k < param.size(); ++k) {
-    const double x0 = param[k];
-    auto quotient = [&](double h) {
-      param[k] = x0 + h;
-      const double lp = loss();
-      param[k] = x0 - h;
-      const double lm = loss();
-      param[k] = x0;
-      return (lp - lm) / (2 * h);
-    };
-    const double h = 1e-6 * std::max(1.0, std::abs(x0));
-    const double fd = quotient(h), fd4 = quotient(h / 4);
-    if (std::abs(fd - fd4) > 1e-5 * std::max(1.0, std::abs(fd))) {
-      ++gc.kinks;
-      continue;
-    }
-    ++gc.checked;
-    const double tol = 1e-5 * std::max(1.0, std::abs(fd));
-    if (std::abs(analytic[k] - fd) > tol) {
-      ++gc.bad;
-      ADD_FAILURE() << name << "[" << k << "]: analytic " << analytic[k] << " vs finite difference " << fd;
-    }
-  }
-}
-
 }  // namespace
 
 class RasterGradient : public ::testing::TestWithParam<int> {};
@@ -78,12 +43,12 @@ TEST_P(RasterGradient, EveryParameterMatchesFiniteDifferences) {
   GaussiansD grad = g.zerosLike();
   rasterizeBackwardT(g, cam, s, fwd, w.data(), grad);
   auto loss = [&] { return linearLoss(rasterizeT(g, cam, s), w); };
-  GradCheck gc;
-  checkArray(g.means, grad.means, loss, "means", gc);
-  checkArray(g.log_scales, grad.log_scales, loss, "log_scales", gc);
-  checkArray(g.rotations, grad.rotations, loss, "rotations", gc);
-  checkArray(g.opacities, grad.opacities, loss, "opacities", gc);
-  checkArray(g.sh, grad.sh, loss, "sh", gc);
+  test::GradCheck gc;
+  test::checkGradientArray(g.means, grad.means, loss, "means", gc);
+  test::checkGradientArray(g.log_scales, grad.log_scales, loss, "log_scales", gc);
+  test::checkGradientArray(g.rotations, grad.rotations, loss, "rotations", gc);
+  test::checkGradientArray(g.opacities, grad.opacities, loss, "opacities", gc);
+  test::checkGradientArray(g.sh, grad.sh, loss, "sh", gc);
   EXPECT_EQ(gc.bad, 0);
   EXPECT_LE(gc.kinks, gc.checked / 20) << "too many parameters on kinks: " << gc.kinks;
   int visible = 0;
