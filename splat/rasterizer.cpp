@@ -528,6 +528,135 @@ void walkAllPixels(const RasterStateT<T>& st, int W, int H, Weights&& weights, V
 
 }  // namespace
 
+// Fills the backward pass's per-pair slots (9 per pair: opacity, mean2d 2, conic 3,
+// colour 3). The generic version walks pixel by pixel (the double tests run it); the
+// float version below is the SIMD kernel with the same arithmetic per contribution.
+template <typename T>
+void backwardSlots(const RasterStateT<T>& st, int W, int H, const T* dL_drgb, T* slots) {
+  constexpr int kSlot = 9;
+  walkAllPixels(
+      st, W, H, [&](std::size_t pix) { return &dL_drgb[pix * 3]; },
+      [&](std::uint32_t e, const TileGaussian<T>& q, T dx, T dy, T G, bool unclamped, T dL_dalpha, T wcol,
+          const T* w) {
+        T* sl = &slots[static_cast<std::size_t>(st.entry_slot[e]) * kSlot];
+        alphaToProjected(q, dx, dy, G, unclamped, dL_dalpha, sl);
+        for (int c = 0; c < 3; ++c) sl[6 + c] += wcol * w[c];
+      });
+}
+
+inline float hsum(v4f v) { return (v[0] + v[1]) + (v[2] + v[3]); }
+
+template <>
+void backwardSlots<float>(const RasterStateT<float>& st, int W, int H, const float* dL_drgb, float* slots) {
+  constexpr int kSlot = 9;
+  constexpr int P = kTileSize * kTileSize;
+  const RasterSettings& rs = st.settings;
+  const float bg[3] = {rs.background[0], rs.background[1], rs.background[2]};
+  arena().execute([&] {
+    tbb::parallel_for(0, st.tiles_x * st.tiles_y, [&](int tile) {
+      std::vector<TileGaussian<float>> q;
+      gatherTile(st, tile, q);
+      if (q.empty()) return;
+      const std::uint32_t base = st.tile_start[tile];
+      int x0, y0, x1, y1;
+      tilePixels(st, tile, W, H, x0, y0, x1, y1);
+      const int w = x1 - x0, h = y1 - y0;
+      // Per-pixel state of the back-to-front walk (see walkBack for the scalar form).
+      alignas(64) float Tr[P], finalT[P], walked[P], acc0[P], acc1[P], acc2[P], la[P], lc0[P], lc1[P], lc2[P],
+          w0[P], w1[P], w2[P], bgdot[P];
+      std::uint32_t jmax = 0;
+      for (int k = 0; k < P; ++k) {
+        const int r = k / kTileSize, c = k % kTileSize;
+        const bool inside = c < w && r < h;
+        const std::size_t pix = inside ? static_cast<std::size_t>(y0 + r) * W + (x0 + c) : 0;
+        Tr[k] = finalT[k] = inside ? st.final_T[pix] : 1.0f;
+        walked[k] = inside ? static_cast<float>(st.n_walked[pix]) : 0.0f;
+        if (inside) jmax = std::max(jmax, st.n_walked[pix]);
+        acc0[k] = acc1[k] = acc2[k] = la[k] = lc0[k] = lc1[k] = lc2[k] = 0.0f;
+        w0[k] = inside ? dL_drgb[pix * 3] : 0.0f;
+        w1[k] = inside ? dL_drgb[pix * 3 + 1] : 0.0f;
+        w2[k] = inside ? dL_drgb[pix * 3 + 2] : 0.0f;
+        bgdot[k] = bg[0] * w0[k] + bg[1] * w1[k] + bg[2] * w2[k];
+      }
+      const v4f lane{0.5f, 1.5f, 2.5f, 3.5f};
+      auto load = [](const float* p) {
+        v4f v;
+        std::memcpy(&v, p, 16);
+        return v;
+      };
+      auto store = [](float* p, v4f v) { std::memcpy(p, &v, 16); };
+      for (std::uint32_t jj = jmax; jj-- > 0;) {
+        const TileGaussian<float>& g = q[jj];
+        int c0, c1, r0, r1;
+        tileSpan(g.mx, g.hx, x0, x1, c0, c1);
+        tileSpan(g.my, g.hy, y0, y1, r0, r1);
+        const v4f mx = v4(g.mx), hx = v4(g.hx), o = v4(g.o), jv = v4(static_cast<float>(jj));
+        const v4f ha = v4(-0.5f) * v4(g.a);
+        const v4f col0 = v4(g.col[0]), col1 = v4(g.col[1]), col2 = v4(g.col[2]);
+        v4f s_op = v4(0), s_mx = v4(0), s_my = v4(0), s_ca = v4(0), s_cb = v4(0), s_cc = v4(0), s_c0 = v4(0),
+            s_c1 = v4(0), s_c2 = v4(0);
+        for (int r = r0; r <= r1; ++r) {
+          const float dys = static_cast<float>(y0 + r) + 0.5f - g.my;
+          if (!(std::abs(dys) <= g.hy)) continue;
+          const v4f dy = v4(dys), qy = v4(rowQuad(g, dys)), by = v4(rowCross(g, dys));
+          for (int cb = c0 & ~3; cb <= c1; cb += 4) {
+            const int k = r * kTileSize + cb;
+            const v4f dx = (v4(static_cast<float>(x0 + cb)) + lane) - mx;
+            const v4f power = ha * dx * dx + qy - by * dx;
+            const v4f G = expNonPositive4(power < v4(0.0f) ? power : v4(0.0f));
+            const v4f oG = o * G;
+            const v4f alpha = oG < v4(kMaxAlpha) ? oG : v4(kMaxAlpha);
+            const v4f adx = reinterpret_cast<v4f>(reinterpret_cast<v4i>(dx) & 0x7fffffff);
+            const v4i valid = (jv < load(walked + k)) & (adx <= hx) & (power <= v4(0.0f)) & (oG >= v4(kMinAlpha));
+            const v4f a_eff = valid ? alpha : v4(0.0f);
+            const v4f t = load(Tr + k) / (v4(1.0f) - a_eff);  // transmittance in front of jj
+            const v4f lav = load(la + k);
+            v4f a0 = load(acc0 + k), a1 = load(acc1 + k), a2 = load(acc2 + k);
+            a0 = valid ? lav * load(lc0 + k) + (v4(1.0f) - lav) * a0 : a0;
+            a1 = valid ? lav * load(lc1 + k) + (v4(1.0f) - lav) * a1 : a1;
+            a2 = valid ? lav * load(lc2 + k) + (v4(1.0f) - lav) * a2 : a2;
+            const v4f ww0 = load(w0 + k), ww1 = load(w1 + k), ww2 = load(w2 + k);
+            v4f dLda = (col0 - a0) * ww0;
+            dLda += (col1 - a1) * ww1;
+            dLda += (col2 - a2) * ww2;
+            dLda = dLda * t - load(finalT + k) / (v4(1.0f) - alpha) * load(bgdot + k);
+            store(acc0 + k, a0);
+            store(acc1 + k, a1);
+            store(acc2 + k, a2);
+            store(la + k, valid ? alpha : lav);
+            store(lc0 + k, valid ? col0 : load(lc0 + k));
+            store(lc1 + k, valid ? col1 : load(lc1 + k));
+            store(lc2 + k, valid ? col2 : load(lc2 + k));
+            store(Tr + k, t);
+            const v4i gm = valid & (oG < v4(kMaxAlpha));
+            const v4f dG = o * dLda * G;
+            s_op += gm ? G * dLda : v4(0.0f);
+            s_mx += gm ? dG * (v4(g.a) * dx + v4(g.b) * dy) : v4(0.0f);
+            s_my += gm ? dG * (v4(g.b) * dx + v4(g.c) * dy) : v4(0.0f);
+            s_ca += gm ? dG * v4(-0.5f) * dx * dx : v4(0.0f);
+            s_cb += gm ? dG * (-dx * dy) : v4(0.0f);
+            s_cc += gm ? dG * v4(-0.5f) * dy * dy : v4(0.0f);
+            const v4f wcol = alpha * t;
+            s_c0 += valid ? wcol * ww0 : v4(0.0f);
+            s_c1 += valid ? wcol * ww1 : v4(0.0f);
+            s_c2 += valid ? wcol * ww2 : v4(0.0f);
+          }
+        }
+        float* sl = &slots[static_cast<std::size_t>(st.entry_slot[base + jj]) * kSlot];
+        sl[0] = hsum(s_op);
+        sl[1] = hsum(s_mx);
+        sl[2] = hsum(s_my);
+        sl[3] = hsum(s_ca);
+        sl[4] = hsum(s_cb);
+        sl[5] = hsum(s_cc);
+        sl[6] = hsum(s_c0);
+        sl[7] = hsum(s_c1);
+        sl[8] = hsum(s_c2);
+      }
+    });
+  });
+}
+
 template <typename T>
 void rasterizeBackwardT(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& s,
                         const RenderOutputT<T>& fwd, const T* dL_drgb, GaussiansT<T>& grad,
@@ -540,14 +669,7 @@ void rasterizeBackwardT(const GaussiansT<T>& g, const Camera& cam, const RasterS
   // Per pair slot: opacity, mean2d (2), conic (3), colour (3).
   constexpr int kSlot = 9;
   std::vector<T> slots(static_cast<std::size_t>(pairs) * kSlot, T(0));
-  walkAllPixels(
-      st, W, H, [&](std::size_t pix) { return &dL_drgb[pix * 3]; },
-      [&](std::uint32_t e, const TileGaussian<T>& q, T dx, T dy, T G, bool unclamped, T dL_dalpha, T wcol,
-          const T* w) {
-        T* sl = &slots[static_cast<std::size_t>(st.entry_slot[e]) * kSlot];
-        alphaToProjected(q, dx, dy, G, unclamped, dL_dalpha, sl);
-        for (int c = 0; c < 3; ++c) sl[6 + c] += wcol * w[c];
-      });
+  backwardSlots(st, W, H, dL_drgb, slots.data());
 
   arena().execute([&] {
     // Reduce each Gaussian's slots in slot order, then chain to its parameters.

@@ -87,12 +87,24 @@ TEST(RasterGradient, MeanTwoDGradientMatchesAShiftOfThePrincipalPoint) {
   EXPECT_GT(std::abs(sx) + std::abs(sy), 1e-3);
 }
 
-TEST(Rasterizer, FloatPathMatchesDoublePath) {
+struct FloatCase {
+  int gaussians, sh_degree;
+  double spread;
+  float background;
+  std::uint64_t seed;
+};
+
+class FloatPath : public ::testing::TestWithParam<FloatCase> {};
+
+// The float product path (SIMD kernels) against the same code in double.
+TEST_P(FloatPath, MatchesDoublePath) {
+  const FloatCase fc = GetParam();
   const Camera cam = test::smallCamera(64, 48);
-  const GaussiansD gd = test::randomScene<double>(60, 3, 5);
+  const GaussiansD gd = test::randomScene<double>(fc.gaussians, fc.sh_degree, fc.seed, fc.spread);
   const Gaussians gf = gd.cast<float>();
   RasterSettings s;
-  s.sh_degree = 3;
+  s.sh_degree = fc.sh_degree;
+  s.background = {fc.background, 0.5f * fc.background, 1.0f - fc.background};
   const auto rd = rasterizeT(gd, cam, s);
   const auto rf = rasterizeT(gf, cam, s);
   double max_diff = 0;
@@ -119,6 +131,10 @@ TEST(Rasterizer, FloatPathMatchesDoublePath) {
   compare(gradd.opacities, gradf.opacities, "opacities");
   compare(gradd.sh, gradf.sh, "sh");
 }
+
+INSTANTIATE_TEST_SUITE_P(Scenes, FloatPath,
+                         ::testing::Values(FloatCase{60, 3, 0.9, 0.0f, 5}, FloatCase{300, 0, 0.6, 0.7f, 6},
+                                           FloatCase{150, 1, 1.5, 0.3f, 7}));
 
 TEST(Rasterizer, BitIdenticalAcrossRunsAndThreadCounts) {
   const Camera cam = test::smallCamera(96, 80);
