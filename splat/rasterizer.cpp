@@ -255,6 +255,28 @@ inline v4f expNonPositive4(v4f x) {
   return x < v4(-87.0f) ? v4(0.0f) : p * scale;
 }
 
+// One Gaussian at four pixel centres of a row: the quantities both SIMD kernels need,
+// computed in one place so that the forward and backward passes make identical
+// threshold decisions. `touches` is rule 4's rectangle test in x plus the alpha test
+// (o G >= 1/255 is alpha >= 1/255, as 0.99 > 1/255); the row's y test is the caller's.
+struct Lanes {
+  v4f dx, G, oG, alpha;
+  v4i touches;
+};
+
+inline Lanes evalLanes(v4f dx, v4f ha, v4f qy, v4f by, v4f o, v4f hx) {
+  Lanes l;
+  l.dx = dx;
+  // Same expression tree as powerAt(): ((-0.5 a) dx) dx + row_quad - row_cross dx.
+  const v4f power = ha * dx * dx + qy - by * dx;
+  l.G = expNonPositive4(power < v4(0.0f) ? power : v4(0.0f));
+  l.oG = o * l.G;
+  l.alpha = l.oG < v4(kMaxAlpha) ? l.oG : v4(kMaxAlpha);
+  const v4f adx = reinterpret_cast<v4f>(reinterpret_cast<v4i>(dx) & 0x7fffffff);
+  l.touches = (adx <= hx) & (power <= v4(0.0f)) & (l.oG >= v4(kMinAlpha));
+  return l;
+}
+
 template <>
 void compositeTile<float>(const std::vector<TileGaussian<float>>& q, int x0, int y0, int x1, int y1,
                           const float bg[3], int W, RenderOutputT<float>& out, RasterStateT<float>& st) {
@@ -283,16 +305,11 @@ void compositeTile<float>(const std::vector<TileGaussian<float>>& q, int x0, int
       const v4f qy = v4(rowQuad(g, dy)), by = v4(rowCross(g, dy));
       for (int cb = c0 & ~3; cb <= c1; cb += 4) {
         const int k = r * kTileSize + cb;
-        // Same expression tree as powerAt(): ((-0.5 a) dx) dx + row_quad - row_cross dx.
-        const v4f dx = (v4(static_cast<float>(x0 + cb)) + lane) - mx;
-        const v4f power = ha * dx * dx + qy - by * dx;
-        const v4f G = expNonPositive4(power < v4(0.0f) ? power : v4(0.0f));
-        const v4f oG = o * G;
-        const v4f alpha = oG < v4(kMaxAlpha) ? oG : v4(kMaxAlpha);
+        const Lanes L = evalLanes((v4(static_cast<float>(x0 + cb)) + lane) - mx, ha, qy, by, o, hx);
+        const v4f alpha = L.alpha;
         v4f t, c0v, c1v, c2v, dv, wv, cv;
         std::memcpy(&t, Tr + k, 16);
-        const v4f adx = reinterpret_cast<v4f>(reinterpret_cast<v4i>(dx) & 0x7fffffff);
-        const v4i ok = (t > v4(0.0f)) & (adx <= hx) & (power <= v4(0.0f)) & (oG >= v4(kMinAlpha));
+        const v4i ok = (t > v4(0.0f)) & L.touches;
         const v4f next = t * (v4(1.0f) - alpha);
         const v4i stop = ok & (next < v4(kMinTransmittance));
         const v4i take = ok & ~stop;
@@ -601,13 +618,9 @@ void backwardSlots<float>(const RasterStateT<float>& st, int W, int H, const flo
           const v4f dy = v4(dys), qy = v4(rowQuad(g, dys)), by = v4(rowCross(g, dys));
           for (int cb = c0 & ~3; cb <= c1; cb += 4) {
             const int k = r * kTileSize + cb;
-            const v4f dx = (v4(static_cast<float>(x0 + cb)) + lane) - mx;
-            const v4f power = ha * dx * dx + qy - by * dx;
-            const v4f G = expNonPositive4(power < v4(0.0f) ? power : v4(0.0f));
-            const v4f oG = o * G;
-            const v4f alpha = oG < v4(kMaxAlpha) ? oG : v4(kMaxAlpha);
-            const v4f adx = reinterpret_cast<v4f>(reinterpret_cast<v4i>(dx) & 0x7fffffff);
-            const v4i valid = (jv < load(walked + k)) & (adx <= hx) & (power <= v4(0.0f)) & (oG >= v4(kMinAlpha));
+            const Lanes L = evalLanes((v4(static_cast<float>(x0 + cb)) + lane) - mx, ha, qy, by, o, hx);
+            const v4f dx = L.dx, G = L.G, oG = L.oG, alpha = L.alpha;
+            const v4i valid = (jv < load(walked + k)) & L.touches;
             const v4f a_eff = valid ? alpha : v4(0.0f);
             const v4f t = load(Tr + k) / (v4(1.0f) - a_eff);  // transmittance in front of jj
             const v4f lav = load(la + k);
