@@ -6,6 +6,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <bit>
 #include <cmath>
@@ -387,6 +388,7 @@ RenderOutputT<T> rasterizeT(const GaussiansT<T>& g, const Camera& cam, const Ras
   st->n_walked.assign(static_cast<std::size_t>(W) * H, 0);
   st->proj.resize(n);
   std::vector<std::uint32_t> count(n, 0);
+  std::vector<std::array<int, 4>> tile_rect(n);  // tiles touched: x0, x1, y0, y1 (inclusive)
 
   arena().execute([&] {
     // Projection and the number of tiles each Gaussian touches.
@@ -404,8 +406,9 @@ RenderOutputT<T> rasterizeT(const GaussiansT<T>& g, const Camera& cam, const Ras
         pixelRange(P.mean2d[0], P.half[0], W, px0, px1);
         pixelRange(P.mean2d[1], P.half[1], H, py0, py1);
         if (px0 > px1 || py0 > py1) continue;
-        count[i] = static_cast<std::uint32_t>((px1 / kTileSize - px0 / kTileSize + 1) *
-                                              (py1 / kTileSize - py0 / kTileSize + 1));
+        tile_rect[i] = {px0 / kTileSize, px1 / kTileSize, py0 / kTileSize, py1 / kTileSize};
+        count[i] = static_cast<std::uint32_t>((tile_rect[i][1] - tile_rect[i][0] + 1) *
+                                              (tile_rect[i][3] - tile_rect[i][2] + 1));
       }
     });
   });
@@ -419,13 +422,10 @@ RenderOutputT<T> rasterizeT(const GaussiansT<T>& g, const Camera& cam, const Ras
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& r) {
       for (std::size_t i = r.begin(); i < r.end(); ++i) {
         if (!count[i]) continue;
-        const Projected<T>& P = st->proj[i];
-        int px0, px1, py0, py1;
-        pixelRange(P.mean2d[0], P.half[0], W, px0, px1);
-        pixelRange(P.mean2d[1], P.half[1], H, py0, py1);
+        const auto& [tx0, tx1, ty0, ty1] = tile_rect[i];
         std::uint32_t k = st->gauss_start[i];
-        for (int ty = py0 / kTileSize; ty <= py1 / kTileSize; ++ty)
-          for (int tx = px0 / kTileSize; tx <= px1 / kTileSize; ++tx)
+        for (int ty = ty0; ty <= ty1; ++ty)
+          for (int tx = tx0; tx <= tx1; ++tx)
             slot_tile[k++] = static_cast<std::uint32_t>(ty * st->tiles_x + tx);
       }
     });
@@ -448,19 +448,21 @@ RenderOutputT<T> rasterizeT(const GaussiansT<T>& g, const Camera& cam, const Ras
   const T bg[3] = {T(s.background[0]), T(s.background[1]), T(s.background[2])};
   arena().execute([&] {
     tbb::parallel_for(0, tiles, [&](int tile) {
-      // Rule 6: by camera z, ties by index (entries arrive in index order; stable sort).
+      // Rule 6: by camera z, ties by index.
+      struct Entry {
+        T depth;
+        std::uint32_t gauss, slot;
+      };
       const std::uint32_t b = st->tile_start[tile], e = st->tile_start[tile + 1];
-      std::vector<std::pair<T, std::uint32_t>> order(e - b);
-      for (std::uint32_t k = b; k < e; ++k) order[k - b] = {st->proj[st->entry_gauss[k]].depth, st->entry_slot[k]};
-      std::vector<std::uint32_t> gs(e - b);
-      for (std::uint32_t k = b; k < e; ++k) gs[k - b] = st->entry_gauss[k];
-      std::vector<std::uint32_t> idx(e - b);
-      for (std::uint32_t k = 0; k < e - b; ++k) idx[k] = k;
-      std::stable_sort(idx.begin(), idx.end(),
-                       [&](std::uint32_t x, std::uint32_t y) { return order[x].first < order[y].first; });
-      for (std::uint32_t k = 0; k < e - b; ++k) {
-        st->entry_gauss[b + k] = gs[idx[k]];
-        st->entry_slot[b + k] = order[idx[k]].second;
+      std::vector<Entry> entries(e - b);
+      for (std::uint32_t k = b; k < e; ++k)
+        entries[k - b] = {st->proj[st->entry_gauss[k]].depth, st->entry_gauss[k], st->entry_slot[k]};
+      std::sort(entries.begin(), entries.end(), [](const Entry& x, const Entry& y) {
+        return x.depth < y.depth || (x.depth == y.depth && x.gauss < y.gauss);
+      });
+      for (std::uint32_t k = b; k < e; ++k) {
+        st->entry_gauss[k] = entries[k - b].gauss;
+        st->entry_slot[k] = entries[k - b].slot;
       }
 
       std::vector<TileGaussian<T>> q;
