@@ -29,13 +29,5 @@ if [ ${#missing[@]} -eq 0 ]; then
   exec bash "${here}/install_node_tools.sh"
 fi
 
-sudo_cmd=()
-if [ "$(id -u)" -ne 0 ]; then
-  command -v sudo >/dev/null || { echo "install_deps: need root or sudo to install: ${missing[*]}" >&2; exit 1; }
-  sudo_cmd=(sudo)
-fi
-echo "install_deps: installing ${missing[*]}"
-export DEBIAN_FRONTEND=noninteractive
-"${sudo_cmd[@]}" apt-get update -qq
-"${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+bash "${here}/apt_install.sh" "${missing[@]}"
 bash "${here}/install_node_tools.sh"

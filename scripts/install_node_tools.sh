@@ -10,15 +10,7 @@ prefix="${repo}/build/node_tools"
 tool="${prefix}/node_modules/.bin/splat-transform"
 
 if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
-  sudo_cmd=()
-  if [ "$(id -u)" -ne 0 ]; then
-    command -v sudo >/dev/null || { echo "install_node_tools: need root or sudo to install nodejs npm" >&2; exit 1; }
-    sudo_cmd=(sudo)
-  fi
-  echo "install_node_tools: installing nodejs npm"
-  export DEBIAN_FRONTEND=noninteractive
-  "${sudo_cmd[@]}" apt-get update -qq
-  "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends nodejs npm
+  bash "${repo}/scripts/apt_install.sh" nodejs npm
 fi
 
 if [ -x "${tool}" ]; then
