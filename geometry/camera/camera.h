@@ -23,6 +23,7 @@ struct Intrinsics {
   // The same camera for an image resized by `factor` (e.g. 0.5 for half size).
   Intrinsics scaled(double factor) const;
   bool valid() const;
+  bool operator==(const Intrinsics&) const = default;
 };
 
 // A plane n.x + d = 0 with unit normal n pointing to the inside of a volume.

@@ -21,11 +21,6 @@ double secondsSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-bool sameIntrinsics(const Intrinsics& a, const Intrinsics& b) {
-  return a.width == b.width && a.height == b.height && a.fx == b.fx && a.fy == b.fy &&
-         a.cx == b.cx && a.cy == b.cy;
-}
-
 // Replaces `dst` by the finished folder `src` so that a reader never sees a half-written
 // dataset: the old one is moved aside first and removed last.
 void replaceFolder(const fs::path& src, const fs::path& dst) {
@@ -46,7 +41,7 @@ ColmapModel colmapModelOf(const SyntheticScene& scene) {
   for (size_t i = 0; i < scene.cameras.size(); ++i) {
     const Camera& cam = scene.cameras[i];
     auto it = std::find_if(distinct.begin(), distinct.end(),
-                           [&](const Intrinsics& K) { return sameIntrinsics(K, cam.K); });
+                           [&](const Intrinsics& K) { return K == cam.K; });
     std::uint32_t cam_id;
     if (it == distinct.end()) {
       distinct.push_back(cam.K);
