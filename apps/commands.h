@@ -9,5 +9,7 @@ using Action = std::function<int()>;
 
 void addInfoCommand(CLI::App& app, Action& action);   // apps/cmd_info.cpp
 void addSceneCommand(CLI::App& app, Action& action);  // apps/cmd_scene.cpp
+void addTrainCommand(CLI::App& app, Action& action);  // apps/cmd_train.cpp
+void addBenchCommand(CLI::App& app, Action& action);  // apps/cmd_bench.cpp
 
 }  // namespace saresgs::apps

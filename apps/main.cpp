@@ -12,6 +12,8 @@ int main(int argc, char** argv) {
   saresgs::apps::Action action;
   saresgs::apps::addInfoCommand(app, action);
   saresgs::apps::addSceneCommand(app, action);
+  saresgs::apps::addTrainCommand(app, action);
+  saresgs::apps::addBenchCommand(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

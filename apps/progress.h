@@ -8,12 +8,14 @@ namespace saresgs::apps {
 
 class Progress {
  public:
-  void update(const std::string& stage, int done, int total);
+  // `detail` (e.g. "loss 0.031  Gaussians 41k") is printed after the counts.
+  void update(const std::string& stage, int done, int total, const std::string& detail = {});
 
  private:
   std::string stage_;
   std::chrono::steady_clock::time_point start_;
   int last_decile_ = -1;
+  std::chrono::steady_clock::time_point last_draw_;
 };
 
 }  // namespace saresgs::apps

@@ -128,6 +128,7 @@ Scene loadBlenderDataset(const std::string& path, const DatasetOptions& opts) {
     readSplit(root, "transforms_test.json", opts, scene, scene.test);
   if (scene.train.empty())
     throw InputError((root / "transforms_train.json").string(), "frames", "expected at least one frame");
+  scene.background = opts.load.background;
   scene.finalize();  // no sparse points: the AABB spans the train cameras
   return scene;
 }

@@ -44,6 +44,12 @@ bool readManifestSplit(const fs::path& manifest, Scene& scene) {
   } catch (const nlohmann::json::exception& e) {
     throw InputError(manifest.string(), "json", std::string("not valid JSON: ") + e.what());
   }
+  if (j.contains("background")) {
+    const auto& b = j["background"];
+    if (!b.is_array() || b.size() != 3 || !b[0].is_number() || !b[1].is_number() || !b[2].is_number())
+      throw InputError(manifest.string(), "background", "expected an array of 3 numbers");
+    scene.background = std::array<float, 3>{b[0].get<float>(), b[1].get<float>(), b[2].get<float>()};
+  }
   if (!j.contains("split")) return false;
   std::map<std::string, int> index;
   for (int i = 0; i < static_cast<int>(scene.views.size()); ++i) index[scene.views[i].name] = i;

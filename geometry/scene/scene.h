@@ -58,6 +58,9 @@ class Scene {
   std::vector<SparsePoint> points;
   AABB aabb;             // of the sparse points (of the cameras when there are none)
   double extent = 0.0;   // 3DGS scene scale from the train cameras
+  // The colour behind the content when the dataset knows it (Blender: the compositing
+  // background; synthetic scenes: the manifest's), for training against the same one.
+  std::optional<std::array<float, 3>> background;
   ImageLoadOptions load;
 
   Scene();

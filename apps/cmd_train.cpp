@@ -1,0 +1,150 @@
+// saresgs train: plain 3DGS (optionally with residual supervision) on all train views of
+// a dataset; writes results.json, test renders beside their ground truth, and the .ply.
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+
+#include "apps/commands.h"
+#include "apps/progress.h"
+#include "geometry/image/contact_sheet.h"
+#include "geometry/io/atomic_file.h"
+#include "geometry/scene/scene.h"
+#include "splat/ply.h"
+#include "splat/rasterize_detail.h"
+#include "splat/train/trainer.h"
+
+namespace saresgs::apps {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct TrainArgs {
+  std::string dataset, out;
+  int iterations = 3000;
+  int downscale = 1;
+  int threads = 0;
+  int checkpoint_every = 1000;
+  bool resume = false;
+  std::string ranking = "both";
+  TrainerOptions opt;
+};
+
+std::string shortCount(std::size_t n) {
+  char buf[32];
+  if (n >= 10000) std::snprintf(buf, sizeof buf, "%.0fk", n / 1000.0);
+  else std::snprintf(buf, sizeof buf, "%zu", n);
+  return buf;
+}
+
+// Ground truth and render side by side per test view, one PNG each, plus one sheet.
+void writeTestRenders(const Trainer& t, const Evaluation& ev, const std::string& dir) {
+  fs::create_directories(dir);
+  std::vector<Image8> images;
+  images.reserve(2 * ev.views.size());
+  std::vector<ContactSheetItem> sheet;
+  for (const ViewMetrics& m : ev.views) {
+    const SceneView& v = t.scene().views[static_cast<std::size_t>(m.view)];
+    images.push_back(t.scene().image(m.view));
+    images.push_back(toByte(t.render(v.camera).rgb));
+    char label[64];
+    std::snprintf(label, sizeof label, "%.2f dB", m.psnr);
+    const std::vector<ContactSheetItem> pair = {{&images[images.size() - 2], v.name + " truth", false},
+                                                {&images.back(), std::string("render ") + label, true}};
+    writeImage(dir + "/" + fs::path(v.name).stem().string() + ".png",
+               makeContactSheet(pair, 2, images.back().width));
+    sheet.insert(sheet.end(), pair.begin(), pair.end());
+  }
+  if (!sheet.empty()) writeImage(dir + "/all.png", makeContactSheet(sheet, 4, 256));
+}
+
+int runTrain(TrainArgs& a) {
+  if (a.threads > 0) setRasterThreads(a.threads);
+  a.opt.residual.ranking = parseUncertaintyRanking(a.ranking);
+  DatasetOptions dopt;
+  dopt.load.downscale = a.downscale;
+  const Scene scene = loadDataset(a.dataset, dopt);
+  fs::create_directories(a.out);
+  const std::string ckpt = a.out + "/checkpoint.bin";
+  Trainer trainer(scene, a.opt);
+  if (a.resume && fs::exists(ckpt)) {
+    trainer.loadCheckpoint(ckpt);
+    std::cerr << "resumed " << ckpt << " at iteration " << trainer.iteration() << "\n";
+  }
+  std::cerr << "training on " << scene.train.size() << " views (" << scene.test.size() << " test), "
+            << trainer.gaussians().size() << " initial Gaussians, " << a.iterations << " iterations\n";
+  Progress progress;
+  const int start = trainer.iteration();
+  const auto t0 = std::chrono::steady_clock::now();
+  while (trainer.iteration() < a.iterations) {
+    const int chunk = std::min(a.iterations - trainer.iteration(),
+                               a.checkpoint_every > 0 ? a.checkpoint_every - trainer.iteration() % a.checkpoint_every
+                                                      : a.iterations);
+    trainer.train(scene.train, chunk, [&](const TrainProgress& p) {
+      char detail[128];
+      std::snprintf(detail, sizeof detail, "it %d  loss %.4f  Gaussians %s", p.iteration, p.loss_ema,
+                    shortCount(p.gaussians).c_str());
+      progress.update("train", p.iteration - start, a.iterations - start, detail);
+    });
+    if (a.checkpoint_every > 0) trainer.saveCheckpoint(ckpt);
+  }
+  const double train_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+  const std::vector<int>& eval_views = scene.test.empty() ? scene.train : scene.test;
+  const Evaluation ev = trainer.evaluate(eval_views);
+  writeTestRenders(trainer, ev, a.out + "/test_renders");
+  writeGaussiansPly(a.out + "/point_cloud.ply", trainer.gaussians());
+
+  nlohmann::json j;
+  j["dataset"] = a.dataset;
+  j["iterations"] = a.iterations;
+  j["evaluated_on"] = scene.test.empty() ? "train (the dataset has no test views)" : "test";
+  j["psnr"] = ev.psnr;
+  j["ssim"] = ev.ssim;
+  j["gaussians"] = trainer.gaussians().size();
+  j["train_seconds_this_run"] = train_seconds;
+  j["threads"] = rasterThreads();
+  j["residual"] = a.opt.residual.enabled;
+  const StageSeconds& s = trainer.seconds();
+  j["stage_seconds"] = {{"render", s.render}, {"loss", s.loss}, {"backward", s.backward},
+                        {"optimizer", s.optimizer}, {"densify", s.densify}};
+  for (const ViewMetrics& m : ev.views)
+    j["views"].push_back({{"name", scene.views[static_cast<std::size_t>(m.view)].name}, {"psnr", m.psnr}, {"ssim", m.ssim}});
+  writeFileAtomic(a.out + "/results.json", j.dump(2) + "\n");
+  std::printf("PSNR %.2f dB  SSIM %.4f  on %zu %s views; %zu Gaussians; %.1f s (%.1f it/s)\n", ev.psnr, ev.ssim,
+              ev.views.size(), scene.test.empty() ? "train" : "test", trainer.gaussians().size(), train_seconds,
+              train_seconds > 0 ? (a.iterations - start) / train_seconds : 0.0);
+  std::printf("wrote %s/results.json, %s/test_renders/, %s/point_cloud.ply\n", a.out.c_str(), a.out.c_str(),
+              a.out.c_str());
+  return 0;
+}
+
+}  // namespace
+
+void addTrainCommand(CLI::App& app, Action& action) {
+  auto a = std::make_shared<TrainArgs>();
+  CLI::App* sub = app.add_subcommand("train", "Train 3D Gaussians on all train views of a dataset");
+  sub->add_option("--dataset", a->dataset, "COLMAP, Blender or `saresgs scene` folder")->required();
+  sub->add_option("--out", a->out, "Output folder")->required();
+  sub->add_option("--iterations", a->iterations, "Training iterations")->check(CLI::Range(1, 10000000))->capture_default_str();
+  sub->add_option("--downscale", a->downscale, "Image downscale factor")->check(CLI::Range(1, 64))->capture_default_str();
+  sub->add_option("--sh-degree", a->opt.max_sh_degree, "Maximum SH degree")->check(CLI::Range(0, 3))->capture_default_str();
+  sub->add_option("--seed", a->opt.seed, "Random seed")->capture_default_str();
+  sub->add_option("--threads", a->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
+  sub->add_option("--densify-until", a->opt.densify.until_iter, "Last densification iteration")->capture_default_str();
+  sub->add_option("--max-gaussians", a->opt.densify.max_gaussians, "Cap on the model size (0: none)")->capture_default_str();
+  sub->add_option("--random-init", a->opt.random_init_points, "Random points when the dataset has none")->capture_default_str();
+  sub->add_flag("--residual", a->opt.residual.enabled, "Add SA-ResGS residual supervision");
+  sub->add_option("--residual-alpha", a->opt.residual.alpha, "Random fraction of G_sub")->check(CLI::Range(0.0, 1.0))->capture_default_str();
+  sub->add_option("--residual-beta", a->opt.residual.beta, "Uncertain fraction of G_sub")->check(CLI::Range(0.0, 1.0))->capture_default_str();
+  sub->add_option("--residual-ranking", a->ranking, "both | opacity | scale | random")
+      ->check(CLI::IsMember({"both", "opacity", "scale", "random"}))->capture_default_str();
+  sub->add_option("--checkpoint-every", a->checkpoint_every, "Iterations between checkpoints (0: none)")->capture_default_str();
+  sub->add_flag("--resume", a->resume, "Continue from OUT/checkpoint.bin when it exists");
+  sub->callback([&action, a] { action = [a] { return runTrain(*a); }; });
+}
+
+}  // namespace saresgs::apps

@@ -1,0 +1,134 @@
+#include "splat/train/densify.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Geometry>
+
+#include "splat/model_ops.h"
+
+namespace saresgs {
+
+namespace {
+
+float sigmoid(float x) { return 1.0f / (1.0f + std::exp(-x)); }
+float logit(float p) { return std::log(p / (1.0f - p)); }
+
+float maxScale(const Gaussians& g, std::size_t i) {
+  return std::exp(std::max({g.log_scales[3 * i], g.log_scales[3 * i + 1], g.log_scales[3 * i + 2]}));
+}
+
+Eigen::Matrix3f rotationOf(const Gaussians& g, std::size_t i) {
+  Eigen::Quaternionf q(g.rotations[4 * i], g.rotations[4 * i + 1], g.rotations[4 * i + 2], g.rotations[4 * i + 3]);
+  if (!(q.norm() > 0) || !std::isfinite(q.norm())) return Eigen::Matrix3f::Identity();
+  return q.normalized().toRotationMatrix();
+}
+
+// Keeps the moments aligned with a gathered model; gathered-in Gaussians listed in
+// `fresh` (positions in the new model) start from zero moments.
+void gatherAdam(AdamState& adam, const std::vector<int>& idx, std::size_t fresh_from) {
+  adam.m = gatherGaussians(adam.m, idx);
+  adam.v = gatherGaussians(adam.v, idx);
+  for (Gaussians* mom : {&adam.m, &adam.v}) {
+    mom->forEachArray([&](std::vector<float>& a, std::size_t per) {
+      std::fill(a.begin() + static_cast<std::ptrdiff_t>(fresh_from * per), a.end(), 0.0f);
+    });
+  }
+}
+
+}  // namespace
+
+void accumulateDensifyStats(DensifyStats& st, const std::vector<float>& grad_mean2d, const std::vector<float>& radii,
+                            const std::vector<std::uint8_t>& visible, int width, int height) {
+  const float sx = 0.5f * static_cast<float>(width), sy = 0.5f * static_cast<float>(height);
+  for (std::size_t i = 0; i < st.count.size(); ++i) {
+    if (!visible[i] || !(radii[i] > 0)) continue;
+    const float gx = grad_mean2d[2 * i] * sx, gy = grad_mean2d[2 * i + 1] * sy;
+    st.grad_accum[i] += std::sqrt(gx * gx + gy * gy);
+    st.count[i] += 1;
+    st.max_radius[i] = std::max(st.max_radius[i], radii[i]);
+  }
+}
+
+DensifyReport densifyAndPrune(Gaussians& g, AdamState& adam, DensifyStats& st, const DensifyOptions& opt,
+                              double extent, bool prune_big, std::mt19937_64& rng) {
+  DensifyReport rep;
+  const std::size_t n = g.size();
+  const float dense_limit = opt.percent_dense * static_cast<float>(extent);
+  std::vector<int> clone, split;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (st.count[i] == 0) continue;
+    const float mean_grad = st.grad_accum[i] / static_cast<float>(st.count[i]);
+    if (!(mean_grad >= opt.grad_threshold)) continue;
+    (maxScale(g, i) <= dense_limit ? clone : split).push_back(static_cast<int>(i));
+  }
+  // A cap on the model size trims growth (largest gradients first would need a sort; the
+  // index order is deterministic and the cap is a CPU-budget guard, not a method).
+  if (opt.max_gaussians > 0) {
+    std::size_t room = opt.max_gaussians > n ? opt.max_gaussians - n : 0;
+    if (clone.size() > room) clone.resize(room);
+    room -= clone.size();
+    const std::size_t split_room = room / static_cast<std::size_t>(std::max(1, opt.split_count - 1));
+    if (split.size() > split_room) split.resize(split_room);
+  }
+  rep.cloned = clone.size();
+  rep.split = split.size();
+
+  // New model: originals, then clones, then split children; split parents are dropped
+  // with the pruning below.
+  std::vector<int> idx(n);
+  for (std::size_t i = 0; i < n; ++i) idx[i] = static_cast<int>(i);
+  idx.insert(idx.end(), clone.begin(), clone.end());
+  for (int s : split)
+    for (int k = 0; k < opt.split_count; ++k) idx.push_back(s);
+  Gaussians out = gatherGaussians(g, idx);
+  std::normal_distribution<float> normal(0.0f, 1.0f);
+  const float shrink = std::log(0.8f * static_cast<float>(opt.split_count));
+  std::size_t j = n + clone.size();
+  for (int s : split) {
+    const Eigen::Matrix3f R = rotationOf(g, static_cast<std::size_t>(s));
+    for (int k = 0; k < opt.split_count; ++k, ++j) {
+      Eigen::Vector3f z;
+      for (int a = 0; a < 3; ++a) z[a] = normal(rng) * std::exp(g.log_scales[3 * s + a]);
+      const Eigen::Vector3f p = R * z;
+      for (int a = 0; a < 3; ++a) {
+        out.means[3 * j + a] += p[a];
+        out.log_scales[3 * j + a] -= shrink;
+      }
+    }
+  }
+  gatherAdam(adam, idx, n);
+
+  std::vector<float> radius(idx.size(), 0.0f);
+  for (std::size_t i = 0; i < n; ++i) radius[i] = st.max_radius[i];
+  std::vector<std::uint8_t> drop(idx.size(), 0);
+  for (int s : split) drop[static_cast<std::size_t>(s)] = 1;
+  for (std::size_t i = 0; i < idx.size(); ++i) {
+    if (sigmoid(out.opacities[i]) < opt.min_opacity) drop[i] = 1;
+    if (prune_big && (radius[i] > opt.max_screen_radius || maxScale(out, i) > opt.max_world_scale * extent)) drop[i] = 1;
+    // A non-finite parameter can only come from a diverged step; such a Gaussian is dropped
+    // rather than allowed to poison every render it touches.
+    bool finite = std::isfinite(out.opacities[i]);
+    for (int a = 0; a < 3 && finite; ++a) finite = std::isfinite(out.means[3 * i + a]) && std::isfinite(out.log_scales[3 * i + a]);
+    if (!finite) drop[i] = 1;
+  }
+  std::vector<int> keep;
+  keep.reserve(idx.size());
+  for (std::size_t i = 0; i < idx.size(); ++i)
+    if (!drop[i]) keep.push_back(static_cast<int>(i));
+  rep.pruned = idx.size() - keep.size() - split.size();
+  g = gatherGaussians(out, keep);
+  adam.m = gatherGaussians(adam.m, keep);
+  adam.v = gatherGaussians(adam.v, keep);
+  st.resize(g.size());
+  return rep;
+}
+
+void resetOpacity(Gaussians& g, AdamState& adam, float ceiling) {
+  const float cap = logit(ceiling);
+  for (std::size_t i = 0; i < g.size(); ++i) g.opacities[i] = std::min(g.opacities[i], cap);
+  std::fill(adam.m.opacities.begin(), adam.m.opacities.end(), 0.0f);
+  std::fill(adam.v.opacities.begin(), adam.v.opacities.end(), 0.0f);
+}
+
+}  // namespace saresgs

@@ -1,0 +1,62 @@
+#pragma once
+// Adaptive density control as 3DGS does it: Gaussians whose mean view-space (NDC)
+// gradient exceeds a threshold are cloned when small and split in two when large;
+// Gaussians that are nearly transparent or too big are pruned; opacities are reset
+// periodically. The schedule (from, until, interval, reset) is a parameter, so the
+// active loop can restart it.
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "splat/gaussians.h"
+#include "splat/train/adam.h"
+
+namespace saresgs {
+
+struct DensifyOptions {
+  bool enabled = true;
+  int from_iter = 500;
+  int until_iter = 15000;
+  int interval = 100;
+  int opacity_reset_interval = 3000;
+  float grad_threshold = 2e-4f;   // mean |dL/d mean2d| in NDC units
+  float percent_dense = 0.01f;    // clone below, split above this fraction of extent
+  float min_opacity = 0.005f;     // prune below
+  float max_screen_radius = 20;   // px; prunes only after the first opacity reset
+  float max_world_scale = 0.1f;   // fraction of extent; likewise
+  int split_count = 2;
+  std::size_t max_gaussians = 0;  // 0: unlimited; otherwise no growth beyond it
+};
+
+// Per-Gaussian statistics gathered between densification steps.
+struct DensifyStats {
+  std::vector<float> grad_accum;   // sum of |2D-mean gradient| in NDC units
+  std::vector<std::int32_t> count; // iterations in which the Gaussian was visible
+  std::vector<float> max_radius;   // px
+  void resize(std::size_t n) {
+    grad_accum.assign(n, 0.0f);
+    count.assign(n, 0);
+    max_radius.assign(n, 0.0f);
+  }
+};
+
+// Adds one iteration's statistics. grad_mean2d is in pixels (2 per Gaussian); the NDC
+// gradient is that times (W/2, H/2), the unit 3DGS's threshold is given in.
+void accumulateDensifyStats(DensifyStats& st, const std::vector<float>& grad_mean2d,
+                            const std::vector<float>& radii, const std::vector<std::uint8_t>& visible, int width,
+                            int height);
+
+struct DensifyReport {
+  std::size_t cloned = 0, split = 0, pruned = 0;
+};
+
+// Clones, splits, then prunes. New Gaussians get zero Adam moments (as 3DGS appends
+// them to the optimiser); the stats are reset for the new model. `prune_big` enables
+// the screen- and world-size pruning (3DGS: after the first opacity reset).
+DensifyReport densifyAndPrune(Gaussians& g, AdamState& adam, DensifyStats& st, const DensifyOptions& opt,
+                              double extent, bool prune_big, std::mt19937_64& rng);
+
+// Opacity <- min(opacity, 0.01), with its Adam moments zeroed (3DGS's reset).
+void resetOpacity(Gaussians& g, AdamState& adam, float ceiling = 0.01f);
+
+}  // namespace saresgs

@@ -1,0 +1,339 @@
+#include "splat/train/trainer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+#include <stdexcept>
+
+#include "geometry/error.h"
+#include "geometry/io/atomic_file.h"
+#include "splat/loss.h"
+#include "splat/metrics.h"
+#include "splat/train/init.h"
+
+namespace saresgs {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+Gaussians initialModel(const Scene& scene, const TrainerOptions& opt) {
+  std::vector<ColoredPoint> pts;
+  if (!scene.points.empty()) {
+    pts.reserve(scene.points.size());
+    for (const auto& p : scene.points)
+      pts.push_back({p.xyz, {p.rgb[0] / 255.0f, p.rgb[1] / 255.0f, p.rgb[2] / 255.0f}});
+  } else {
+    // 3DGS's NeRF-synthetic init is uniform in [-1.3, 1.3]^3 with cameras ~4 from the
+    // origin (extent ~4.4): a cube of half-size 0.3 extent about the cameras' centre.
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (int v : scene.train) c += scene.views[static_cast<std::size_t>(v)].camera.center();
+    if (!scene.train.empty()) c /= static_cast<double>(scene.train.size());
+    const double h = 0.3 * std::max(scene.extent, 1e-6);
+    std::mt19937_64 init_rng(opt.seed ^ 0x5eed1417ULL);
+    pts = randomPointsInBox(c.array() - h, c.array() + h, opt.random_init_points, init_rng);
+  }
+  return gaussiansFromPoints(pts, opt.max_sh_degree, opt.initial_opacity);
+}
+
+void scaleImage(ImageF& img, float w) {
+  if (w == 1.0f) return;
+  for (float& x : img.data) x *= w;
+}
+
+// --- checkpoint serialisation: a tagged binary stream -----------------------------
+constexpr char kMagic[8] = {'S', 'A', 'R', 'C', 'K', 'P', 'T', '1'};
+
+struct Writer {
+  std::ostream& os;
+  template <typename T>
+  void pod(const T& v) { os.write(reinterpret_cast<const char*>(&v), sizeof(T)); }
+  template <typename T>
+  void vec(const std::vector<T>& v) {
+    pod<std::uint64_t>(v.size());
+    os.write(reinterpret_cast<const char*>(v.data()), static_cast<std::streamsize>(v.size() * sizeof(T)));
+  }
+  void model(const Gaussians& g) {
+    pod<std::int32_t>(g.max_sh_degree);
+    g.forEachArray([&](const std::vector<float>& a, std::size_t) { vec(a); });
+  }
+};
+
+struct Reader {
+  const std::string& bytes;
+  const std::string& file;
+  std::size_t pos = 0;
+  void need(std::size_t n, const char* field) {
+    if (bytes.size() - pos < n) throw InputError(file, field, "file is truncated");
+  }
+  template <typename T>
+  T pod(const char* field) {
+    need(sizeof(T), field);
+    T v;
+    std::memcpy(&v, bytes.data() + pos, sizeof(T));
+    pos += sizeof(T);
+    return v;
+  }
+  template <typename T>
+  std::vector<T> vec(const char* field, std::size_t expected = SIZE_MAX) {
+    const auto n = pod<std::uint64_t>(field);
+    if (expected != SIZE_MAX && n != expected)
+      throw InputError(file, field, "expected " + std::to_string(expected) + " values, found " + std::to_string(n));
+    if (n > (bytes.size() - pos) / sizeof(T)) throw InputError(file, field, "file is truncated");
+    std::vector<T> v(n);
+    std::memcpy(v.data(), bytes.data() + pos, n * sizeof(T));
+    pos += n * sizeof(T);
+    return v;
+  }
+  Gaussians model(const char* field) {
+    Gaussians g;
+    g.max_sh_degree = pod<std::int32_t>(field);
+    if (g.max_sh_degree < 0 || g.max_sh_degree > 3) throw InputError(file, field, "SH degree outside 0..3");
+    std::size_t n = SIZE_MAX;
+    g.forEachArray([&](std::vector<float>& a, std::size_t per) {
+      a = vec<float>(field, n == SIZE_MAX ? SIZE_MAX : n * per);
+      if (n == SIZE_MAX) {
+        if (a.size() % per) throw InputError(file, field, "array length is not a multiple of " + std::to_string(per));
+        n = a.size() / per;
+      }
+    });
+    return g;
+  }
+};
+
+}  // namespace
+
+ViewLoss viewLossAndGradient(const Gaussians& g, const Camera& cam, const RasterSettings& s, const ImageF& target,
+                             double lambda_ssim, const ResidualOptions& res, std::mt19937_64& rng, Gaussians& grad,
+                             std::vector<float>& grad_mean2d, StageSeconds& seconds) {
+  ViewLoss out;
+  // One branch: render (optionally a subset), loss, backward scaled by `weight`.
+  auto branch = [&](std::span<const std::uint8_t> mask, double weight) {
+    auto t0 = Clock::now();
+    RenderResult fwd = rasterize(g, cam, s, mask);
+    seconds.render += since(t0);
+    t0 = Clock::now();
+    LossResult L = photometricLoss(fwd.rgb, target, lambda_ssim, true);
+    scaleImage(L.grad, static_cast<float>(weight));
+    seconds.loss += since(t0);
+    t0 = Clock::now();
+    rasterizeBackward(g, cam, s, fwd, L.grad, grad, &grad_mean2d);
+    seconds.backward += since(t0);
+    out.loss += weight * L.loss;
+    if (out.radii.empty()) {
+      out.radii = std::move(fwd.radii);
+      out.visible = std::move(fwd.visible);
+    }
+  };
+  if (!res.enabled) {
+    branch({}, 1.0);
+  } else {
+    if (!res.sub_only) branch({}, res.lambda_full);
+    const ResidualSubset sub = selectResidualSubset(g, res, rng);
+    branch(sub.mask, res.sub_only ? 1.0 : res.lambda_sub);
+  }
+  return out;
+}
+
+float meansLearningRate(const TrainerOptions& opt, int iteration, double extent) {
+  const double t = std::clamp(static_cast<double>(iteration) / std::max(1, opt.means_lr_steps), 0.0, 1.0);
+  return static_cast<float>(
+      std::exp(std::log(opt.lr.means * extent) * (1 - t) + std::log(opt.means_lr_final * extent) * t));
+}
+
+Trainer::Trainer(const Scene& scene, const TrainerOptions& opt) : scene_(scene), opt_(opt), rng_(opt.seed) {
+  if (scene_.views.empty()) throw std::invalid_argument("Trainer: the scene has no views");
+  initial_ = initialModel(scene_, opt_);
+  reset();
+}
+
+void Trainer::reset() {
+  g_ = initial_;
+  adam_.resetFor(g_);
+  stats_.resize(g_.size());
+  iteration_ = 0;
+  loss_ema_ = 0;
+  view_stack_.clear();
+}
+
+int Trainer::activeShDegree() const {
+  const int steps = opt_.sh_interval > 0 ? iteration_ / opt_.sh_interval : opt_.max_sh_degree;
+  return std::min(opt_.max_sh_degree, steps);
+}
+
+RasterSettings Trainer::rasterSettings() const {
+  RasterSettings s = opt_.raster;
+  s.sh_degree = activeShDegree();
+  if (scene_.background) s.background = *scene_.background;
+  return s;
+}
+
+const ImageF& Trainer::target(int view) {
+  auto it = targets_.find(view);
+  if (it == targets_.end()) it = targets_.emplace(view, scene_.imageFloat(view)).first;
+  return it->second;
+}
+
+int Trainer::nextView(const std::vector<int>& views) {
+  if (views != view_set_) {
+    view_set_ = views;
+    view_stack_.clear();
+  }
+  if (view_stack_.empty()) {
+    view_stack_ = views;
+    std::shuffle(view_stack_.begin(), view_stack_.end(), rng_);
+  }
+  const int v = view_stack_.back();
+  view_stack_.pop_back();
+  return v;
+}
+
+void Trainer::train(const std::vector<int>& views, int iterations,
+                    const std::function<void(const TrainProgress&)>& progress) {
+  if (views.empty()) throw std::invalid_argument("Trainer::train: no views to train on");
+  for (int v : views)
+    if (v < 0 || v >= static_cast<int>(scene_.views.size()))
+      throw std::invalid_argument("Trainer::train: view index " + std::to_string(v) + " is not in the scene");
+  for (int k = 0; k < iterations; ++k) {
+    const double loss = step(nextView(views));
+    loss_ema_ = iteration_ == 1 ? loss : 0.4 * loss + 0.6 * loss_ema_;
+    if (progress) progress({iteration_, k + 1, iterations, loss, loss_ema_, g_.size()});
+  }
+}
+
+double Trainer::step(int view) {
+  ++iteration_;
+  const Camera& cam = scene_.views.at(static_cast<std::size_t>(view)).camera;
+  const ImageF& gt = target(view);
+  if (adam_.m.size() != g_.size()) adam_.resetFor(g_);
+  if (stats_.count.size() != g_.size()) stats_.resize(g_.size());
+  const RasterSettings s = rasterSettings();
+  if (grad_.size() != g_.size() || grad_.max_sh_degree != g_.max_sh_degree) grad_ = g_.zerosLike();
+  else grad_.forEachArray([](std::vector<float>& a, std::size_t) { std::fill(a.begin(), a.end(), 0.0f); });
+  grad2d_.assign(2 * g_.size(), 0.0f);
+
+  const ViewLoss vl = viewLossAndGradient(g_, cam, s, gt, opt_.lambda_ssim, opt_.residual, rng_, grad_, grad2d_, seconds_);
+  const double loss = vl.loss;
+  const std::vector<float>& radii = vl.radii;
+  const std::vector<std::uint8_t>& visible = vl.visible;
+
+  auto t0 = Clock::now();
+  const DensifyOptions& d = opt_.densify;
+  if (d.enabled && iteration_ < d.until_iter)
+    accumulateDensifyStats(stats_, grad2d_, radii, visible, cam.K.width, cam.K.height);
+  LearningRates lr = opt_.lr;
+  const double ext = std::max(scene_.extent, 1e-12);
+  lr.means = meansLearningRate(opt_, iteration_, ext);
+  adamStep(g_, grad_, adam_, lr);
+  seconds_.optimizer += since(t0);
+
+  t0 = Clock::now();
+  if (d.enabled && iteration_ < d.until_iter) {
+    if (iteration_ > d.from_iter && d.interval > 0 && iteration_ % d.interval == 0)
+      last_densify_ = densifyAndPrune(g_, adam_, stats_, d, ext, iteration_ > d.opacity_reset_interval, rng_);
+    const bool white = s.background[0] == 1.0f && s.background[1] == 1.0f && s.background[2] == 1.0f;
+    if ((d.opacity_reset_interval > 0 && iteration_ % d.opacity_reset_interval == 0) ||
+        (white && iteration_ == d.from_iter))
+      resetOpacity(g_, adam_);
+  }
+  seconds_.densify += since(t0);
+  return loss;
+}
+
+RenderResult Trainer::render(const Camera& cam) const { return rasterize(g_, cam, rasterSettings()); }
+
+Evaluation Trainer::evaluate(const std::vector<int>& views) const {
+  Evaluation e;
+  for (int v : views) {
+    const RenderResult r = render(scene_.views.at(static_cast<std::size_t>(v)).camera);
+    const ImageF gt = scene_.imageFloat(v);
+    e.views.push_back({v, psnr(r.rgb, gt), ssim(r.rgb, gt)});
+    e.psnr += e.views.back().psnr;
+    e.ssim += e.views.back().ssim;
+  }
+  if (!e.views.empty()) {
+    e.psnr /= static_cast<double>(e.views.size());
+    e.ssim /= static_cast<double>(e.views.size());
+  }
+  return e;
+}
+
+void Trainer::saveCheckpoint(const std::string& path) const {
+  writeStreamAtomic(
+      path,
+      [&](std::ostream& os) {
+        Writer w{os};
+        os.write(kMagic, sizeof(kMagic));
+        w.pod<std::uint64_t>(scene_.views.size());
+        w.pod<std::int32_t>(iteration_);
+        w.pod<double>(loss_ema_);
+        std::ostringstream rs;
+        rs << rng_;
+        const std::string rng_text = rs.str();
+        w.vec(std::vector<char>(rng_text.begin(), rng_text.end()));
+        w.vec(view_set_);
+        w.vec(view_stack_);
+        w.model(g_);
+        w.model(adam_.m);
+        w.model(adam_.v);
+        w.pod<std::int64_t>(adam_.step);
+        w.vec(stats_.grad_accum);
+        w.vec(stats_.count);
+        w.vec(stats_.max_radius);
+        w.pod(seconds_);
+      },
+      true);
+}
+
+void Trainer::loadCheckpoint(const std::string& path) {
+  const std::string bytes = readFile(path);
+  Reader r{bytes, path};
+  r.need(sizeof(kMagic), "magic");
+  if (std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0)
+    throw InputError(path, "magic", "not a saresgs trainer checkpoint (version 1)");
+  r.pos = sizeof(kMagic);
+  const auto views = r.pod<std::uint64_t>("views");
+  if (views != scene_.views.size())
+    throw InputError(path, "views", "written for a scene with " + std::to_string(views) + " views, this one has " +
+                                        std::to_string(scene_.views.size()));
+  const int iteration = r.pod<std::int32_t>("iteration");
+  const double ema = r.pod<double>("loss_ema");
+  const std::vector<char> rng_text = r.vec<char>("rng");
+  std::mt19937_64 rng;
+  std::istringstream rs(std::string(rng_text.begin(), rng_text.end()));
+  rs >> rng;
+  if (!rs) throw InputError(path, "rng", "unreadable generator state");
+  std::vector<int> view_set = r.vec<int>("view_set"), view_stack = r.vec<int>("view_stack");
+  for (int v : view_set)
+    if (v < 0 || v >= static_cast<int>(views)) throw InputError(path, "view_set", "view index out of range");
+  Gaussians g = r.model("gaussians"), m = r.model("adam.m"), v = r.model("adam.v");
+  if (m.size() != g.size() || v.size() != g.size() || m.max_sh_degree != g.max_sh_degree ||
+      v.max_sh_degree != g.max_sh_degree)
+    throw InputError(path, "adam", "moments do not match the model's shape");
+  if (g.max_sh_degree != opt_.max_sh_degree)
+    throw InputError(path, "gaussians", "SH degree " + std::to_string(g.max_sh_degree) + " differs from the trainer's " +
+                                            std::to_string(opt_.max_sh_degree));
+  const auto step = r.pod<std::int64_t>("adam.step");
+  DensifyStats st;
+  st.grad_accum = r.vec<float>("stats.grad_accum", g.size());
+  st.count = r.vec<std::int32_t>("stats.count", g.size());
+  st.max_radius = r.vec<float>("stats.max_radius", g.size());
+  const StageSeconds secs = r.pod<StageSeconds>("seconds");
+  if (r.pos != bytes.size()) throw InputError(path, "end", "unexpected trailing bytes");
+  iteration_ = iteration;
+  loss_ema_ = ema;
+  rng_ = rng;
+  view_set_ = std::move(view_set);
+  view_stack_ = std::move(view_stack);
+  g_ = std::move(g);
+  adam_.m = std::move(m);
+  adam_.v = std::move(v);
+  adam_.step = step;
+  stats_ = std::move(st);
+  seconds_ = secs;
+}
+
+}  // namespace saresgs

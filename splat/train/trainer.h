@@ -1,0 +1,139 @@
+#pragma once
+// The 3DGS trainer that the active loop drives: train N iterations on a given set of
+// views, render any camera, evaluate, reset to the initial state, checkpoint and resume
+// bit-identically. Optionally adds SA-ResGS's residual supervision (residual.h).
+//
+// One iteration (as 3DGS, with the optional residual branch):
+//   view <- next of a shuffled stack of the current views (refilled when empty)
+//   active SH degree <- min(max, iteration / sh_interval); means lr <- log-linear decay
+//   L = lambda_full L(render(G), I) + lambda_sub L(render(G_sub), I)   (residual)
+//     or L(render(G), I)                                               (plain)
+//   backward, densification statistics, Adam step, then densify / prune / reset
+//   opacity on the schedule. (3DGS densifies before its optimiser step, which then skips
+//   the replaced tensors; stepping first keeps every iteration's update.)
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "geometry/scene/scene.h"
+#include "splat/gaussians.h"
+#include "splat/rasterize.h"
+#include "splat/train/adam.h"
+#include "splat/train/densify.h"
+#include "splat/train/residual.h"
+
+namespace saresgs {
+
+struct TrainerOptions {
+  int max_sh_degree = 3;
+  int sh_interval = 1000;          // iterations per SH degree step
+  LearningRates lr;                // lr.means is multiplied by extent
+  float means_lr_final = 1.6e-6f;  // times extent
+  int means_lr_steps = 30000;
+  DensifyOptions densify;
+  ResidualOptions residual;
+  RasterSettings raster;           // sh_degree is set by the schedule
+  double lambda_ssim = 0.2;
+  int random_init_points = 20000;  // used when the scene has no sparse points
+  float initial_opacity = 0.1f;
+  std::uint64_t seed = 0;
+};
+
+struct StageSeconds {
+  double render = 0, loss = 0, backward = 0, optimizer = 0, densify = 0;
+  double total() const { return render + loss + backward + optimizer + densify; }
+};
+
+struct TrainProgress {
+  int iteration = 0;  // since the last reset
+  int done = 0, total = 0;  // within this train() call
+  double loss = 0;          // this iteration's loss
+  double loss_ema = 0;      // 0.4 / 0.6 moving average, as 3DGS displays it
+  std::size_t gaussians = 0;
+};
+
+struct ViewMetrics {
+  int view = -1;
+  double psnr = 0, ssim = 0;
+};
+struct Evaluation {
+  std::vector<ViewMetrics> views;
+  double psnr = 0, ssim = 0;  // means over views
+};
+
+// The loss and its gradient for one view: the full render's loss, or with residual
+// supervision lambda_full L(full) + lambda_sub L(G_sub) (sub-only: L(G_sub)). Gradients
+// are added to `grad` and `grad_mean2d` (2 per Gaussian, pixels); the radii and
+// visibility of the full render (of the subset in sub-only mode) come back for
+// densification. Stage times are added to `seconds`.
+struct ViewLoss {
+  double loss = 0;
+  std::vector<float> radii;
+  std::vector<std::uint8_t> visible;
+};
+ViewLoss viewLossAndGradient(const Gaussians& g, const Camera& cam, const RasterSettings& s, const ImageF& target,
+                             double lambda_ssim, const ResidualOptions& residual, std::mt19937_64& rng,
+                             Gaussians& grad, std::vector<float>& grad_mean2d, StageSeconds& seconds);
+
+// 3DGS's position learning rate at `iteration`: log-linear from lr.means * extent to
+// means_lr_final * extent over means_lr_steps iterations, then constant.
+float meansLearningRate(const TrainerOptions& opt, int iteration, double extent);
+
+class Trainer {
+ public:
+  // Builds the initial model from the scene's sparse points (or random points when it
+  // has none). The scene is copied (copies share its image cache).
+  Trainer(const Scene& scene, const TrainerOptions& opt);
+
+  // Trains `iterations` iterations on `views` (indices into scene.views); `progress` is
+  // called after each iteration.
+  void train(const std::vector<int>& views, int iterations,
+             const std::function<void(const TrainProgress&)>& progress = {});
+  // One iteration on view `view`; returns its loss.
+  double step(int view);
+
+  RenderResult render(const Camera& cam) const;
+  Evaluation evaluate(const std::vector<int>& views) const;
+  // The model, optimiser and schedules as after construction; the random generator
+  // continues (so that repeated resets do not replay the same views).
+  void reset();
+
+  // Everything a resumed run needs, written atomically; load throws InputError naming
+  // the file and field on a mismatch (another scene size, truncated file).
+  void saveCheckpoint(const std::string& path) const;
+  void loadCheckpoint(const std::string& path);
+
+  const Gaussians& gaussians() const { return g_; }
+  Gaussians& mutableGaussians() { return g_; }  // for tests and importers; resets Adam on next step
+  const Scene& scene() const { return scene_; }
+  const TrainerOptions& options() const { return opt_; }
+  int iteration() const { return iteration_; }
+  int activeShDegree() const;
+  RasterSettings rasterSettings() const;
+  const StageSeconds& seconds() const { return seconds_; }
+  const DensifyReport& lastDensify() const { return last_densify_; }
+
+ private:
+  const ImageF& target(int view);
+  int nextView(const std::vector<int>& views);
+
+  Scene scene_;
+  TrainerOptions opt_;
+  Gaussians initial_, g_, grad_;
+  std::vector<float> grad2d_;
+  AdamState adam_;
+  DensifyStats stats_;
+  DensifyReport last_densify_;
+  std::mt19937_64 rng_;
+  int iteration_ = 0;
+  double loss_ema_ = 0;
+  std::vector<int> view_set_, view_stack_;
+  std::map<int, ImageF> targets_;  // float images of the views trained on
+  StageSeconds seconds_;
+};
+
+}  // namespace saresgs

@@ -1,0 +1,276 @@
+// The trainer's parts against independent oracles: nearest-neighbour scales against
+// brute force, Adam against a double-precision scalar formula, densification against
+// hand-built cases and the split's sampling covariance, the residual subset's counts.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <set>
+
+#include "splat/train/adam.h"
+#include "splat/train/densify.h"
+#include "splat/train/init.h"
+#include "splat/train/residual.h"
+
+namespace saresgs {
+namespace {
+
+double bruteMeanSq(const std::vector<Eigen::Vector3d>& p, std::size_t i, int k) {
+  std::vector<double> d;
+  for (std::size_t j = 0; j < p.size(); ++j)
+    if (j != i) d.push_back((p[j] - p[i]).squaredNorm());
+  std::sort(d.begin(), d.end());
+  const std::size_t kk = std::min<std::size_t>(static_cast<std::size_t>(k), d.size());
+  double s = 0;
+  for (std::size_t j = 0; j < kk; ++j) s += d[j];
+  return std::max(s / static_cast<double>(kk), 1e-7);
+}
+
+TEST(TrainInit, KnnDistancesMatchBruteForce) {
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> nd(0, 1);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (int trial = 0; trial < 4; ++trial) {
+    std::vector<Eigen::Vector3d> p;
+    const int n = 400 + 300 * trial;
+    for (int i = 0; i < n; ++i) {
+      if (trial == 1) p.emplace_back(u(rng) * 10, 0.0, 0.0);                // a line: flat box
+      else if (trial == 2) p.emplace_back(nd(rng), nd(rng), 1e-3 * nd(rng));  // a thin sheet
+      else p.emplace_back(nd(rng) * (i % 10 == 0 ? 20 : 1), nd(rng), nd(rng));  // clusters + outliers
+    }
+    if (trial == 3) p.push_back(p[0]), p.push_back(p[0]);  // duplicates
+    const auto d = meanSquaredKnnDistance(p);
+    for (std::size_t i = 0; i < p.size(); ++i) ASSERT_NEAR(d[i], bruteMeanSq(p, i, 3), 1e-12 * (1 + d[i])) << trial << " " << i;
+  }
+  EXPECT_EQ(meanSquaredKnnDistance({Eigen::Vector3d(1, 2, 3)}).at(0), 1e-7);
+  const auto two = meanSquaredKnnDistance({Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0, 3, 4)});
+  EXPECT_DOUBLE_EQ(two[0], 25.0);  // fewer than 3 neighbours: the mean over those there are
+}
+
+TEST(TrainInit, GaussiansFromPointsFollowTheReferenceInit) {
+  std::vector<ColoredPoint> pts = {{Eigen::Vector3d(0, 0, 0), {1.0f, 0.5f, 0.0f}},
+                                   {Eigen::Vector3d(1, 0, 0), {0.2f, 0.2f, 0.2f}},
+                                   {Eigen::Vector3d(0, 2, 0), {0, 0, 0}},
+                                   {Eigen::Vector3d(0, 0, 3), {0, 0, 0}}};
+  const Gaussians g = gaussiansFromPoints(pts, 2);
+  ASSERT_EQ(g.size(), 4u);
+  EXPECT_EQ(g.shCoeffs(), 9);
+  // Point 0's neighbours are at 1, 2, 3: mean squared distance 14/3.
+  EXPECT_NEAR(g.log_scales[0], 0.5 * std::log(14.0 / 3.0), 1e-6);
+  EXPECT_EQ(g.log_scales[0], g.log_scales[1]);
+  EXPECT_NEAR(1 / (1 + std::exp(-g.opacities[0])), 0.1, 1e-6);
+  EXPECT_EQ(g.rotations[0], 1.0f);
+  EXPECT_NEAR(g.sh[0] * kShC0 + 0.5, 1.0, 1e-6);
+  EXPECT_NEAR(g.sh[1] * kShC0 + 0.5, 0.5, 1e-6);
+  for (int k = 3; k < 27; ++k) EXPECT_EQ(g.sh[k], 0.0f);
+  EXPECT_THROW(gaussiansFromPoints({}, 0), std::invalid_argument);
+}
+
+TEST(TrainAdam, MatchesTheScalarFormulaInDouble) {
+  std::mt19937_64 rng(9);
+  std::normal_distribution<float> nd(0, 1);
+  Gaussians p;
+  p.max_sh_degree = 1;
+  p.resize(7);
+  p.forEachArray([&](std::vector<float>& a, std::size_t) { for (float& x : a) x = nd(rng); });
+  const Gaussians p0 = p;
+  AdamState st;
+  st.resetFor(p);
+  LearningRates lr;
+  lr.means = 0.01f;
+  std::vector<Gaussians> grads;
+  for (int t = 0; t < 4; ++t) {
+    Gaussians g = p.zerosLike();
+    g.forEachArray([&](std::vector<float>& a, std::size_t) { for (float& x : a) x = nd(rng) * (t == 2 ? 1e-4f : 1.0f); });
+    grads.push_back(g);
+    adamStep(p, g, st, lr);
+  }
+  EXPECT_EQ(st.step, 4);
+  // sh entry (Gaussian 3, coefficient 2, channel 1) uses the SH-rest rate; entry 0 the DC rate.
+  auto check = [&](const std::vector<float>& (*pick)(const Gaussians&), std::size_t idx, double rate) {
+    double x = pick(p0)[idx], m = 0, v = 0;
+    for (int t = 1; t <= 4; ++t) {
+      const double gi = pick(grads[t - 1])[idx];
+      m = 0.9 * m + 0.1 * gi;
+      v = 0.999 * v + 0.001 * gi * gi;
+      const double mh = m / (1 - std::pow(0.9, t)), vh = v / (1 - std::pow(0.999, t));
+      x -= rate * mh / (std::sqrt(vh) + 1e-15);
+    }
+    EXPECT_NEAR(pick(p)[idx], x, 1e-5 * (1 + std::abs(x))) << idx;
+  };
+  check([](const Gaussians& g) -> const std::vector<float>& { return g.means; }, 5, 0.01);
+  check([](const Gaussians& g) -> const std::vector<float>& { return g.log_scales; }, 4, 5e-3);
+  check([](const Gaussians& g) -> const std::vector<float>& { return g.rotations; }, 9, 1e-3);
+  check([](const Gaussians& g) -> const std::vector<float>& { return g.opacities; }, 6, 5e-2);
+  check([](const Gaussians& g) -> const std::vector<float>& { return g.sh; }, 3 * 12 + 0, 2.5e-3);
+  check([](const Gaussians& g) -> const std::vector<float>& { return g.sh; }, 3 * 12 + 2 * 3 + 1, 2.5e-3 / 20);
+}
+
+// Four Gaussians: 0 small with a large gradient (clone), 1 large with a large gradient
+// (split), 2 small gradient (kept), 3 nearly transparent (pruned).
+struct DensifyCase {
+  Gaussians g;
+  AdamState adam;
+  DensifyStats st;
+  DensifyOptions opt;
+  double extent = 10;
+  DensifyCase() {
+    g.resize(4);
+    for (int i = 0; i < 4; ++i) {
+      g.means[3 * i] = static_cast<float>(i);
+      g.rotations[4 * i] = 1;
+      g.opacities[i] = 0.0f;
+      g.sh[3 * i] = 0.1f * i;
+      for (int k = 0; k < 3; ++k) g.log_scales[3 * i + k] = std::log(0.05f);  // 0.05 < 0.01 * 10
+    }
+    for (int k = 0; k < 3; ++k) g.log_scales[3 + k] = std::log(0.5f);
+    g.opacities[3] = std::log(0.001f / 0.999f);
+    adam.resetFor(g);
+    for (int i = 0; i < 4; ++i) adam.m.opacities[i] = adam.v.opacities[i] = 1.0f + i;
+    st.resize(4);
+    const float grads[4] = {3e-4f, 5e-4f, 1e-4f, 1e-4f};
+    for (int i = 0; i < 4; ++i) {
+      st.grad_accum[i] = 2 * grads[i];
+      st.count[i] = 2;
+    }
+  }
+};
+
+TEST(TrainDensify, ClonesSmallSplitsLargePrunesTransparent) {
+  DensifyCase c;
+  std::mt19937_64 rng(1);
+  const DensifyReport r = densifyAndPrune(c.g, c.adam, c.st, c.opt, c.extent, false, rng);
+  EXPECT_EQ(r.cloned, 1u);
+  EXPECT_EQ(r.split, 1u);
+  EXPECT_EQ(r.pruned, 1u);
+  // Kept: 0, 2, clone of 0, two children of 1.
+  ASSERT_EQ(c.g.size(), 5u);
+  EXPECT_EQ(c.g.means[0], 0.0f);
+  EXPECT_EQ(c.g.means[3], 2.0f);
+  EXPECT_EQ(c.g.means[6], 0.0f);
+  EXPECT_EQ(c.g.sh[6], 0.0f);
+  for (int j = 3; j < 5; ++j) {
+    EXPECT_NEAR(c.g.log_scales[3 * j], std::log(0.5f / 1.6f), 1e-6);
+    EXPECT_NE(c.g.means[3 * j], 1.0f);  // moved by a sample
+    EXPECT_NEAR(c.g.sh[3 * j], 0.1f, 1e-7);
+  }
+  // Moments follow their Gaussians; new ones start at zero.
+  EXPECT_EQ(c.adam.m.opacities, (std::vector<float>{1, 3, 0, 0, 0}));
+  EXPECT_EQ(c.st.count, std::vector<std::int32_t>(5, 0));
+}
+
+TEST(TrainDensify, BigPruningOnlyWhenAsked) {
+  for (bool prune_big : {false, true}) {
+    DensifyCase c;
+    c.st.grad_accum.assign(4, 0.0f);  // nothing densifies
+    c.st.max_radius = {30, 1, 1, 1};  // Gaussian 0 is big on screen
+    c.g.log_scales[6] = std::log(2.0f);  // Gaussian 2 is big in the world (> 0.1 * 10)
+    std::mt19937_64 rng(1);
+    densifyAndPrune(c.g, c.adam, c.st, c.opt, c.extent, prune_big, rng);
+    EXPECT_EQ(c.g.size(), prune_big ? 1u : 3u);
+  }
+}
+
+TEST(TrainDensify, SplitSamplesFollowTheRotatedCovariance) {
+  Gaussians g;
+  g.resize(1);
+  const Eigen::Quaternionf q = Eigen::Quaternionf(Eigen::AngleAxisf(0.7f, Eigen::Vector3f(1, 2, 3).normalized()));
+  g.rotations = {2 * q.w(), 2 * q.x(), 2 * q.y(), 2 * q.z()};  // unnormalised on purpose
+  g.log_scales = {std::log(0.3f), std::log(0.1f), std::log(0.02f)};
+  g.opacities = {0};
+  AdamState adam;
+  adam.resetFor(g);
+  DensifyStats st;
+  st.resize(1);
+  st.grad_accum = {1};
+  st.count = {1};
+  DensifyOptions opt;
+  opt.split_count = 20000;
+  std::mt19937_64 rng(2);
+  densifyAndPrune(g, adam, st, opt, 1.0, false, rng);
+  ASSERT_EQ(g.size(), 20000u);
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const Eigen::Vector3d p(g.means[3 * i], g.means[3 * i + 1], g.means[3 * i + 2]);
+    cov += p * p.transpose();
+  }
+  cov /= static_cast<double>(g.size());
+  const Eigen::Matrix3d R = q.toRotationMatrix().cast<double>();
+  const Eigen::Matrix3d expect = R * Eigen::Vector3d(0.09, 0.01, 0.0004).asDiagonal() * R.transpose();
+  EXPECT_LT((cov - expect).norm(), 0.03 * expect.norm()) << cov << "\nvs\n" << expect;
+}
+
+TEST(TrainDensify, CapLimitsGrowthAndOpacityResetZeroesItsMoments) {
+  DensifyCase c;
+  c.opt.max_gaussians = 4;
+  std::mt19937_64 rng(1);
+  const DensifyReport r = densifyAndPrune(c.g, c.adam, c.st, c.opt, c.extent, false, rng);
+  EXPECT_EQ(r.cloned + r.split, 0u);
+  EXPECT_LE(c.g.size(), 4u);
+  resetOpacity(c.g, c.adam);
+  for (std::size_t i = 0; i < c.g.size(); ++i) EXPECT_LE(1 / (1 + std::exp(-c.g.opacities[i])), 0.01f + 1e-7f);
+  for (float m : c.adam.m.opacities) EXPECT_EQ(m, 0.0f);
+}
+
+Gaussians rankedModel(int n) {
+  Gaussians g;
+  g.resize(n);
+  for (int i = 0; i < n; ++i) {
+    g.opacities[i] = static_cast<float>(i);                // lowest opacity: low indices
+    g.log_scales[3 * i + (i % 3)] = static_cast<float>(-i);  // largest scale: low indices too...
+  }
+  // ...so make the scale ranking distinct: reverse it for the upper half.
+  for (int i = n / 2; i < n; ++i) g.log_scales[3 * i + (i % 3)] = static_cast<float>(i);
+  return g;
+}
+
+TEST(TrainResidual, SubsetHoldsExactProportionsAndTheIntendedGaussians) {
+  const int n = 1000;
+  const Gaussians g = rankedModel(n);
+  ResidualOptions o;
+  std::mt19937_64 rng(4);
+  const ResidualSubset s = selectResidualSubset(g, o, rng);
+  EXPECT_EQ(s.random.size(), 900u);
+  EXPECT_EQ(std::set<int>(s.random.begin(), s.random.end()).size(), 900u);
+  // Lowest opacity: 0..99; largest scale: 999 down to 900. Union of both.
+  std::vector<int> expect;
+  for (int i = 0; i < 100; ++i) expect.push_back(i);
+  for (int i = 900; i < 1000; ++i) expect.push_back(i);
+  EXPECT_EQ(s.uncertain, expect);
+  std::size_t in = 0;
+  for (int i = 0; i < n; ++i) {
+    const bool want = std::binary_search(s.random.begin(), s.random.end(), i) ||
+                      std::binary_search(expect.begin(), expect.end(), i);
+    EXPECT_EQ(s.mask[i], want ? 1 : 0);
+    in += s.mask[i];
+  }
+  EXPECT_GT(in, 900u);
+  EXPECT_LE(in, 1000u);
+
+  o.ranking = UncertaintyRanking::kOpacity;  // beta doubled: 0..199
+  const ResidualSubset so = selectResidualSubset(g, o, rng);
+  ASSERT_EQ(so.uncertain.size(), 200u);
+  EXPECT_EQ(so.uncertain.front(), 0);
+  EXPECT_EQ(so.uncertain.back(), 199);
+  o.ranking = UncertaintyRanking::kScale;  // 800..999
+  const ResidualSubset ss = selectResidualSubset(g, o, rng);
+  ASSERT_EQ(ss.uncertain.size(), 200u);
+  EXPECT_EQ(ss.uncertain.front(), 800);
+  o.ranking = UncertaintyRanking::kRandom;
+  EXPECT_EQ(selectResidualSubset(g, o, rng).uncertain.size(), 200u);
+  EXPECT_THROW(parseUncertaintyRanking("loud"), std::invalid_argument);
+  EXPECT_TRUE(selectResidualSubset(Gaussians{}, o, rng).mask.empty());
+}
+
+TEST(TrainResidual, SameGeneratorStateSameSubset) {
+  const Gaussians g = rankedModel(300);
+  ResidualOptions o;
+  std::mt19937_64 a(11), b(11);
+  EXPECT_EQ(selectResidualSubset(g, o, a).mask, selectResidualSubset(g, o, b).mask);
+  EXPECT_NE(selectResidualSubset(g, o, a).random, selectResidualSubset(g, o, a).random);
+}
+
+}  // namespace
+}  // namespace saresgs

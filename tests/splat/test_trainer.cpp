@@ -1,0 +1,204 @@
+// The trainer end to end on a tiny synthetic dataset: it learns, it is deterministic,
+// a resumed run equals an uninterrupted one bit for bit, reset restores the start, and
+// extreme models train without NaN or Inf.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "common/test_support.h"
+#include "splat/train/trainer.h"
+#include "tiny_dataset.h"
+
+namespace saresgs {
+namespace {
+
+using test::TempDir;
+using test::tinyDataset;
+
+TrainerOptions quickOptions(bool residual = false) {
+  TrainerOptions o;
+  o.max_sh_degree = 1;
+  o.sh_interval = 40;
+  o.densify.from_iter = 20;
+  o.densify.interval = 20;
+  o.densify.opacity_reset_interval = 60;
+  o.residual.enabled = residual;
+  o.seed = 7;
+  return o;
+}
+
+bool bitIdentical(const Gaussians& a, const Gaussians& b) {
+  if (a.size() != b.size() || a.max_sh_degree != b.max_sh_degree) return false;
+  bool same = true;
+  std::vector<const std::vector<float>*> arrays;
+  a.forEachArray([&](const std::vector<float>& x, std::size_t) { arrays.push_back(&x); });
+  std::size_t k = 0;
+  b.forEachArray([&](const std::vector<float>& y, std::size_t) {
+    const auto& x = *arrays[k++];
+    same = same && x.size() == y.size() && std::memcmp(x.data(), y.data(), x.size() * sizeof(float)) == 0;
+  });
+  return same;
+}
+
+bool allFinite(const Gaussians& g) {
+  bool ok = true;
+  g.forEachArray([&](const std::vector<float>& a, std::size_t) {
+    for (float x : a) ok = ok && std::isfinite(x);
+  });
+  return ok;
+}
+
+TEST(Trainer, MeansLearningRateDecaysLogLinearly) {
+  TrainerOptions o;
+  EXPECT_NEAR(meansLearningRate(o, 0, 2.0), 3.2e-4, 1e-10);
+  EXPECT_NEAR(meansLearningRate(o, 30000, 2.0), 3.2e-6, 1e-12);
+  EXPECT_NEAR(meansLearningRate(o, 15000, 2.0), std::sqrt(3.2e-4 * 3.2e-6), 1e-10);
+  EXPECT_NEAR(meansLearningRate(o, 90000, 2.0), 3.2e-6, 1e-12);
+}
+
+TEST(Trainer, InitialModelComesFromTheSparsePoints) {
+  const Scene& s = tinyDataset();
+  Trainer t(s, quickOptions());
+  ASSERT_EQ(t.gaussians().size(), s.points.size());
+  EXPECT_FLOAT_EQ(t.gaussians().means[0], static_cast<float>(s.points[0].xyz.x()));
+  EXPECT_EQ(t.activeShDegree(), 0);
+  ASSERT_TRUE(s.background.has_value());  // the manifest's white
+  EXPECT_EQ(t.rasterSettings().background[0], 1.0f);
+}
+
+TEST(Trainer, WithoutPointsStartsFromRandomPointsAroundTheCameras) {
+  Scene s = tinyDataset();
+  s.points.clear();
+  TrainerOptions o = quickOptions();
+  o.random_init_points = 500;
+  Trainer t(s, o);
+  ASSERT_EQ(t.gaussians().size(), 500u);
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (int v : s.train) c += s.views[v].camera.center();
+  c /= static_cast<double>(s.train.size());
+  for (std::size_t i = 0; i < 500; ++i)
+    for (int k = 0; k < 3; ++k) EXPECT_LE(std::abs(t.gaussians().means[3 * i + k] - c[k]), 0.3 * s.extent + 1e-4);
+}
+
+TEST(Trainer, TrainingRaisesTrainPsnr) {
+  const Scene& s = tinyDataset();
+  Trainer t(s, quickOptions());
+  const double before = t.evaluate(s.train).psnr;
+  int calls = 0;
+  t.train(s.train, 150, [&](const TrainProgress& p) {
+    ++calls;
+    EXPECT_EQ(p.done, calls);
+    EXPECT_TRUE(std::isfinite(p.loss));
+  });
+  EXPECT_EQ(calls, 150);
+  EXPECT_EQ(t.iteration(), 150);
+  EXPECT_EQ(t.activeShDegree(), 1);
+  const double after = t.evaluate(s.train).psnr;
+  EXPECT_GT(after, before + 3.0) << before << " -> " << after;
+  EXPECT_NE(t.gaussians().size(), s.points.size());  // densification ran
+  EXPECT_TRUE(allFinite(t.gaussians()));
+}
+
+TEST(Trainer, SameSeedSameParametersBitForBit) {
+  const Scene& s = tinyDataset();
+  for (bool residual : {false, true}) {
+    Trainer a(s, quickOptions(residual)), b(s, quickOptions(residual));
+    a.train(s.train, 70);
+    b.train(s.train, 70);
+    EXPECT_TRUE(bitIdentical(a.gaussians(), b.gaussians())) << residual;
+    TrainerOptions other = quickOptions(residual);
+    other.seed = 8;
+    Trainer c(s, other);
+    c.train(s.train, 70);
+    EXPECT_FALSE(bitIdentical(a.gaussians(), c.gaussians())) << residual;
+  }
+}
+
+TEST(Trainer, ResumedRunEqualsAnUninterruptedOne) {
+  const Scene& s = tinyDataset();
+  TempDir d;
+  for (bool residual : {false, true}) {
+    Trainer full(s, quickOptions(residual));
+    full.train(s.train, 90);
+    Trainer first(s, quickOptions(residual));
+    first.train(s.train, 50);  // stops between densification steps, mid view stack
+    first.saveCheckpoint(d.file("ckpt.bin"));
+    Trainer resumed(s, quickOptions(residual));
+    resumed.loadCheckpoint(d.file("ckpt.bin"));
+    EXPECT_EQ(resumed.iteration(), 50);
+    resumed.train(s.train, 40);
+    EXPECT_TRUE(bitIdentical(full.gaussians(), resumed.gaussians())) << residual;
+  }
+}
+
+TEST(Trainer, ResetRestoresTheInitialModel) {
+  const Scene& s = tinyDataset();
+  Trainer t(s, quickOptions());
+  const Gaussians start = t.gaussians();
+  t.train(s.train, 30);
+  EXPECT_FALSE(bitIdentical(start, t.gaussians()));
+  t.reset();
+  EXPECT_EQ(t.iteration(), 0);
+  EXPECT_TRUE(bitIdentical(start, t.gaussians()));
+  t.train({s.train[0], s.train[1]}, 5);  // a different view set trains fine after reset
+  EXPECT_EQ(t.iteration(), 5);
+}
+
+TEST(Trainer, BadCheckpointsAreClearErrors) {
+  const Scene& s = tinyDataset();
+  TempDir d;
+  Trainer t(s, quickOptions());
+  t.train(s.train, 3);
+  t.saveCheckpoint(d.file("c.bin"));
+  const std::string bytes = test::readBytes(d.file("c.bin"));
+  test::writeBytes(d.file("trunc.bin"), bytes.substr(0, bytes.size() / 2));
+  EXPECT_TRUE(test::throwsInputError([&] { t.loadCheckpoint(d.file("trunc.bin")); }, d.file("trunc.bin"), ""));
+  test::writeBytes(d.file("junk.bin"), "hello world, not a checkpoint");
+  EXPECT_TRUE(test::throwsInputError([&] { t.loadCheckpoint(d.file("junk.bin")); }, d.file("junk.bin"), "magic"));
+  Scene fewer = s;
+  fewer.views.pop_back();
+  fewer.train.erase(std::remove(fewer.train.begin(), fewer.train.end(), static_cast<int>(fewer.views.size())),
+                    fewer.train.end());
+  fewer.test.erase(std::remove(fewer.test.begin(), fewer.test.end(), static_cast<int>(fewer.views.size())),
+                   fewer.test.end());
+  Trainer other(fewer, quickOptions());
+  EXPECT_TRUE(test::throwsInputError([&] { other.loadCheckpoint(d.file("c.bin")); }, d.file("c.bin"), "views"));
+  EXPECT_TRUE(test::throwsInputError([&] { t.loadCheckpoint(d.file("missing.bin")); }, d.file("missing.bin"), ""));
+  EXPECT_THROW(t.train({}, 1), std::invalid_argument);
+  EXPECT_THROW(t.train({9999}, 1), std::invalid_argument);
+}
+
+TEST(Trainer, ExtremeModelsTrainWithoutNanOrInf) {
+  const Scene& s = tinyDataset();
+  Trainer t(s, quickOptions(true));
+  Gaussians& g = t.mutableGaussians();
+  const Camera& cam = s.views[s.train[0]].camera;
+  const Eigen::Vector3d c = cam.center(), dir = cam.viewDirection();
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<float> u(-1, 1);
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    switch (i % 8) {
+      case 0: for (int k = 0; k < 3; ++k) g.log_scales[3 * i + k] = std::log(1e-6f * static_cast<float>(s.extent)); break;
+      case 1: for (int k = 0; k < 3; ++k) g.log_scales[3 * i + k] = std::log(1e4f * static_cast<float>(s.extent)); break;
+      case 2: g.opacities[i] = 30; break;
+      case 3: g.opacities[i] = -30; break;
+      case 4: for (int k = 0; k < 4; ++k) g.rotations[4 * i + k] = 0; break;
+      case 5:  // at the near plane of the first camera
+        for (int k = 0; k < 3; ++k) g.means[3 * i + k] = static_cast<float>(c[k] + 0.0101 * dir[k] + 1e-3 * u(rng));
+        break;
+      case 6:  // behind it
+        for (int k = 0; k < 3; ++k) g.means[3 * i + k] = static_cast<float>(c[k] - 0.5 * dir[k]);
+        break;
+      default: break;
+    }
+  }
+  t.train(s.train, 45);
+  EXPECT_TRUE(allFinite(t.gaussians()));
+  const RenderResult r = t.render(cam);
+  for (float x : r.rgb.data) ASSERT_TRUE(std::isfinite(x));
+}
+
+}  // namespace
+}  // namespace saresgs
