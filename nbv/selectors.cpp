@@ -1,0 +1,85 @@
+#include "nbv/selectors.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
+
+#include "splat/fisher.h"
+
+namespace saresgs {
+
+int selectRandom(const std::vector<int>& candidates, std::mt19937_64& rng) {
+  if (candidates.empty()) throw std::invalid_argument("selectRandom: no candidates");
+  std::uniform_int_distribution<std::size_t> pick(0, candidates.size() - 1);
+  return candidates[pick(rng)];
+}
+
+std::vector<double> farthestViewScores(const Scene& scene, const std::vector<int>& chosen,
+                                       const std::vector<int>& candidates, ViewDistance metric,
+                                       const Eigen::Vector3d& center) {
+  auto dist = [&](int a, int b) {
+    const Eigen::Vector3d ca = scene.views.at(a).camera.center(), cb = scene.views.at(b).camera.center();
+    if (metric == ViewDistance::kEuclidean) return (ca - cb).norm();
+    const Eigen::Vector3d da = ca - center, db = cb - center;
+    const double na = da.norm(), nb = db.norm();
+    if (!(na > 0) || !(nb > 0)) return 0.0;  // a camera at the centre has no direction
+    // atan2 of |cross| and dot is accurate for nearly equal directions, unlike acos.
+    return std::atan2(da.cross(db).norm(), da.dot(db));
+  };
+  std::vector<double> out;
+  out.reserve(candidates.size());
+  for (int c : candidates) {
+    double d = std::numeric_limits<double>::infinity();
+    for (int v : chosen) d = std::min(d, dist(c, v));
+    out.push_back(chosen.empty() ? 0.0 : d);
+  }
+  return out;
+}
+
+std::vector<double> fisherScores(const Gaussians& g, const RasterSettings& s, const Scene& scene,
+                                 const std::vector<int>& chosen, const std::vector<int>& candidates,
+                                 double lambda) {
+  Gaussians H = g.zerosLike();
+  for (int v : chosen) addViewInformation(g, scene.views.at(v).camera, s, H);
+  Gaussians Hv = g.zerosLike();
+  std::vector<double> out;
+  out.reserve(candidates.size());
+  for (int c : candidates) {
+    clearInformation(Hv);
+    addViewInformation(g, scene.views.at(c).camera, s, Hv);
+    out.push_back(fisherScore(Hv, H, lambda));
+  }
+  return out;
+}
+
+std::size_t argmaxScore(const std::vector<double>& scores, const std::vector<int>& candidates) {
+  if (scores.empty() || scores.size() != candidates.size()) throw std::invalid_argument("argmaxScore: bad sizes");
+  std::size_t best = 0;
+  for (std::size_t i = 1; i < scores.size(); ++i) {
+    // NaN never wins; equal scores go to the lower view index.
+    if (scores[i] > scores[best] || (scores[i] == scores[best] && candidates[i] < candidates[best]) ||
+        std::isnan(scores[best]))
+      best = i;
+  }
+  return best;
+}
+
+std::vector<int> topFraction(const std::vector<double>& scores, const std::vector<int>& candidates, double fraction) {
+  if (scores.size() != candidates.size()) throw std::invalid_argument("topFraction: bad sizes");
+  std::vector<std::size_t> order(scores.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    const double sa = std::isnan(scores[a]) ? -INFINITY : scores[a], sb = std::isnan(scores[b]) ? -INFINITY : scores[b];
+    return sa != sb ? sa > sb : candidates[a] < candidates[b];
+  });
+  const std::size_t k = std::clamp<std::size_t>(
+      static_cast<std::size_t>(std::ceil(fraction * static_cast<double>(scores.size()) - 1e-9)), 1, std::max<std::size_t>(1, scores.size()));
+  std::vector<int> out;
+  for (std::size_t i = 0; i < std::min(k, order.size()); ++i) out.push_back(candidates[order[i]]);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+}  // namespace saresgs
