@@ -9,11 +9,11 @@
 
 #include "apps/commands.h"
 #include "apps/progress.h"
-#include "geometry/image/contact_sheet.h"
 #include "geometry/io/atomic_file.h"
 #include "geometry/scene/scene.h"
 #include "splat/ply.h"
 #include "splat/rasterize_detail.h"
+#include "splat/train/test_renders.h"
 #include "splat/train/trainer.h"
 
 namespace saresgs::apps {
@@ -38,27 +38,6 @@ std::string shortCount(std::size_t n) {
   if (n >= 10000) std::snprintf(buf, sizeof buf, "%.0fk", n / 1000.0);
   else std::snprintf(buf, sizeof buf, "%zu", n);
   return buf;
-}
-
-// Ground truth and render side by side per test view, one PNG each, plus one sheet.
-void writeTestRenders(const Trainer& t, const Evaluation& ev, const std::string& dir) {
-  fs::create_directories(dir);
-  std::vector<Image8> images;
-  images.reserve(2 * ev.views.size());
-  std::vector<ContactSheetItem> sheet;
-  for (const ViewMetrics& m : ev.views) {
-    const SceneView& v = t.scene().views[static_cast<std::size_t>(m.view)];
-    images.push_back(t.scene().image(m.view));
-    images.push_back(toByte(t.render(v.camera).rgb));
-    char label[64];
-    std::snprintf(label, sizeof label, "%.2f dB", m.psnr);
-    const std::vector<ContactSheetItem> pair = {{&images[images.size() - 2], v.name + " truth", false},
-                                                {&images.back(), std::string("render ") + label, true}};
-    writeImage(dir + "/" + fs::path(v.name).stem().string() + ".png",
-               makeContactSheet(pair, 2, images.back().width));
-    sheet.insert(sheet.end(), pair.begin(), pair.end());
-  }
-  if (!sheet.empty()) writeImage(dir + "/all.png", makeContactSheet(sheet, 4, 256));
 }
 
 int runTrain(TrainArgs& a) {

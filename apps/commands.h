@@ -11,5 +11,6 @@ void addInfoCommand(CLI::App& app, Action& action);   // apps/cmd_info.cpp
 void addSceneCommand(CLI::App& app, Action& action);  // apps/cmd_scene.cpp
 void addTrainCommand(CLI::App& app, Action& action);  // apps/cmd_train.cpp
 void addBenchCommand(CLI::App& app, Action& action);  // apps/cmd_bench.cpp
+void addActiveCommand(CLI::App& app, Action& action);  // apps/cmd_active.cpp
 
 }  // namespace saresgs::apps

@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   saresgs::apps::addSceneCommand(app, action);
   saresgs::apps::addTrainCommand(app, action);
   saresgs::apps::addBenchCommand(app, action);
+  saresgs::apps::addActiveCommand(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
