@@ -32,6 +32,7 @@ class HashedBits {
 
   void insert(const Voxel& v) { set(spatialHash(v, static_cast<std::uint32_t>(size_))); }
   void set(std::uint32_t bit) { words_[bit >> 6] |= std::uint64_t{1} << (bit & 63); }
+  void reset(std::uint32_t bit) { words_[bit >> 6] &= ~(std::uint64_t{1} << (bit & 63)); }
   bool test(std::uint32_t bit) const { return (words_[bit >> 6] >> (bit & 63)) & 1u; }
   std::size_t size() const { return size_; }  // T
   std::size_t count() const;                   // set bits

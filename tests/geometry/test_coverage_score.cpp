@@ -57,6 +57,18 @@ TEST(SpatialHash, FormulaAndRange) {
   EXPECT_EQ(spatialHash({0, 0, 1}, 1u << 11), 805459861u % (1u << 11));
   const std::uint32_t y = 3, z = 7;
   EXPECT_EQ(spatialHash({1, 3, 7}, 1u << 16), (1u ^ (y * 2654435761u) ^ (z * 805459861u)) % (1u << 16));
+  // Against the formula in 64-bit arithmetic reduced mod 2^32, then mod T, for random
+  // voxels (negative ones too) and every table size of the paper's ablation.
+  std::mt19937_64 rng(20);
+  std::uniform_int_distribution<int> c(-300000, 300000);
+  for (int log2T = 11; log2T <= 19; ++log2T)
+    for (int i = 0; i < 2000; ++i) {
+      const Voxel v{c(rng), c(rng), c(rng)};
+      const auto u32 = [](std::int64_t x) { return static_cast<std::uint64_t>(x) & 0xFFFFFFFFull; };
+      const std::uint64_t h = (u32(v[0]) * 1ull % (1ull << 32)) ^ (u32(v[1]) * 2654435761ull % (1ull << 32)) ^
+                              (u32(v[2]) * 805459861ull % (1ull << 32));
+      ASSERT_EQ(spatialHash(v, 1u << log2T), h % (1ull << log2T));
+    }
   // Negative coordinates wrap as uint32.
   EXPECT_EQ(spatialHash({-1, 0, 0}, 1u << 13), (1u << 13) - 1);
   EXPECT_TRUE(test::throwsInputError([] { HashedBits b(1000); }, "hash encoding", "table_size"));
@@ -240,6 +252,18 @@ TEST(Prefilter, ScoreCandidatesHashedAndExact) {
     EXPECT_TRUE(std::isfinite(ex[j].hamming) && std::isfinite(hs[j].hamming));
     // At load ~0.01 a few collisions at most.
     EXPECT_NEAR(static_cast<double>(hs[j].new_count), static_cast<double>(ex[j].new_count), 0.02 * ex[j].new_count + 2);
+  }
+  // The batch scorer gives exactly the dense bit-vector scores.
+  for (std::size_t T : {std::size_t{1} << 11, std::size_t{1} << 19}) {
+    o.table_size = T;
+    const auto batch = scoreCandidates(obs, cands, 50000, o);
+    const HashedBits ho = HashedBits::encode(obs, T);
+    for (std::size_t j = 0; j < cands.size(); ++j) {
+      const CoverageScore d = scoreHashed(ho, HashedBits::encode(cands[j], T));
+      EXPECT_EQ(batch[j].differing, d.differing);
+      EXPECT_EQ(batch[j].new_count, d.new_count);
+      EXPECT_EQ(batch[j].hamming, d.hamming);
+    }
   }
   EXPECT_EQ(ex.back().new_count, 0u);
   EXPECT_EQ(ex.back().differing, obs.size());
