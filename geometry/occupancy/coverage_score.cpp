@@ -135,4 +135,13 @@ std::vector<int> topPercent(std::span<const double> scores, double percent) {
   return idx;
 }
 
+std::vector<int> prefilterCandidates(const VoxelSet& observed, std::span<const VoxelSet> candidates,
+                                     std::size_t universe, const PrefilterOptions& opts) {
+  const std::vector<CoverageScore> scores = scoreCandidates(observed, candidates, universe, opts);
+  std::vector<double> values;
+  values.reserve(scores.size());
+  for (const CoverageScore& s : scores) values.push_back(criterionValue(s, opts.criterion));
+  return topPercent(values, opts.keep_percent);
+}
+
 }  // namespace saresgs

@@ -11,6 +11,13 @@
 //   new_count   |cand \ obs|: "how many newly covered voxels a candidate adds", the
 //               paper's prose reading of d_j (for hashed bits: popcount(b_cand & ~b_obs)).
 // DESIGN.md asks for both so the ablation can tell them apart.
+// Typical use (the paper's V_obs is a subset of the scene voxels V):
+//   observed = grids.observedSceneVoxels(); universe = grids.sceneCount();
+//   candidates[j] = frustumSet(grids, cam_j) or tracer.visibleSet(cam_j, stride);
+//   scores = scoreCandidates(observed, candidates, universe, opts);
+//   kept = topPercent(values of criterionValue(scores[j], opts.criterion), opts.keep_percent).
+// Observed voxels outside V would add the same count to every candidate's exact XOR
+// (no effect on the ranking) and only collision noise to the hashed one.
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -79,5 +86,10 @@ double criterionValue(const CoverageScore& s, CoverageCriterion c);
 // result is deterministic. Throws InputError("prefilter", ...) for percent outside
 // (0, 100] or a NaN score.
 std::vector<int> topPercent(std::span<const double> scores, double percent = 20.0);
+
+// scoreCandidates, then topPercent of criterionValue(opts.criterion) with
+// opts.keep_percent: the candidate indices kept for the Fisher stage, best first.
+std::vector<int> prefilterCandidates(const VoxelSet& observed, std::span<const VoxelSet> candidates,
+                                     std::size_t universe, const PrefilterOptions& opts);
 
 }  // namespace saresgs

@@ -201,7 +201,9 @@ TEST(HashCollisions, Room360ScoresDeviateFromExactAsTheoryPredicts) {
     // consecutive buckets), hence the one-sided bound there.
     for (const auto& [err, pred] : {std::pair{sum_err_xor, sum_pred_xor}, std::pair{sum_err_new, sum_pred_new}}) {
       EXPECT_LE(err, 1.25 * pred + 20) << "log2T " << log2T;
-      if (pred >= 500) EXPECT_GE(err, 0.75 * pred) << "log2T " << log2T;
+      if (pred >= 500) {
+        EXPECT_GE(err, 0.75 * pred) << "log2T " << log2T;
+      }
     }
   }
 }
@@ -274,4 +276,33 @@ TEST(Prefilter, ScoreCandidatesHashedAndExact) {
   v.clear();
   for (const auto& s : ex) v.push_back(criterionValue(s, CoverageCriterion::Hamming));
   EXPECT_EQ(topPercent(v, 20), (std::vector<int>{8, 7}));
+  o.encoding = CoverageEncoding::Exact;
+  o.criterion = CoverageCriterion::NewCount;
+  o.keep_percent = 30;
+  EXPECT_EQ(prefilterCandidates(obs, cands, 50000, o), (std::vector<int>{8, 7, 6}));
+  EXPECT_TRUE(prefilterCandidates(obs, {}, 50000, o).empty());
+}
+
+TEST(Prefilter, HammingAndNewCountRankDifferently) {
+  // The XOR distance also rewards *not* seeing observed voxels; the new-voxel count does
+  // not. E sees 990 observed voxels and 40 new ones, F sees only 20 new ones:
+  // XOR(E) = 10 + 40 = 50, XOR(F) = 1000 + 20 = 1020, new(E) = 40, new(F) = 20.
+  std::mt19937_64 rng(26);
+  const VoxelSet obs = randomVoxelSet(rng, 1000);
+  const std::vector<Voxel> ov = obs.voxels();
+  std::vector<Voxel> fresh = randomVoxelSet(rng, 60).voxels();
+  ASSERT_EQ(intersectionSize(obs, VoxelSet::fromVoxels(fresh)), 0u);
+  std::vector<Voxel> e(ov.begin(), ov.begin() + 990);
+  e.insert(e.end(), fresh.begin(), fresh.begin() + 40);
+  const std::vector<Voxel> f(fresh.begin() + 40, fresh.end());
+  const std::vector<VoxelSet> cands{VoxelSet::fromVoxels(e), VoxelSet::fromVoxels(f)};
+  for (CoverageEncoding enc : {CoverageEncoding::Exact, CoverageEncoding::Hashed}) {
+    PrefilterOptions o;
+    o.encoding = enc;
+    o.keep_percent = 50;  // keep 1 of 2
+    o.criterion = CoverageCriterion::Hamming;
+    EXPECT_EQ(prefilterCandidates(obs, cands, 100000, o), std::vector<int>{1});
+    o.criterion = CoverageCriterion::NewCount;
+    EXPECT_EQ(prefilterCandidates(obs, cands, 100000, o), std::vector<int>{0});
+  }
 }

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <random>
 #include <set>
@@ -224,6 +225,8 @@ TEST(OccupancyGrids, MemoryFollowsOccupiedVoxelsNotTheBox) {
   EXPECT_LT(g.sceneCount(), 20000u);
   // OpenVDB's fixed cost is one 32^3-entry top internal node (~300 KB); leaves add
   // ~100 B per 8^3 block.
+  std::printf("[ sparse memory ] %zu fine voxels in a 2048^3 box: scene VDB %.1f KB\n", g.sceneCount(),
+              g.memory().scene_vdb / 1024.0);
   EXPECT_LT(g.memory().scene_vdb, std::size_t{4} << 20);
   EXPECT_LT(g.memory().total(), std::size_t{4} << 20);
 }
