@@ -67,7 +67,8 @@ class VisibilityTracer {
   std::int64_t firstHit(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir) const;
   // firstHit for the ray of each samplePixels(cam.K, stride) position, in that order.
   std::vector<std::int64_t> tracePixels(const Camera& cam, int stride) const;
-  // The set of voxels hit first by the sampled rays.
+  // The set of voxels hit first by the sampled rays. Not a subset of the frustum set in
+  // general: a voxel at the image border can be hit while its centre projects outside.
   VoxelSet visibleSet(const Camera& cam, int stride = 4) const;
 
  private:
