@@ -48,7 +48,7 @@ class CoveragePrefilter {
   virtual void load(const std::string& bytes) = 0;
 };
 
-struct PrefilterOptions {
+struct PrefilterChoice {
   std::string set = "frustum";    // frustum | visible
   std::string encoding = "hash:13";  // hash:K | exact
   std::string score = "xor";      // xor | new
@@ -64,7 +64,7 @@ struct ActiveOptions {
   bool reset_after_add = true;
   double fisher_lambda = 1e-6;
   ViewDistance fvs_metric = ViewDistance::kEuclidean;
-  PrefilterOptions prefilter;
+  PrefilterChoice prefilter;
   bool time_exhaustive_fisher = false;  // prefiltered methods: also time Fisher on all
   int progress_test_views = 3;
   TrainerOptions trainer;
@@ -131,7 +131,7 @@ std::optional<double> depthAuse(const Trainer& t, const std::vector<int>& train_
                                 double lambda = 1e-6);
 
 // Factory for the coverage prefilter (nbv/coverage_prefilter.cpp).
-std::unique_ptr<CoveragePrefilter> makeCoveragePrefilter(const Scene& scene, const PrefilterOptions& o,
+std::unique_ptr<CoveragePrefilter> makeCoveragePrefilter(const Scene& scene, const PrefilterChoice& o,
                                                          std::uint64_t seed);
 
 }  // namespace saresgs

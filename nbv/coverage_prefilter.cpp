@@ -6,7 +6,7 @@
 
 namespace saresgs {
 
-std::unique_ptr<CoveragePrefilter> makeCoveragePrefilter(const Scene&, const PrefilterOptions&, std::uint64_t) {
+std::unique_ptr<CoveragePrefilter> makeCoveragePrefilter(const Scene&, const PrefilterChoice&, std::uint64_t) {
   throw std::runtime_error("the coverage methods (coverage, sa-hash, sa-resgs) need the SA-Point prefilter, "
                            "which this build does not have yet");
 }
