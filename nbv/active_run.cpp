@@ -123,7 +123,9 @@ int ActiveRun::selectNext(SelectionLog& log) {
   std::vector<int> pool = candidates;
   if (needs.coverage) {
     std::vector<int> fresh(selected_.begin() + observed_upto_, selected_.end());
-    prefilter_->observe(fresh, *trainer_, log.seconds);
+    prefilter_->observe(
+        fresh, [this](const Camera& c) { return trainer_->render(c).rgb; },
+        [this](const Camera& c) { return trainer_->render(c).depth; }, log.seconds);
     observed_upto_ = static_cast<int>(selected_.size());
     const std::vector<double> cov = prefilter_->score(candidates, log.seconds);
     if (!needs.fisher) {

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "geometry/lifting/sa_points.h"
 #include "geometry/scene/scene.h"
 #include "nbv/selectors.h"
 #include "splat/train/trainer.h"
@@ -36,12 +37,15 @@ struct SelectionSeconds {
 };
 
 // The prefilter of the coverage methods: builds its state from the scene, learns what the
-// chosen views observe (SA-Points from the trainer's renders), and scores candidates
-// (higher = more new coverage). Implemented in nbv/coverage_prefilter.cpp.
+// chosen views observe (SA-Points lifted against `render`: the trainer's renders in an
+// active run, ground-truth renders in the coverage tool), and scores candidates (higher
+// = more new coverage). Implemented in nbv/coverage_prefilter.cpp.
 class CoveragePrefilter {
  public:
   virtual ~CoveragePrefilter() = default;
-  virtual void observe(const std::vector<int>& new_views, const Trainer& trainer, SelectionSeconds& t) = 0;
+  // `depth` serves the `depth` lifting module (the renderer's own depth for the real view).
+  virtual void observe(const std::vector<int>& new_views, const ViewRenderer& render, const DepthRenderer& depth,
+                       SelectionSeconds& t) = 0;
   virtual std::vector<double> score(const std::vector<int>& candidates, SelectionSeconds& t) = 0;
   // Serialised observed state, so a resumed run continues with the same grids.
   virtual std::string save() const = 0;
@@ -49,10 +53,18 @@ class CoveragePrefilter {
 };
 
 struct PrefilterChoice {
-  std::string set = "frustum";    // frustum | visible
-  std::string encoding = "hash:13";  // hash:K | exact
-  std::string score = "xor";      // xor | new
-  double keep_fraction = 0.2;     // top N % kept for Fisher
+  std::string set = "frustum";       // frustum | visible
+  std::string encoding = "hash:13";  // hash:K (K = 11..19) | exact
+  std::string score = "xor";         // xor | new
+  double keep_fraction = 0.2;        // top N % kept for Fisher
+  int visible_stride = 4;            // pixel stride of the visibility rays
+  std::string lifting = "flow";      // flow (DIS + epipolar refinement) | depth (oracle)
+  // Occupancy grid: resolution along the longest side and the SfM points per occupied
+  // voxel. The paper's m = 5 (indoor) at 128 leaves a 12k-point SfM cloud almost empty,
+  // so the default is sized for sparse clouds (see third_party_notes/openvdb.md).
+  int resolution = 64;
+  int min_points = 2;
+  int upsample = 2;
 };
 
 struct ActiveOptions {

@@ -9,7 +9,7 @@
 
 #include "common/test_support.h"
 #include "splat/train/trainer.h"
-#include "tiny_dataset.h"
+#include "common/tiny_dataset.h"
 
 namespace saresgs {
 namespace {

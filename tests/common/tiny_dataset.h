@@ -10,17 +10,23 @@
 
 namespace saresgs::test {
 
+// The options the tiny dataset is made with (tests rebuild the scene for ground truth).
+inline SyntheticOptions tinyDatasetOptions() {
+  SyntheticOptions o;
+  o.layout = "object";
+  o.width = 64;
+  o.height = 48;
+  o.num_views = 16;
+  o.seed = 3;
+  return o;
+}
+
 inline const Scene& tinyDataset() {
   static std::unique_ptr<TempDir> dir;
   static Scene scene;
   if (!dir) {
     dir = std::make_unique<TempDir>();
-    SyntheticOptions o;
-    o.layout = "object";
-    o.width = 64;
-    o.height = 48;
-    o.num_views = 16;
-    o.seed = 3;
+    const SyntheticOptions o = tinyDatasetOptions();
     WriteDatasetOptions w;
     w.simulated.max_points = 1500;
     w.simulated.candidates = 6000;

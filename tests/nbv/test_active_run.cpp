@@ -1,0 +1,184 @@
+// The active loop on a tiny synthetic scene: the protocol's view counts, a killed and
+// resumed run equals an uninterrupted one bit for bit, and the coverage prefilter prefers
+// the view of the unobserved side.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+
+#include "common/test_support.h"
+#include "common/tiny_dataset.h"
+#include "nbv/active_run.h"
+
+namespace saresgs {
+namespace {
+
+using test::TempDir;
+using test::tinyDataset;
+
+ActiveOptions tinyOptions(Method m) {
+  ActiveOptions o;
+  o.method = m;
+  o.initial_views = 2;
+  o.max_views = 5;
+  o.interval = 6;
+  o.total_iterations = 90;
+  o.trainer.max_sh_degree = 0;
+  o.trainer.densify.from_iter = 10;
+  o.trainer.densify.interval = 10;
+  o.prefilter.encoding = "exact";
+  o.prefilter.resolution = 24;
+  o.progress_test_views = 1;
+  o.seed = 5;
+  return o;
+}
+
+bool sameModel(const Gaussians& a, const Gaussians& b) {
+  if (a.size() != b.size()) return false;
+  return std::memcmp(a.means.data(), b.means.data(), a.means.size() * 4) == 0 &&
+         std::memcmp(a.sh.data(), b.sh.data(), a.sh.size() * 4) == 0 &&
+         std::memcmp(a.opacities.data(), b.opacities.data(), a.opacities.size() * 4) == 0;
+}
+
+TEST(ActiveRun, ProtocolCountsAndIterationBudget) {
+  const Scene& s = tinyDataset();
+  for (Method m : {Method::kRandom, Method::kFvs, Method::kFisher}) {
+    ActiveRun run(s, tinyOptions(m));
+    int last_iteration = 0, calls = 0;
+    const ActiveResult r = run.run([&](const ActiveProgress& p) {
+      EXPECT_GE(p.iteration, last_iteration);
+      last_iteration = p.iteration;
+      ++calls;
+    });
+    ASSERT_EQ(r.initial_views.size(), 2u);
+    EXPECT_EQ(r.initial_views[0], s.train[0]);
+    ASSERT_EQ(r.selected_views.size(), 5u) << toString(m);
+    std::set<int> distinct(r.selected_views.begin(), r.selected_views.end());
+    EXPECT_EQ(distinct.size(), 5u);
+    for (int v : r.selected_views) EXPECT_NE(std::find(s.train.begin(), s.train.end(), v), s.train.end());
+    // 2*6 + 3*6 + 4*6 = 54 iterations over three selections, then the rest of 90.
+    EXPECT_EQ(last_iteration, 90);
+    EXPECT_EQ(calls, 90);
+    EXPECT_EQ(r.steps.size(), 4u);  // three selections and the final phase
+    EXPECT_TRUE(std::isfinite(r.test.psnr));
+    ASSERT_TRUE(r.ause.has_value());  // the synthetic dataset has depth
+    EXPECT_TRUE(std::isfinite(*r.ause));
+    if (m == Method::kFvs) {
+      // Farthest view: the first selection maximises the distance to the initial views.
+      const SelectionLog& l = r.steps[0];
+      double best = -1;
+      int best_view = -1;
+      for (int c : l.candidates) {
+        double d = 1e300;
+        for (int v : r.initial_views) d = std::min(d, (s.views[c].camera.center() - s.views[v].camera.center()).norm());
+        if (d > best) best = d, best_view = c;
+      }
+      EXPECT_EQ(l.selected, best_view);
+    }
+  }
+}
+
+TEST(ActiveRun, OnlyWhatAMethodNeedsIsComputed) {
+  EXPECT_FALSE(needsOf(Method::kRandom).fisher);
+  EXPECT_FALSE(needsOf(Method::kFvs).coverage);
+  EXPECT_FALSE(needsOf(Method::kFisher).coverage);
+  EXPECT_TRUE(needsOf(Method::kSaResgs).residual && needsOf(Method::kSaResgs).coverage);
+  const Scene& s = tinyDataset();
+  ActiveRun run(s, tinyOptions(Method::kRandom));
+  const ActiveResult r = run.run();
+  for (const auto& l : r.steps) {
+    EXPECT_EQ(l.seconds.fisher, 0.0);
+    EXPECT_EQ(l.seconds.lifting, 0.0);
+    EXPECT_EQ(l.seconds.prefilter, 0.0);
+  }
+  EXPECT_THROW(parseMethod("oracle"), std::invalid_argument);
+}
+
+TEST(ActiveRun, ResumedAfterAKillEqualsAnUninterruptedRun) {
+  const Scene& s = tinyDataset();
+  for (Method m : {Method::kFisher, Method::kSaResgs}) {
+    TempDir d;
+    ActiveRun whole(s, tinyOptions(m));
+    const ActiveResult a = whole.run();
+    struct Killed {};
+    {
+      ActiveRun first(s, tinyOptions(m), d.file("ckpt.json"));
+      // Dies in the middle of the third phase, after two checkpoints.
+      EXPECT_THROW(first.run([](const ActiveProgress& p) {
+        if (p.iteration == 40) throw Killed{};
+      }), Killed);
+    }
+    ASSERT_TRUE(std::filesystem::exists(d.file("ckpt.json")));
+    ActiveRun resumed(s, tinyOptions(m), d.file("ckpt.json"));
+    const ActiveResult b = resumed.run();
+    EXPECT_EQ(a.selected_views, b.selected_views) << toString(m);
+    EXPECT_EQ(a.test.psnr, b.test.psnr) << toString(m);
+    EXPECT_EQ(a.test.ssim, b.test.ssim);
+    EXPECT_EQ(a.ause, b.ause);
+    EXPECT_TRUE(sameModel(whole.trainer().gaussians(), resumed.trainer().gaussians())) << toString(m);
+    ASSERT_EQ(a.steps.size(), b.steps.size());
+    for (std::size_t k = 0; k < a.steps.size(); ++k) EXPECT_EQ(a.steps[k].scores, b.steps[k].scores);
+  }
+}
+
+TEST(ActiveRun, CheckpointOfAnotherMethodIsRefused) {
+  const Scene& s = tinyDataset();
+  TempDir d;
+  ActiveOptions o = tinyOptions(Method::kRandom);
+  o.max_views = 3;
+  ActiveRun(s, o, d.file("c.json")).run();
+  ActiveRun other(s, tinyOptions(Method::kFvs), d.file("c.json"));
+  EXPECT_TRUE(test::throwsInputError([&] { other.run(); }, d.file("c.json"), "method"));
+}
+
+TEST(CoveragePrefilter, PrefersTheViewOfTheUnobservedSide) {
+  const Scene& s = tinyDataset();
+  const SyntheticScene truth = makeSyntheticScene(test::tinyDatasetOptions());
+  const ViewRenderer render = [&](const Camera& c) { return truth.render(c); };
+  const DepthRenderer depth = [&](const Camera& c) { return truth.renderDepth(c); };
+  // Observe from the first train view; candidates: the train view nearest to it and the
+  // one farthest from it (the other side of the object).
+  const int seen = s.train[0];
+  const Eigen::Vector3d c0 = s.views[seen].camera.center();
+  int near = -1, far = -1;
+  double dn = 1e300, df = -1;
+  for (int v : s.train) {
+    if (v == seen) continue;
+    const double d = (s.views[v].camera.center() - c0).norm();
+    if (d < dn) dn = d, near = v;
+    if (d > df) df = d, far = v;
+  }
+  // Around an object every frustum holds every voxel; only the visible set (what rays
+  // hit first) tells the sides apart.
+  for (const char* lifting : {"depth", "flow"}) {
+    for (const char* score : {"new", "xor"}) {
+      for (const char* enc : {"exact", "hash:15"}) {
+        PrefilterChoice pc;
+        pc.set = "visible";
+        pc.visible_stride = 1;
+        pc.lifting = lifting;
+        pc.score = score;
+        pc.encoding = enc;
+        pc.resolution = 32;
+        auto pf = makeCoveragePrefilter(s, pc, 0);
+        SelectionSeconds t;
+        const auto before = pf->score({near, far}, t);
+        pf->observe({seen}, render, depth, t);
+        const auto sc = pf->score({near, far}, t);
+        EXPECT_GT(sc[1], sc[0]) << lifting << " " << score << " " << enc;
+        if (std::string(score) == "new") {
+          // The observation covered some of what the near view sees, and more of it than
+          // of what the far view sees.
+          EXPECT_GT(before[0] - sc[0], before[1] - sc[1]) << lifting << " " << enc;
+          EXPECT_GT(before[0] - sc[0], 0.0) << lifting << " " << enc;
+        }
+      }
+    }
+  }
+  PrefilterChoice bad;
+  bad.encoding = "hash:40";
+  EXPECT_THROW(makeCoveragePrefilter(s, bad, 0), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace saresgs
