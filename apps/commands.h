@@ -12,5 +12,6 @@ void addSceneCommand(CLI::App& app, Action& action);  // apps/cmd_scene.cpp
 void addTrainCommand(CLI::App& app, Action& action);  // apps/cmd_train.cpp
 void addBenchCommand(CLI::App& app, Action& action);  // apps/cmd_bench.cpp
 void addActiveCommand(CLI::App& app, Action& action);  // apps/cmd_active.cpp
+void addCoverageCommand(CLI::App& app, Action& action);  // apps/cmd_coverage.cpp
 
 }  // namespace saresgs::apps

@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   saresgs::apps::addTrainCommand(app, action);
   saresgs::apps::addBenchCommand(app, action);
   saresgs::apps::addActiveCommand(app, action);
+  saresgs::apps::addCoverageCommand(app, action);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

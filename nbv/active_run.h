@@ -18,6 +18,8 @@
 
 namespace saresgs {
 
+class OccupancyGrids;  // geometry/occupancy/occupancy_grid.h
+
 enum class Method { kRandom, kFvs, kFisher, kCoverage, kSaHash, kSaResgs, kResgs };
 Method parseMethod(const std::string& s);  // random|fvs|fisher|coverage|sa-hash|sa-resgs|resgs
 const char* toString(Method m);
@@ -47,6 +49,8 @@ class CoveragePrefilter {
   virtual void observe(const std::vector<int>& new_views, const ViewRenderer& render, const DepthRenderer& depth,
                        SelectionSeconds& t) = 0;
   virtual std::vector<double> score(const std::vector<int>& candidates, SelectionSeconds& t) = 0;
+  virtual const OccupancyGrids& grids() const = 0;
+  virtual const LiftingReport& liftingReport() const = 0;  // summed over observed views
   // Serialised observed state, so a resumed run continues with the same grids.
   virtual std::string save() const = 0;
   virtual void load(const std::string& bytes) = 0;

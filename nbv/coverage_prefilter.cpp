@@ -67,7 +67,8 @@ class SaPointPrefilter : public CoveragePrefilter {
     }
   }
 
-  std::size_t observedCount() const { return grids_->observedSceneVoxels().size(); }
+  const OccupancyGrids& grids() const override { return *grids_; }
+  const LiftingReport& liftingReport() const override { return last_report_; }
 
   std::vector<double> score(const std::vector<int>& candidates, SelectionSeconds& t) override {
     const auto t0 = std::chrono::steady_clock::now();

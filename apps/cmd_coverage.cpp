@@ -1,0 +1,150 @@
+// saresgs coverage: which voxels do these views observe, and which other views would add
+// most? No training: SA-Points come from ground-truth renders when the dataset is a
+// rebuildable synthetic scene, from a trained model (--model) otherwise.
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+#include "apps/commands.h"
+#include "geometry/error.h"
+#include "geometry/io/atomic_file.h"
+#include "geometry/synth/from_manifest.h"
+#include "nbv/coverage_report.h"
+#include "splat/ply.h"
+#include "splat/rasterize.h"
+
+namespace saresgs::apps {
+
+namespace {
+
+struct CoverageArgs {
+  std::string dataset, out, views, model;
+  PrefilterChoice choice;
+  int downscale = 1;
+};
+
+std::vector<int> parseViews(const std::string& text, const Scene& scene) {
+  std::vector<int> out;
+  std::stringstream ss(text);
+  for (std::string item; std::getline(ss, item, ',');) {
+    // A train index or an image name.
+    int v = -1;
+    try {
+      std::size_t used = 0;
+      const int i = std::stoi(item, &used);
+      if (used == item.size()) {
+        if (i < 0 || i >= static_cast<int>(scene.train.size()))
+          throw InputError("--views", item, "train index out of range 0.." + std::to_string(scene.train.size() - 1));
+        v = scene.train[static_cast<std::size_t>(i)];
+      }
+    } catch (const std::invalid_argument&) {
+    }
+    if (v < 0) {
+      for (int t : scene.train)
+        if (scene.views[static_cast<std::size_t>(t)].name == item) v = t;
+      if (v < 0) throw InputError("--views", item, "neither a train index nor the name of a train image");
+    }
+    out.push_back(v);
+  }
+  if (out.empty()) throw InputError("--views", text, "expected a comma-separated list of train views");
+  return out;
+}
+
+int runCoverage(const CoverageArgs& a) {
+  DatasetOptions dopt;
+  dopt.load.downscale = a.downscale;
+  const Scene scene = loadDataset(a.dataset, dopt);
+  const std::vector<int> views = parseViews(a.views, scene);
+  ViewRenderer render;
+  DepthRenderer depth;
+  std::string source;
+  std::optional<SyntheticScene> truth;
+  Gaussians model;
+  if (!a.model.empty()) {
+    model = readGaussiansPly(a.model);
+    RasterSettings rs;
+    rs.sh_degree = model.max_sh_degree;
+    if (scene.background) rs.background = *scene.background;
+    render = [&, rs](const Camera& c) { return rasterize(model, c, rs).rgb; };
+    depth = [&, rs](const Camera& c) { return rasterize(model, c, rs).depth; };
+    source = "model " + a.model;
+  } else if ((truth = rebuildSyntheticScene(a.dataset, scene))) {
+    render = [&](const Camera& c) { return truth->render(c); };
+    depth = [&](const Camera& c) { return truth->renderDepth(c); };
+    source = "ground-truth renders of the synthetic scene";
+  } else {
+    throw InputError(a.dataset, "manifest.json",
+                     "not a rebuildable synthetic scene: give a trained model with --model to render extrapolated views");
+  }
+  std::cerr << "coverage of " << views.size() << " views from " << source << "\n";
+  const CoverageAnalysis c = analyzeCoverage(scene, views, a.choice, render, depth);
+
+  std::filesystem::create_directories(a.out);
+  nlohmann::json j;
+  j["dataset"] = a.dataset;
+  j["source"] = source;
+  j["set"] = a.choice.set;
+  j["encoding"] = a.choice.encoding;
+  j["score"] = a.choice.score;
+  j["lifting"] = a.choice.lifting;
+  auto name = [&](int v) { return scene.views[static_cast<std::size_t>(v)].name; };
+  for (int v : views) j["views"].push_back(name(v));
+  j["observed_fraction"] = c.observed_fraction;
+  j["scene_voxels"] = c.scene_voxels;
+  j["observed_voxels"] = c.observed_voxels;
+  j["sa_points"] = c.lifting.toJson();
+  for (int v : c.top) j["top"].push_back(name(v));
+  j["seconds"] = {{"grid", c.seconds_grid},
+                  {"lifting", c.seconds_lifting},
+                  {"triangulation", c.seconds_triangulation},
+                  {"scoring", c.seconds_scoring}};
+  std::string csv = "view,score,rank,kept\n";
+  for (const auto& k : c.candidates) {
+    j["candidates"].push_back({{"view", name(k.view)}, {"score", k.score}, {"rank", k.rank}, {"kept", k.kept}});
+    csv += name(k.view) + "," + std::to_string(k.score) + "," + std::to_string(k.rank) + "," + (k.kept ? "1" : "0") + "\n";
+  }
+  writeFileAtomic(a.out + "/coverage.json", j.dump(2) + "\n");
+  writeFileAtomic(a.out + "/coverage.csv", csv);
+  writeImage(a.out + "/coverage.png", plotCoverage(scene, c));
+
+  std::printf("observed %zu of %zu scene voxels (%.1f %%) from %zu SA-Points; kept %zu of %zu candidates\n",
+              c.observed_voxels, c.scene_voxels, 100 * c.observed_fraction, c.lifting.kept, c.top.size(),
+              c.candidates.size());
+  std::printf("%-16s %12s %6s\n", "candidate", a.choice.score == "new" ? "new voxels" : "hamming", "rank");
+  std::vector<CandidateCoverage> by_rank = c.candidates;
+  std::sort(by_rank.begin(), by_rank.end(), [](const auto& x, const auto& y) { return x.rank < y.rank; });
+  for (std::size_t i = 0; i < by_rank.size() && i < 10; ++i)
+    std::printf("%-16s %12.6g %6d%s\n", name(by_rank[i].view).c_str(), by_rank[i].score, by_rank[i].rank,
+                by_rank[i].kept ? "  *" : "");
+  std::printf("seconds: grid %.3f, lifting %.2f, triangulation %.3f, scoring %.3f\n", c.seconds_grid, c.seconds_lifting,
+              c.seconds_triangulation, c.seconds_scoring);
+  std::printf("wrote %s/coverage.json, coverage.csv, coverage.png\n", a.out.c_str());
+  return 0;
+}
+
+}  // namespace
+
+void addCoverageCommand(CLI::App& app, Action& action) {
+  auto a = std::make_shared<CoverageArgs>();
+  CLI::App* sub = app.add_subcommand("coverage", "Observed voxels of some views and the coverage score of the others");
+  sub->add_option("--dataset", a->dataset, "COLMAP, Blender or `saresgs scene` folder")->required();
+  sub->add_option("--views", a->views, "Observed train views: indices into the train list or image names, comma-separated")->required();
+  sub->add_option("--out", a->out, "Output folder")->required();
+  sub->add_option("--model", a->model, "Trained .ply to render extrapolated views (datasets without ground truth)");
+  sub->add_option("--set", a->choice.set, "frustum | visible")->check(CLI::IsMember({"frustum", "visible"}))->capture_default_str();
+  sub->add_option("--encoding", a->choice.encoding, "hash:K (K = 11..19) | exact")->capture_default_str();
+  sub->add_option("--score", a->choice.score, "xor | new")->check(CLI::IsMember({"xor", "new"}))->capture_default_str();
+  sub->add_option("--lifting", a->choice.lifting, "flow | depth")->check(CLI::IsMember({"flow", "depth"}))->capture_default_str();
+  sub->add_option("--keep", a->choice.keep_fraction, "Fraction of candidates kept (top N %)")->check(CLI::Range(0.0, 1.0))->capture_default_str();
+  sub->add_option("--resolution", a->choice.resolution, "Grid resolution along the longest side")->check(CLI::Range(4, 4096))->capture_default_str();
+  sub->add_option("--min-points", a->choice.min_points, "SfM points per occupied voxel (paper: 2 outdoor, 5 indoor)")->check(CLI::Range(1, 1000))->capture_default_str();
+  sub->add_option("--upsample", a->choice.upsample, "Upsampling of the occupied voxels")->check(CLI::Range(1, 16))->capture_default_str();
+  sub->add_option("--stride", a->choice.visible_stride, "Pixel stride of visibility rays")->check(CLI::Range(1, 64))->capture_default_str();
+  sub->add_option("--downscale", a->downscale, "Image downscale factor")->check(CLI::Range(1, 64))->capture_default_str();
+  sub->callback([&action, a] { action = [a] { return runCoverage(*a); }; });
+}
+
+}  // namespace saresgs::apps

@@ -1,0 +1,56 @@
+#include "geometry/synth/from_manifest.h"
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+
+#include "geometry/error.h"
+#include "geometry/io/atomic_file.h"
+
+namespace saresgs {
+
+std::optional<SyntheticOptions> syntheticOptionsFromManifest(const std::string& folder) {
+  const std::string path = (std::filesystem::path(folder) / "manifest.json").string();
+  if (!std::filesystem::exists(path)) return std::nullopt;
+  nlohmann::json m;
+  try {
+    m = nlohmann::json::parse(readFile(path));
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(path, "json", std::string("not valid JSON: ") + e.what());
+  }
+  if (!m.contains("layout") || !m.contains("objects") || !m["objects"].is_array()) return std::nullopt;
+  for (const auto& o : m["objects"]) {
+    const std::string mesh = o.value("mesh", ""), tex = o.value("texture", "");
+    if (mesh.rfind("procedural:", 0) != 0 || tex.rfind("procedural:", 0) != 0) return std::nullopt;
+  }
+  try {
+    SyntheticOptions s;
+    s.layout = m.at("layout");
+    s.seed = m.at("seed");
+    s.width = m.at("width");
+    s.height = m.at("height");
+    s.num_views = m.at("num_views");
+    s.up_axis = m.value("up_axis", "y");
+    s.projection = m.value("projection", "triplanar");
+    return s;
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(path, "layout", std::string("incomplete synthetic-scene manifest: ") + e.what());
+  }
+}
+
+std::optional<SyntheticScene> rebuildSyntheticScene(const std::string& folder, const Scene& dataset) {
+  const auto opts = syntheticOptionsFromManifest(folder);
+  if (!opts) return std::nullopt;
+  SyntheticScene s = makeSyntheticScene(*opts);
+  if (s.cameras.size() != dataset.views.size()) return std::nullopt;
+  const double tol = 1e-6 * std::max(1.0, dataset.extent);
+  for (std::size_t i = 0; i < s.cameras.size(); ++i) {
+    // Views are matched by name: the dataset may order them differently.
+    const std::string& name = s.names[i];
+    const auto it = std::find_if(dataset.views.begin(), dataset.views.end(), [&](const SceneView& v) { return v.name == name; });
+    if (it == dataset.views.end() || (it->camera.center() - s.cameras[i].center()).norm() > tol) return std::nullopt;
+  }
+  return s;
+}
+
+}  // namespace saresgs
