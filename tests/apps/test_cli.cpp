@@ -65,3 +65,45 @@ TEST(Cli, BadInputGivesAClearErrorAndNonZeroExit) {
   r = run("");
   EXPECT_NE(r.code, 0);
 }
+
+// One small scene for the pipeline commands: train, its outputs read back by real
+// consumers (our .ply reader, the JSON), then coverage and an active run on it.
+TEST(Cli, TrainCoverageAndActiveOnASmallScene) {
+  TempDir d;
+  ASSERT_EQ(run("scene --layout object --views 12 --width 64 --height 48 --out " + d.file("s")).code, 0);
+
+  Result r = run("train --dataset " + d.file("s") + " --iterations 60 --sh-degree 1 --out " + d.file("t"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("PSNR"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("[train]"), std::string::npos) << r.output;  // progress on stderr
+  const std::string results = saresgs::test::readBytes(d.file("t/results.json"));
+  EXPECT_NE(results.find("\"psnr\""), std::string::npos);
+  EXPECT_NE(results.find("\"ssim\""), std::string::npos);
+  EXPECT_TRUE(fs::exists(d.path() / "t" / "test_renders" / "all.png"));
+  ASSERT_TRUE(fs::exists(d.path() / "t" / "point_cloud.ply"));
+
+  r = run("coverage --dataset " + d.file("s") + " --views 0,3 --set visible --encoding exact --score new --resolution 32 --out " +
+          d.file("c"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("observed"), std::string::npos) << r.output;
+  for (const char* f : {"coverage.json", "coverage.csv", "coverage.png"}) EXPECT_TRUE(fs::exists(d.path() / "c" / f)) << f;
+  // The trained model renders the extrapolated views just as well (datasets without truth).
+  r = run("coverage --dataset " + d.file("s") + " --views 0,3 --model " + d.file("t/point_cloud.ply") + " --resolution 32 --out " +
+          d.file("c2"));
+  ASSERT_EQ(r.code, 0) << r.output;
+
+  r = run("active --dataset " + d.file("s") + " --method fvs --max-views 5 --interval 4 --iterations 40 --out " + d.file("a"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  const std::string ar = saresgs::test::readBytes(d.file("a/results.json"));
+  for (const char* key : {"\"psnr\"", "\"ssim\"", "\"ause\"", "\"selected_views\"", "\"seconds\""})
+    EXPECT_NE(ar.find(key), std::string::npos) << key;
+  EXPECT_TRUE(fs::exists(d.path() / "a" / "cameras.png"));
+  // Running again into the same folder without --resume is refused (nothing overwritten).
+  r = run("active --dataset " + d.file("s") + " --method fvs --max-views 5 --interval 4 --iterations 40 --out " + d.file("a"));
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.output.find("--resume"), std::string::npos) << r.output;
+
+  r = run("coverage --dataset " + d.file("s") + " --views 0,99 --out " + d.file("c3"));
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.output.find("--views"), std::string::npos) << r.output;
+}
