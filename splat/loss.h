@@ -6,7 +6,10 @@
 // reference implementation) and is the mean of the SSIM map over pixels and channels.
 // Unlike the evaluation metric (metrics.h) nothing is clamped, so the loss is
 // differentiable everywhere except where L1 has its kink (render == target, where the
-// L1 gradient is taken as 0). Computation is in double; results are deterministic.
+// L1 gradient is taken as 0). Computation is in float (separable filtering, TBB over fixed
+// row blocks, sums reduced in double in a fixed order): values agree with a double
+// evaluation to about 1e-7 relative, and results are bit-identical from call to call and
+// for any thread count.
 #include "geometry/image/image.h"
 
 namespace saresgs {
