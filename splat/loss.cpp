@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstddef>
 #include <cstring>
@@ -52,6 +53,13 @@
 // and per-row sums (float runs of 4, then double) are added in row order, so results are
 // bit-identical for any thread count.
 
+// Runtime AVX2 dispatch needs GCC-style target attributes and __builtin_cpu_supports.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__AVX2__)
+#define SARESGS_SSIM_AVX2 1
+#else
+#define SARESGS_SSIM_AVX2 0
+#endif
+
 namespace saresgs {
 
 namespace detail {
@@ -63,7 +71,7 @@ constexpr int kTaps = 2 * kRadius + 1;
 constexpr float kC1 = static_cast<float>(0.01 * 0.01);
 constexpr float kC2 = static_cast<float>(0.03 * 0.03);
 constexpr float kShift = 0.5f;  // c: x' = x - c, y' = y - c
-constexpr int kBlockRows = 16;
+constexpr int kBlockRows = 32;
 
 // g[0] is the centre tap, g[k] the taps at -k and +k.
 const std::array<float, kRadius + 1>& window() {
@@ -92,10 +100,19 @@ double insideWeight(int p, int n) {
   return s;
 }
 
+// The loops below are written once, as always-inline bodies, and compiled twice (see
+// Kernels): for the baseline target (SSE2 on x86-64) and, where the CPU has it, for AVX2
+// without FMA. Both perform the same IEEE operations in the same order on each value
+// (nothing is reassociated, no multiply-add is fused), so they give identical bits; AVX2
+// only does 8 values per instruction instead of 4.
+#define SARESGS_KERNEL inline __attribute__((always_inline))
+
+using Taps = std::array<float, kRadius + 1>;
+
 // out[i] = sum_k g_|k| rows[kRadius + k][i]; rows outside the image point at a zero row.
 // Summed from the outer (small) taps inwards.
-void verticalPass(const float* const* rows, float* __restrict out, std::size_t n,
-                  const std::array<float, kRadius + 1>& g) {
+SARESGS_KERNEL void verticalBody(const float* const* rows, float* __restrict out, std::size_t n,
+                                 const Taps& g) {
   const float* __restrict u5 = rows[0];
   const float* __restrict u4 = rows[1];
   const float* __restrict u3 = rows[2];
@@ -113,9 +130,71 @@ void verticalPass(const float* const* rows, float* __restrict out, std::size_t n
              g2 * (u2[i] + d2[i]) + g1 * (u1[i] + d1[i]) + g0 * c0[i];
 }
 
+// verticalBody for two consecutive output rows at once (rows[0..11] = input rows r-5 ..
+// r+6): each output is the same expression as there, so the same bits, but the shared
+// input rows are loaded once.
+SARESGS_KERNEL void vertical2Body(const float* const* rows, float* __restrict out0,
+                                  float* __restrict out1, std::size_t n, const Taps& g) {
+  const float* __restrict r0 = rows[0];
+  const float* __restrict r1 = rows[1];
+  const float* __restrict r2 = rows[2];
+  const float* __restrict r3 = rows[3];
+  const float* __restrict r4 = rows[4];
+  const float* __restrict r5 = rows[5];
+  const float* __restrict r6 = rows[6];
+  const float* __restrict r7 = rows[7];
+  const float* __restrict r8 = rows[8];
+  const float* __restrict r9 = rows[9];
+  const float* __restrict r10 = rows[10];
+  const float* __restrict r11 = rows[11];
+  const float g0 = g[0], g1 = g[1], g2 = g[2], g3 = g[3], g4 = g[4], g5 = g[5];
+  for (std::size_t i = 0; i < n; ++i) {
+    const float a0 = r0[i], a1 = r1[i], a2 = r2[i], a3 = r3[i], a4 = r4[i], a5 = r5[i];
+    const float a6 = r6[i], a7 = r7[i], a8 = r8[i], a9 = r9[i], a10 = r10[i], a11 = r11[i];
+    out0[i] = g5 * (a0 + a10) + g4 * (a1 + a9) + g3 * (a2 + a8) + g2 * (a3 + a7) +
+              g1 * (a4 + a6) + g0 * a5;
+    out1[i] = g5 * (a1 + a11) + g4 * (a2 + a10) + g3 * (a3 + a9) + g2 * (a4 + a8) +
+              g1 * (a5 + a7) + g0 * a6;
+  }
+}
+
+// verticalBody for four consecutive output rows (rows[0..13] = input rows r-5 .. r+8).
+SARESGS_KERNEL void vertical4Body(const float* const* rows, float* __restrict out0,
+                                  float* __restrict out1, float* __restrict out2,
+                                  float* __restrict out3, std::size_t n, const Taps& g) {
+  const float* __restrict r0 = rows[0];
+  const float* __restrict r1 = rows[1];
+  const float* __restrict r2 = rows[2];
+  const float* __restrict r3 = rows[3];
+  const float* __restrict r4 = rows[4];
+  const float* __restrict r5 = rows[5];
+  const float* __restrict r6 = rows[6];
+  const float* __restrict r7 = rows[7];
+  const float* __restrict r8 = rows[8];
+  const float* __restrict r9 = rows[9];
+  const float* __restrict r10 = rows[10];
+  const float* __restrict r11 = rows[11];
+  const float* __restrict r12 = rows[12];
+  const float* __restrict r13 = rows[13];
+  const float g0 = g[0], g1 = g[1], g2 = g[2], g3 = g[3], g4 = g[4], g5 = g[5];
+  for (std::size_t i = 0; i < n; ++i) {
+    const float a0 = r0[i], a1 = r1[i], a2 = r2[i], a3 = r3[i], a4 = r4[i], a5 = r5[i];
+    const float a6 = r6[i], a7 = r7[i], a8 = r8[i], a9 = r9[i], a10 = r10[i], a11 = r11[i];
+    const float a12 = r12[i], a13 = r13[i];
+    out0[i] = g5 * (a0 + a10) + g4 * (a1 + a9) + g3 * (a2 + a8) + g2 * (a3 + a7) +
+              g1 * (a4 + a6) + g0 * a5;
+    out1[i] = g5 * (a1 + a11) + g4 * (a2 + a10) + g3 * (a3 + a9) + g2 * (a4 + a8) +
+              g1 * (a5 + a7) + g0 * a6;
+    out2[i] = g5 * (a2 + a12) + g4 * (a3 + a11) + g3 * (a4 + a10) + g2 * (a5 + a9) +
+              g1 * (a6 + a8) + g0 * a7;
+    out3[i] = g5 * (a3 + a13) + g4 * (a4 + a12) + g3 * (a5 + a11) + g2 * (a6 + a10) +
+              g1 * (a7 + a9) + g0 * a8;
+  }
+}
+
 // out[i] = sum_k g_|k| t[i + k * stride]; t has kRadius * stride zeros before and after.
-void horizontalPass(const float* __restrict t, float* __restrict out, std::size_t n,
-                    std::ptrdiff_t s, const std::array<float, kRadius + 1>& g) {
+SARESGS_KERNEL void horizontalBody(const float* __restrict t, float* __restrict out,
+                                   std::size_t n, std::ptrdiff_t s, const Taps& g) {
   const float g0 = g[0], g1 = g[1], g2 = g[2], g3 = g[3], g4 = g[4], g5 = g[5];
   for (std::size_t i = 0; i < n; ++i) {
     const float* c = t + i;
@@ -127,9 +206,9 @@ void horizontalPass(const float* __restrict t, float* __restrict out, std::size_
 
 // Inputs of the five filters for one row: x', y', x - y, x' y', (x - y)^2. The difference
 // is taken from the unshifted values, so it is exactly zero where render == target.
-void productsRow(const float* __restrict x, const float* __restrict y, float* __restrict xs,
-                 float* __restrict ys, float* __restrict d, float* __restrict p,
-                 float* __restrict q, std::size_t n) {
+SARESGS_KERNEL void productsBody(const float* __restrict x, const float* __restrict y,
+                                 float* __restrict xs, float* __restrict ys, float* __restrict d,
+                                 float* __restrict p, float* __restrict q, std::size_t n) {
   for (std::size_t i = 0; i < n; ++i) {
     const float a = x[i] - kShift, b = y[i] - kShift, e = x[i] - y[i];
     xs[i] = a;
@@ -158,7 +237,7 @@ struct Terms {
   float mx, md, md2, A1, B1, A2, B2, vd, inv, om;  // om = 1 - S
 };
 
-inline Terms ssimTerms(float mxs, float mys, float md, float pxy, float dd, float wgt) {
+SARESGS_KERNEL Terms ssimTerms(float mxs, float mys, float md, float pxy, float dd, float wgt) {
   Terms t;
   const float out = 1.0f - wgt;  // 1 - W: zero away from the borders
   t.mx = mxs + kShift * wgt;
@@ -177,7 +256,7 @@ inline Terms ssimTerms(float mxs, float mys, float md, float pxy, float dd, floa
   return t;
 }
 
-void ssimPoint(const Filtered& f, float* __restrict om, std::size_t n) {
+SARESGS_KERNEL void pointBody(const Filtered& f, float* __restrict om, std::size_t n) {
   const float* __restrict mxs = f.mxs;
   const float* __restrict mys = f.mys;
   const float* __restrict md = f.md;
@@ -189,10 +268,11 @@ void ssimPoint(const Filtered& f, float* __restrict om, std::size_t n) {
     om[i] = ssimTerms(mxs[i], mys[i], md[i], pxy[i], dd[i], wy * wx[i]).om;
 }
 
-// As ssimPoint (the same om), plus the partials with respect to the filtered render
+// As pointBody (the same om), plus the partials with respect to the filtered render
 // quantities, times `scale`: a = dS/dmx' (= dS/dmx + c dS/dpxy), b = dS/ddd, c = dS/dpxy'.
-void ssimPointGrad(const Filtered& f, float* __restrict om, float* __restrict a,
-                   float* __restrict b, float* __restrict c, std::size_t n, float scale) {
+SARESGS_KERNEL void pointGradBody(const Filtered& f, float* __restrict om, float* __restrict a,
+                                  float* __restrict b, float* __restrict c, std::size_t n,
+                                  float scale) {
   const float* __restrict mxs = f.mxs;
   const float* __restrict mys = f.mys;
   const float* __restrict md = f.md;
@@ -211,6 +291,93 @@ void ssimPointGrad(const Filtered& f, float* __restrict om, float* __restrict a,
     b[i] = scale * (-(S * t.B1) * t.inv);
     c[i] = scale * dpxy;
   }
+}
+
+// The chain rule for one row: grad = l1 + G*a + y' G*c + 2 (x - y) G*b.
+SARESGS_KERNEL void combineBody(const float* __restrict x, const float* __restrict y,
+                                const float* __restrict ga, const float* __restrict gb,
+                                const float* __restrict gc, float* __restrict grad,
+                                std::size_t n, float l1_scale) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const float d = x[i] - y[i];
+    const float l1 = d > 0 ? l1_scale : (d < 0 ? -l1_scale : 0.0f);
+    grad[i] = l1 + (ga[i] + ((y[i] - kShift) * gc[i] + 2.0f * d * gb[i]));
+  }
+}
+
+// The L1 part alone (lambda == 0): l1_scale * sign(x - y), from the row of differences.
+SARESGS_KERNEL void signBody(const float* __restrict d, float* __restrict grad, std::size_t n,
+                             float l1_scale) {
+  for (std::size_t i = 0; i < n; ++i)
+    grad[i] = d[i] > 0 ? l1_scale : (d[i] < 0 ? -l1_scale : 0.0f);
+}
+
+struct Kernels {
+  void (*vertical)(const float* const*, float*, std::size_t, const Taps&);
+  void (*vertical2)(const float* const*, float*, float*, std::size_t, const Taps&);
+  void (*vertical4)(const float* const*, float*, float*, float*, float*, std::size_t,
+                    const Taps&);
+  void (*horizontal)(const float*, float*, std::size_t, std::ptrdiff_t, const Taps&);
+  void (*products)(const float*, const float*, float*, float*, float*, float*, float*,
+                   std::size_t);
+  void (*point)(const Filtered&, float*, std::size_t);
+  void (*pointGrad)(const Filtered&, float*, float*, float*, float*, std::size_t, float);
+  void (*combine)(const float*, const float*, const float*, const float*, const float*, float*,
+                  std::size_t, float);
+  void (*sign)(const float*, float*, std::size_t, float);
+};
+
+// Instantiates the bodies for one target; ATTR is empty (baseline) or a target attribute.
+#define SARESGS_KERNEL_SET(NAME, ATTR)                                                         \
+  ATTR void vertical##NAME(const float* const* rows, float* out, std::size_t n,               \
+                           const Taps& g) {                                                   \
+    verticalBody(rows, out, n, g);                                                            \
+  }                                                                                           \
+  ATTR void vertical2##NAME(const float* const* rows, float* out0, float* out1, std::size_t n, \
+                            const Taps& g) {                                                  \
+    vertical2Body(rows, out0, out1, n, g);                                                    \
+  }                                                                                           \
+  ATTR void vertical4##NAME(const float* const* rows, float* out0, float* out1, float* out2,  \
+                            float* out3, std::size_t n, const Taps& g) {                      \
+    vertical4Body(rows, out0, out1, out2, out3, n, g);                                        \
+  }                                                                                           \
+  ATTR void horizontal##NAME(const float* t, float* out, std::size_t n, std::ptrdiff_t s,     \
+                             const Taps& g) {                                                 \
+    horizontalBody(t, out, n, s, g);                                                          \
+  }                                                                                           \
+  ATTR void products##NAME(const float* x, const float* y, float* xs, float* ys, float* d,    \
+                           float* p, float* q, std::size_t n) {                               \
+    productsBody(x, y, xs, ys, d, p, q, n);                                                   \
+  }                                                                                           \
+  ATTR void point##NAME(const Filtered& f, float* om, std::size_t n) { pointBody(f, om, n); } \
+  ATTR void pointGrad##NAME(const Filtered& f, float* om, float* a, float* b, float* c,       \
+                            std::size_t n, float scale) {                                     \
+    pointGradBody(f, om, a, b, c, n, scale);                                                  \
+  }                                                                                           \
+  ATTR void combine##NAME(const float* x, const float* y, const float* ga, const float* gb,   \
+                          const float* gc, float* grad, std::size_t n, float l1_scale) {      \
+    combineBody(x, y, ga, gb, gc, grad, n, l1_scale);                                         \
+  }                                                                                           \
+  ATTR void sign##NAME(const float* d, float* grad, std::size_t n, float l1_scale) {          \
+    signBody(d, grad, n, l1_scale);                                                           \
+  }                                                                                           \
+  constexpr Kernels kKernels##NAME = {vertical##NAME,   vertical2##NAME, vertical4##NAME,     \
+                                      horizontal##NAME, products##NAME,  point##NAME,         \
+                                      pointGrad##NAME,  combine##NAME,   sign##NAME};
+
+SARESGS_KERNEL_SET(Base, )
+#if SARESGS_SSIM_AVX2
+SARESGS_KERNEL_SET(Avx2, __attribute__((target("avx2"))))
+#endif
+
+std::atomic<bool> g_allow_avx2{true};
+
+const Kernels& kernels() {
+#if SARESGS_SSIM_AVX2
+  static const bool has_avx2 = __builtin_cpu_supports("avx2");
+  if (has_avx2 && g_allow_avx2.load(std::memory_order_relaxed)) return kKernelsAvx2;
+#endif
+  return kKernelsBase;
 }
 
 typedef float v4f __attribute__((vector_size(16)));
@@ -257,9 +424,11 @@ struct Job {
   float l1_scale;
   float ssim_scale;
   bool ssim_grad;      // grad && ssim_scale != 0
-  float* da;           // scaled partial maps (W * h each) when ssim_grad, see ssimPointGrad
+  float* da;           // scaled partial maps (h rows of dstride) when ssim_grad, see pointGradBody
+  std::size_t dstride;
   float* db;
   float* dc;
+  const Kernels* k;    // the kernel set for this CPU
   const float* zeros;  // W zeros
   const float* wx;     // horizontal window weight per value of a row
   const float* wy;     // vertical window weight per row
@@ -275,91 +444,133 @@ std::vector<float>& scratch(std::size_t n) {
   return buf;
 }
 
+// Rows are processed in groups of four (two or one at the end of a block): the vertical
+// filter then reads each input row once for several outputs. Every output value is the
+// same expression either way, so a row's values do not depend on its group or block.
+constexpr int kGroup = 4;
+constexpr int kRing = kTaps + kGroup - 1;  // input rows one group reads
+
+struct RowGroup {
+  int r;      // first output row
+  int count;  // 1, 2 or kGroup rows
+};
+
+RowGroup groupAt(int r, int r1) {
+  const int left = r1 - r;
+  return {r, left >= kGroup ? kGroup : (left >= 2 ? 2 : 1)};
+}
+
+// Row stride for scratch rows of W floats: whole cache lines, and never a multiple of
+// 4 KiB, so that the rows one vertical pass reads do not alias in the L1 cache.
+std::size_t rowStride(std::size_t W) {
+  std::size_t s = (W + 15) / 16 * 16;
+  if (s % 1024 == 0) s += 16;
+  return s;
+}
+
+// Filters one map for the output rows of group `p`: vertical pass into the zero-padded
+// rows v[t], then the horizontal pass into out[t]. rowOf(j) gives input row j of the map
+// for 0 <= j < h.
+template <typename RowOf>
+void filterMap(const Job& J, RowOf&& rowOf, RowGroup p, float* const* v, float* const* out) {
+  const auto& g = window();
+  const float* rows[kRing];
+  for (int k = 0; k < kTaps + p.count - 1; ++k) {
+    const int j = p.r - kRadius + k;
+    rows[k] = (j >= 0 && j < J.h) ? rowOf(j) : J.zeros;
+  }
+  const std::size_t P = J.pad, W = J.W;
+  if (p.count == 4)
+    J.k->vertical4(rows, v[0] + P, v[1] + P, v[2] + P, v[3] + P, W, g);
+  else if (p.count == 2)
+    J.k->vertical2(rows, v[0] + P, v[1] + P, W, g);
+  else
+    J.k->vertical(rows, v[0] + P, W, g);
+  for (int t = 0; t < p.count; ++t) J.k->horizontal(v[t] + P, out[t], W, J.channels, g);
+}
+
+// kGroup zero-padded rows for the vertical pass's output, from `at`; returns the end.
+float* paddedRows(const Job& J, float* at, float** v) {
+  const std::size_t PW = rowStride(J.W + 2 * J.pad);
+  for (int t = 0; t < kGroup; ++t) {
+    v[t] = at + t * PW;
+    std::fill(v[t], v[t] + J.pad, 0.0f);
+    std::fill(v[t] + J.pad + J.W, v[t] + PW, 0.0f);
+  }
+  return at + kGroup * PW;
+}
+
 // Forward over rows [r0, r1): SSIM map and L1 per row, and the scaled SSIM partials.
-// The five filter inputs are computed once per input row into a ring of kTaps rows.
+// The five filter inputs are computed once per input row into a ring of kRing rows.
 void forwardBlock(const Job& J, int r0, int r1) {
   constexpr int kMaps = 5;
-  const auto& g = window();
-  const std::size_t W = J.W, P = J.pad, PW = W + 2 * P;
-  const std::size_t ring = kTaps * W;
-  std::vector<float>& buf = scratch(kMaps * ring + PW + (kMaps + 1) * W);
-  float* prod = buf.data();  // kMaps rings; input row j in slot j % kTaps
-  float* vrow = prod + kMaps * ring;
-  std::fill(vrow, vrow + P, 0.0f);
-  std::fill(vrow + P + W, vrow + PW, 0.0f);
-  float* hrow = vrow + PW;  // kMaps filtered rows of W
-  float* om = hrow + kMaps * W;
+  const std::size_t W = J.W, S = rowStride(W), ring = kRing * S;
+  std::vector<float>& buf =
+      scratch(kMaps * ring + kGroup * rowStride(W + 2 * J.pad) + (kGroup * kMaps + 1) * S);
+  float* prod = buf.data();  // kMaps rings; input row j in slot j % kRing
+  float* v[kGroup];
+  float* hrow = paddedRows(J, prod + kMaps * ring, v);  // kGroup x kMaps filtered rows
+  float* om = hrow + kGroup * kMaps * S;
   auto slot = [&](int m, int j) {
-    return prod + m * ring + static_cast<std::size_t>(j % kTaps) * W;
+    return prod + m * ring + static_cast<std::size_t>(j % kRing) * S;
   };
   auto fillRow = [&](int j) {
+    if (j >= J.h) return;
     const std::size_t off = static_cast<std::size_t>(j) * W;
-    productsRow(J.x + off, J.y + off, slot(0, j), slot(1, j), slot(2, j), slot(3, j),
-                slot(4, j), W);
+    J.k->products(J.x + off, J.y + off, slot(0, j), slot(1, j), slot(2, j), slot(3, j),
+                  slot(4, j), W);
   };
 
-  for (int j = std::max(0, r0 - kRadius); j < std::min(J.h, r0 + kRadius); ++j) fillRow(j);
-  const float* rows[kTaps];
-  for (int r = r0; r < r1; ++r) {
-    if (r + kRadius < J.h) fillRow(r + kRadius);
+  for (int j = std::max(0, r0 - kRadius); j < r0 + kRadius; ++j) fillRow(j);
+  for (int r = r0; r < r1;) {
+    const RowGroup p = groupAt(r, r1);
+    for (int t = 0; t < p.count; ++t) fillRow(r + kRadius + t);
     for (int m = 0; m < kMaps; ++m) {
-      for (int k = -kRadius; k <= kRadius; ++k)
-        rows[k + kRadius] = (r + k >= 0 && r + k < J.h) ? slot(m, r + k) : J.zeros;
-      verticalPass(rows, vrow + P, W, g);
-      horizontalPass(vrow + P, hrow + m * W, W, J.channels, g);
+      float* out[kGroup];
+      for (int t = 0; t < kGroup; ++t) out[t] = hrow + (t * kMaps + m) * S;
+      filterMap(J, [&](int j) { return slot(m, j); }, p, v, out);
     }
-
-    const std::size_t off = static_cast<std::size_t>(r) * W;
-    const Filtered f{hrow, hrow + W, hrow + 2 * W, hrow + 3 * W, hrow + 4 * W, J.wx, J.wy[r]};
-    if (J.ssim_grad)
-      ssimPointGrad(f, om, J.da + off, J.db + off, J.dc + off, W, J.ssim_scale);
-    else
-      ssimPoint(f, om, W);
-    J.row_om[r] = sumChunked<false>(om, W);
-    const float* d = slot(2, r);  // this row's x - y, still in the ring
-    J.row_l1[r] = sumChunked<true>(d, W);
-    if (J.grad && !J.ssim_grad) {
-      float* __restrict gr = J.grad + off;
-      const float s = J.l1_scale;
-      for (std::size_t i = 0; i < W; ++i) gr[i] = d[i] > 0 ? s : (d[i] < 0 ? -s : 0.0f);
+    for (int t = 0; t < p.count; ++t) {
+      const int row = r + t;
+      const std::size_t off = static_cast<std::size_t>(row) * W;
+      const float* h = hrow + t * kMaps * S;
+      const Filtered f{h, h + S, h + 2 * S, h + 3 * S, h + 4 * S, J.wx, J.wy[row]};
+      if (J.ssim_grad)
+        J.k->pointGrad(f, om, J.da + row * J.dstride, J.db + row * J.dstride,
+                       J.dc + row * J.dstride, W, J.ssim_scale);
+      else
+        J.k->point(f, om, W);
+      J.row_om[row] = sumChunked<false>(om, W);
+      const float* d = slot(2, row);  // this row's x - y, still in the ring
+      J.row_l1[row] = sumChunked<true>(d, W);
+      if (J.grad && !J.ssim_grad) J.k->sign(d, J.grad + off, W, J.l1_scale);
     }
+    r += p.count;
   }
 }
 
 // Backward over rows [r0, r1): filters the partial maps (G^T = G) and applies the chain
 // rule grad = l1 + G*a + y' G*c + 2 (x - y) G*b.
 void backwardBlock(const Job& J, int r0, int r1) {
-  const auto& g = window();
-  const std::size_t W = J.W, P = J.pad, PW = W + 2 * P;
-  std::vector<float>& buf = scratch(PW + 3 * W);
-  float* vrow = buf.data();
-  std::fill(vrow, vrow + P, 0.0f);
-  std::fill(vrow + P + W, vrow + PW, 0.0f);
-  float* hrow = vrow + PW;
+  const std::size_t W = J.W, S = rowStride(W);
+  std::vector<float>& buf = scratch(kGroup * rowStride(W + 2 * J.pad) + kGroup * 3 * S);
+  float* v[kGroup];
+  float* hrow = paddedRows(J, buf.data(), v);  // kGroup x 3 filtered rows
   const float* maps[3] = {J.da, J.db, J.dc};
-  const float* rows[kTaps];
-  for (int r = r0; r < r1; ++r) {
+  for (int r = r0; r < r1;) {
+    const RowGroup p = groupAt(r, r1);
     for (int m = 0; m < 3; ++m) {
-      for (int k = -kRadius; k <= kRadius; ++k)
-        rows[k + kRadius] = (r + k >= 0 && r + k < J.h)
-                                ? maps[m] + static_cast<std::size_t>(r + k) * W
-                                : J.zeros;
-      verticalPass(rows, vrow + P, W, g);
-      horizontalPass(vrow + P, hrow + m * W, W, J.channels, g);
+      float* out[kGroup];
+      for (int t = 0; t < kGroup; ++t) out[t] = hrow + (t * 3 + m) * S;
+      filterMap(J, [&](int j) { return maps[m] + static_cast<std::size_t>(j) * J.dstride; }, p,
+                v, out);
     }
-    const std::size_t off = static_cast<std::size_t>(r) * W;
-    const float* __restrict xr = J.x + off;
-    const float* __restrict yr = J.y + off;
-    const float* __restrict ga = hrow;
-    const float* __restrict gb = hrow + W;
-    const float* __restrict gc = hrow + 2 * W;
-    float* __restrict gr = J.grad + off;
-    const float s = J.l1_scale;
-    for (std::size_t i = 0; i < W; ++i) {
-      const float d = xr[i] - yr[i];
-      const float l1 = d > 0 ? s : (d < 0 ? -s : 0.0f);
-      gr[i] = l1 + (ga[i] + ((yr[i] - kShift) * gc[i] + 2.0f * d * gb[i]));
+    for (int t = 0; t < p.count; ++t) {
+      const std::size_t off = static_cast<std::size_t>(r + t) * W;
+      const float* h = hrow + t * 3 * S;
+      J.k->combine(J.x + off, J.y + off, h, h + S, h + 2 * S, J.grad + off, W, J.l1_scale);
     }
+    r += p.count;
   }
 }
 
@@ -377,6 +588,16 @@ void forRowBlocks(int h, F&& f) {
 
 }  // namespace
 
+bool ssimAvx2Available() {
+#if SARESGS_SSIM_AVX2
+  return __builtin_cpu_supports("avx2");
+#else
+  return false;
+#endif
+}
+
+void ssimAllowAvx2(bool allow) { g_allow_avx2.store(allow, std::memory_order_relaxed); }
+
 SsimL1Sums ssimL1(const float* x, const float* y, int w, int h, int channels, float* grad,
                   double l1_scale, double ssim_scale) {
   Job J{};
@@ -390,6 +611,7 @@ SsimL1Sums ssimL1(const float* x, const float* y, int w, int h, int channels, fl
   J.l1_scale = static_cast<float>(l1_scale);
   J.ssim_scale = static_cast<float>(ssim_scale);
   J.ssim_grad = grad != nullptr && ssim_scale != 0.0;
+  J.k = &kernels();
   const std::vector<float> zeros(J.W, 0.0f);
   J.zeros = zeros.data();
   std::vector<float> wx(J.W), wy(h);
@@ -404,7 +626,8 @@ SsimL1Sums ssimL1(const float* x, const float* y, int w, int h, int channels, fl
   J.row_l1 = row_l1.data();
   std::unique_ptr<float[]> partials;
   if (J.ssim_grad) {
-    const std::size_t n = J.W * h;
+    J.dstride = rowStride(J.W);
+    const std::size_t n = J.dstride * h;
     partials.reset(new float[3 * n]);
     J.da = partials.get();
     J.db = J.da + n;

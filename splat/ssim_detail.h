@@ -26,4 +26,9 @@ struct SsimL1Sums {
 SsimL1Sums ssimL1(const float* x, const float* y, int w, int h, int channels, float* grad,
                   double l1_scale, double ssim_scale);
 
+// The loops run as AVX2 code (8 floats per instruction, no FMA) where the CPU has it,
+// otherwise as baseline SSE2; both give bit-identical results. For tests and timing:
+bool ssimAvx2Available();
+void ssimAllowAvx2(bool allow);  // false: baseline loops even where AVX2 is available
+
 }  // namespace saresgs::detail
