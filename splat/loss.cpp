@@ -47,11 +47,18 @@
 // Layout: images are interleaved, so a row is one contiguous run of W = w * channels
 // floats; the horizontal filter is an 11-tap filter with stride `channels` over that run,
 // the vertical one combines 11 whole rows. Both are plain float loops that GCC vectorises
-// (SSE2 is enough). The 2-D window is the outer product of the 1-D window normalised in
-// double (as before), rounded to float. Work is split into fixed blocks of kBlockRows
-// rows; each row is computed by the same operations whichever block or thread handles it,
-// and per-row sums (float runs of 4, then double) are added in row order, so results are
-// bit-identical for any thread count.
+// (SSE2 is enough; AVX2 is used at run time where present, with identical results). The
+// 2-D window is the outer product of the 1-D window normalised in double (as before),
+// rounded to float. Work is split into fixed blocks of kBlockRows rows; each row is
+// computed by the same operations whichever block or thread handles it, and per-row sums
+// (float runs of 4, then double) are added in row order, so results are bit-identical
+// for any thread count.
+//
+// Per block, forward: the five filter inputs (x', y', x - y, x'y', (x - y)^2) of each
+// input row go into a ring; groups of four output rows are filtered vertically from it,
+// then horizontally; the SSIM terms give 1 - S and, with the gradient, the three scaled
+// partials, written to full-size maps. Backward (after all blocks): the partial maps are
+// filtered the same way and combined per value.
 
 // Runtime AVX2 dispatch needs GCC-style target attributes and __builtin_cpu_supports.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__AVX2__)
@@ -130,35 +137,9 @@ SARESGS_KERNEL void verticalBody(const float* const* rows, float* __restrict out
              g2 * (u2[i] + d2[i]) + g1 * (u1[i] + d1[i]) + g0 * c0[i];
 }
 
-// verticalBody for two consecutive output rows at once (rows[0..11] = input rows r-5 ..
-// r+6): each output is the same expression as there, so the same bits, but the shared
-// input rows are loaded once.
-SARESGS_KERNEL void vertical2Body(const float* const* rows, float* __restrict out0,
-                                  float* __restrict out1, std::size_t n, const Taps& g) {
-  const float* __restrict r0 = rows[0];
-  const float* __restrict r1 = rows[1];
-  const float* __restrict r2 = rows[2];
-  const float* __restrict r3 = rows[3];
-  const float* __restrict r4 = rows[4];
-  const float* __restrict r5 = rows[5];
-  const float* __restrict r6 = rows[6];
-  const float* __restrict r7 = rows[7];
-  const float* __restrict r8 = rows[8];
-  const float* __restrict r9 = rows[9];
-  const float* __restrict r10 = rows[10];
-  const float* __restrict r11 = rows[11];
-  const float g0 = g[0], g1 = g[1], g2 = g[2], g3 = g[3], g4 = g[4], g5 = g[5];
-  for (std::size_t i = 0; i < n; ++i) {
-    const float a0 = r0[i], a1 = r1[i], a2 = r2[i], a3 = r3[i], a4 = r4[i], a5 = r5[i];
-    const float a6 = r6[i], a7 = r7[i], a8 = r8[i], a9 = r9[i], a10 = r10[i], a11 = r11[i];
-    out0[i] = g5 * (a0 + a10) + g4 * (a1 + a9) + g3 * (a2 + a8) + g2 * (a3 + a7) +
-              g1 * (a4 + a6) + g0 * a5;
-    out1[i] = g5 * (a1 + a11) + g4 * (a2 + a10) + g3 * (a3 + a9) + g2 * (a4 + a8) +
-              g1 * (a5 + a7) + g0 * a6;
-  }
-}
-
-// verticalBody for four consecutive output rows (rows[0..13] = input rows r-5 .. r+8).
+// verticalBody for four consecutive output rows (rows[0..13] = input rows r-5 .. r+8):
+// each output is the same expression as there, so the same bits, but every input row is
+// loaded once for four outputs instead of four times.
 SARESGS_KERNEL void vertical4Body(const float* const* rows, float* __restrict out0,
                                   float* __restrict out1, float* __restrict out2,
                                   float* __restrict out3, std::size_t n, const Taps& g) {
@@ -314,7 +295,6 @@ SARESGS_KERNEL void signBody(const float* __restrict d, float* __restrict grad, 
 
 struct Kernels {
   void (*vertical)(const float* const*, float*, std::size_t, const Taps&);
-  void (*vertical2)(const float* const*, float*, float*, std::size_t, const Taps&);
   void (*vertical4)(const float* const*, float*, float*, float*, float*, std::size_t,
                     const Taps&);
   void (*horizontal)(const float*, float*, std::size_t, std::ptrdiff_t, const Taps&);
@@ -332,10 +312,6 @@ struct Kernels {
   ATTR void vertical##NAME(const float* const* rows, float* out, std::size_t n,               \
                            const Taps& g) {                                                   \
     verticalBody(rows, out, n, g);                                                            \
-  }                                                                                           \
-  ATTR void vertical2##NAME(const float* const* rows, float* out0, float* out1, std::size_t n, \
-                            const Taps& g) {                                                  \
-    vertical2Body(rows, out0, out1, n, g);                                                    \
   }                                                                                           \
   ATTR void vertical4##NAME(const float* const* rows, float* out0, float* out1, float* out2,  \
                             float* out3, std::size_t n, const Taps& g) {                      \
@@ -361,9 +337,9 @@ struct Kernels {
   ATTR void sign##NAME(const float* d, float* grad, std::size_t n, float l1_scale) {          \
     signBody(d, grad, n, l1_scale);                                                           \
   }                                                                                           \
-  constexpr Kernels kKernels##NAME = {vertical##NAME,   vertical2##NAME, vertical4##NAME,     \
-                                      horizontal##NAME, products##NAME,  point##NAME,         \
-                                      pointGrad##NAME,  combine##NAME,   sign##NAME};
+  constexpr Kernels kKernels##NAME = {vertical##NAME,  vertical4##NAME, horizontal##NAME,     \
+                                      products##NAME,  point##NAME,     pointGrad##NAME,      \
+                                      combine##NAME,   sign##NAME};
 
 SARESGS_KERNEL_SET(Base, )
 #if SARESGS_SSIM_AVX2
@@ -374,7 +350,10 @@ std::atomic<bool> g_allow_avx2{true};
 
 const Kernels& kernels() {
 #if SARESGS_SSIM_AVX2
-  static const bool has_avx2 = __builtin_cpu_supports("avx2");
+  static const bool has_avx2 = [] {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2") != 0;
+  }();
   if (has_avx2 && g_allow_avx2.load(std::memory_order_relaxed)) return kKernelsAvx2;
 #endif
   return kKernelsBase;
@@ -424,10 +403,10 @@ struct Job {
   float l1_scale;
   float ssim_scale;
   bool ssim_grad;      // grad && ssim_scale != 0
-  float* da;           // scaled partial maps (h rows of dstride) when ssim_grad, see pointGradBody
-  std::size_t dstride;
-  float* db;
+  float* da;           // scaled partial maps (h rows of dstride floats) when ssim_grad,
+  float* db;           // see pointGradBody
   float* dc;
+  std::size_t dstride;
   const Kernels* k;    // the kernel set for this CPU
   const float* zeros;  // W zeros
   const float* wx;     // horizontal window weight per value of a row
@@ -444,21 +423,18 @@ std::vector<float>& scratch(std::size_t n) {
   return buf;
 }
 
-// Rows are processed in groups of four (two or one at the end of a block): the vertical
-// filter then reads each input row once for several outputs. Every output value is the
+// Rows are processed in groups of four (single rows at the end of a block): the vertical
+// filter then reads each input row once for four outputs. Every output value is the
 // same expression either way, so a row's values do not depend on its group or block.
 constexpr int kGroup = 4;
 constexpr int kRing = kTaps + kGroup - 1;  // input rows one group reads
 
 struct RowGroup {
   int r;      // first output row
-  int count;  // 1, 2 or kGroup rows
+  int count;  // 1 or kGroup rows
 };
 
-RowGroup groupAt(int r, int r1) {
-  const int left = r1 - r;
-  return {r, left >= kGroup ? kGroup : (left >= 2 ? 2 : 1)};
-}
+RowGroup groupAt(int r, int r1) { return {r, r1 - r >= kGroup ? kGroup : 1}; }
 
 // Row stride for scratch rows of W floats: whole cache lines, and never a multiple of
 // 4 KiB, so that the rows one vertical pass reads do not alias in the L1 cache.
@@ -480,10 +456,8 @@ void filterMap(const Job& J, RowOf&& rowOf, RowGroup p, float* const* v, float* 
     rows[k] = (j >= 0 && j < J.h) ? rowOf(j) : J.zeros;
   }
   const std::size_t P = J.pad, W = J.W;
-  if (p.count == 4)
+  if (p.count == kGroup)
     J.k->vertical4(rows, v[0] + P, v[1] + P, v[2] + P, v[3] + P, W, g);
-  else if (p.count == 2)
-    J.k->vertical2(rows, v[0] + P, v[1] + P, W, g);
   else
     J.k->vertical(rows, v[0] + P, W, g);
   for (int t = 0; t < p.count; ++t) J.k->horizontal(v[t] + P, out[t], W, J.channels, g);
@@ -590,7 +564,8 @@ void forRowBlocks(int h, F&& f) {
 
 bool ssimAvx2Available() {
 #if SARESGS_SSIM_AVX2
-  return __builtin_cpu_supports("avx2");
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2") != 0;
 #else
   return false;
 #endif

@@ -144,7 +144,8 @@ double maxAbs(const std::vector<double>& v) {
 }
 
 // The fast loss against the double reference: loss within `value_rel` relative, the SSIM
-// mean within 1e-7 absolute, and every gradient value within `grad_rel` of the largest.
+// mean within 5e-7 absolute (observed <= 5e-8; ~1e-7 where FMA contraction is on, as with
+// SARESGS_NATIVE), and every gradient value within `grad_rel` of the largest.
 void expectMatchesReference(const ImageF& render, const ImageF& target, double lambda,
                             double value_rel, double grad_rel, const char* what) {
   SCOPED_TRACE(what);
@@ -152,7 +153,7 @@ void expectMatchesReference(const ImageF& render, const ImageF& target, double l
   const LossResult r = photometricLoss(render, target, lambda, true);
   EXPECT_NEAR(r.loss, ref.loss, value_rel * std::abs(ref.loss)) << "lambda " << lambda;
   EXPECT_NEAR(r.l1, ref.l1, 1e-7 * ref.l1);
-  EXPECT_NEAR(r.ssim, ref.ssim, 1e-7);
+  EXPECT_NEAR(r.ssim, ref.ssim, 5e-7);
   ASSERT_EQ(r.grad.data.size(), ref.grad.size());
   const double gmax = maxAbs(ref.grad);
   ASSERT_GT(gmax, 0.0);
@@ -273,7 +274,7 @@ TEST(PhotometricLoss, GradientIsNotClampedOutsideTheUnitRange) {
 }
 
 TEST(PhotometricLoss, MatchesTheDoubleReference) {
-  // Value to 1e-6 relative (observed: <= 4e-7), SSIM mean to 1e-7 (observed: <= 5e-8).
+  // Value to 1e-6 relative (observed: <= 4e-7), SSIM mean to 5e-7 (observed: <= 5e-8).
   // Gradient to float tolerance: observed worst |error| / max|gradient| is ~2e-7 on random
   // images and up to ~1.3e-5 on smooth and flat ones, where the covariance and variance
   // maps carry float error of ~1e-8..1e-7 against C2 = 9e-4.
