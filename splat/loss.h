@@ -6,7 +6,11 @@
 // reference implementation) and is the mean of the SSIM map over pixels and channels.
 // Unlike the evaluation metric (metrics.h) nothing is clamped, so the loss is
 // differentiable everywhere except where L1 has its kink (render == target, where the
-// L1 gradient is taken as 0). Computation is in double; results are deterministic.
+// L1 gradient is taken as 0). Computation is in float (separable filtering, TBB over fixed
+// row blocks, sums reduced in double in a fixed order, AVX2 where the CPU has it): the
+// loss agrees with a double evaluation to better than 1e-6 relative (typically 1e-8), the
+// gradient to ~1e-5 of its largest value, and results are bit-identical from call to
+// call, for any thread count, and with or without AVX2.
 #include "geometry/image/image.h"
 
 namespace saresgs {
