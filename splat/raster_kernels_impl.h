@@ -202,8 +202,7 @@ void backwardTileImpl(const TileGaussian<float>* q, int x0, int y0, int x1, int 
                       const BackwardIn& in, const std::uint32_t* entry_slot, float* slots) {
   constexpr int P = kTile * kTile;
   const int w = x1 - x0, h = y1 - y0;
-  alignas(64) float Tr[P], finalT[P], walked[P], acc0[P], acc1[P], acc2[P], la[P], lc0[P], lc1[P], lc2[P],
-      w0[P], w1[P], w2[P], bgdot[P];
+  alignas(64) float Tr[P], finalT[P], walked[P], acc0[P], acc1[P], acc2[P], w0[P], w1[P], w2[P], bgdot[P];
   std::uint32_t jmax = 0;
   for (int k = 0; k < P; ++k) {
     const int r = k / kTile, c = k % kTile;
@@ -213,7 +212,7 @@ void backwardTileImpl(const TileGaussian<float>* q, int x0, int y0, int x1, int 
     const std::uint32_t nw = inside ? in.n_walked[pix] : 0;
     walked[k] = static_cast<float>(nw);
     jmax = nw > jmax ? nw : jmax;
-    acc0[k] = acc1[k] = acc2[k] = la[k] = lc0[k] = lc1[k] = lc2[k] = 0.0f;
+    acc0[k] = acc1[k] = acc2[k] = 0.0f;
     w0[k] = inside ? in.dL_drgb[pix * 3] : 0.0f;
     w1[k] = inside ? in.dL_drgb[pix * 3 + 1] : 0.0f;
     w2[k] = inside ? in.dL_drgb[pix * 3 + 2] : 0.0f;
@@ -226,10 +225,13 @@ void backwardTileImpl(const TileGaussian<float>* q, int x0, int y0, int x1, int 
     tileSpan(g.mx, g.hx, x0, x1, c0, c1);
     tileSpan(g.my, g.hy, y0, y1, r0, r1);
     const vf mx = vs(g.mx), hx = vs(g.hx), o = vs(g.o), jv = vs(static_cast<float>(jj));
-    const vf ha = vs(-0.5f) * vs(g.a), ga = vs(g.a), gb = vs(g.b), gc = vs(g.c);
+    const vf ha = vs(-0.5f) * vs(g.a);
     const vf col0 = vs(g.col[0]), col1 = vs(g.col[1]), col2 = vs(g.col[2]);
     const vf zero = vs(0.0f), one = vs(1.0f);
-    vf s_op = zero, s_mx = zero, s_my = zero, s_ca = zero, s_cb = zero, s_cc = zero, s_c0 = zero, s_c1 = zero,
+    // Sums over the Gaussian's pixels of e = G dL/dalpha (where alpha = o G is not
+    // clamped) times 1, dx, dy, dx^2, dx dy, dy^2, and of alpha T w_c; the 2D
+    // gradients are linear in them (see below).
+    vf s_e = zero, s_x = zero, s_y = zero, s_xx = zero, s_xy = zero, s_yy = zero, s_c0 = zero, s_c1 = zero,
        s_c2 = zero;
     if (c0 <= c1)
       for (int r = r0; r <= r1; ++r) {
@@ -239,51 +241,48 @@ void backwardTileImpl(const TileGaussian<float>* q, int x0, int y0, int x1, int 
         for (int cb = c0 & ~(L - 1); cb <= c1; cb += L) {
           const int k = r * kTile + cb;
           const Lanes Ln = evalLanes((vs(static_cast<float>(x0 + cb)) + lane) - mx, ha, qy, by, o, hx);
-          const vf dx = Ln.dx, G = Ln.G, oG = Ln.oG, alpha = Ln.alpha;
+          const vf dx = Ln.dx, alpha = Ln.alpha;
           const vi valid = (jv < load(walked + k)) & Ln.touches;
           const vf a_eff = valid ? alpha : zero;
           const vf t = load(Tr + k) / (one - a_eff);  // transmittance in front of jj
-          const vf lav = load(la + k);
-          const vf lc0v = load(lc0 + k), lc1v = load(lc1 + k), lc2v = load(lc2 + k);
-          vf a0 = load(acc0 + k), a1 = load(acc1 + k), a2 = load(acc2 + k);
-          a0 = valid ? lav * lc0v + (one - lav) * a0 : a0;
-          a1 = valid ? lav * lc1v + (one - lav) * a1 : a1;
-          a2 = valid ? lav * lc2v + (one - lav) * a2 : a2;
+          store(Tr + k, t);
+          // acc: the colour composited behind jj (normalised), updated once jj is used.
+          const vf a0 = load(acc0 + k), a1 = load(acc1 + k), a2 = load(acc2 + k);
+          const vf d0 = col0 - a0, d1 = col1 - a1, d2 = col2 - a2;
           const vf ww0 = load(w0 + k), ww1 = load(w1 + k), ww2 = load(w2 + k);
-          vf dLda = (col0 - a0) * ww0;
-          dLda += (col1 - a1) * ww1;
-          dLda += (col2 - a2) * ww2;
+          vf dLda = d0 * ww0;
+          dLda += d1 * ww1;
+          dLda += d2 * ww2;
           if constexpr (kBg) dLda = dLda * t - load(finalT + k) / (one - alpha) * load(bgdot + k);
           else dLda = dLda * t;
-          store(acc0 + k, a0);
-          store(acc1 + k, a1);
-          store(acc2 + k, a2);
-          store(la + k, valid ? alpha : lav);
-          store(lc0 + k, valid ? col0 : lc0v);
-          store(lc1 + k, valid ? col1 : lc1v);
-          store(lc2 + k, valid ? col2 : lc2v);
-          store(Tr + k, t);
-          const vi gm = valid & (oG < vs(kMaxA));
-          const vf dG = o * dLda * G;
-          s_op += gm ? G * dLda : zero;
-          s_mx += gm ? dG * (ga * dx + gb * dy) : zero;
-          s_my += gm ? dG * (gb * dx + gc * dy) : zero;
-          s_ca += gm ? dG * vs(-0.5f) * dx * dx : zero;
-          s_cb += gm ? dG * (-dx * dy) : zero;
-          s_cc += gm ? dG * vs(-0.5f) * dy * dy : zero;
-          const vf wcol = alpha * t;
-          s_c0 += valid ? wcol * ww0 : zero;
-          s_c1 += valid ? wcol * ww1 : zero;
-          s_c2 += valid ? wcol * ww2 : zero;
+          store(acc0 + k, a0 + a_eff * d0);
+          store(acc1 + k, a1 + a_eff * d1);
+          store(acc2 + k, a2 + a_eff * d2);
+          const vi gm = valid & (Ln.oG < vs(kMaxA));
+          const vf e = gm ? Ln.G * dLda : zero;
+          s_e += e;
+          const vf ex = e * dx, ey = e * dy;
+          s_x += ex;
+          s_y += ey;
+          s_xx += ex * dx;
+          s_xy += ex * dy;
+          s_yy += ey * dy;
+          const vf wcol = a_eff * t;  // 0 where not valid
+          s_c0 += wcol * ww0;
+          s_c1 += wcol * ww1;
+          s_c2 += wcol * ww2;
         }
       }
+    // dL/dpower = o e; power = -(a dx^2 + 2 b dx dy + c dy^2) / 2 with dx = px - mean.
+    const float e = hsum(s_e), ex = hsum(s_x), ey = hsum(s_y), exx = hsum(s_xx), exy = hsum(s_xy),
+                eyy = hsum(s_yy);
     float* sl = &slots[static_cast<std::size_t>(entry_slot[jj]) * kSlot];
-    sl[0] = hsum(s_op);
-    sl[1] = hsum(s_mx);
-    sl[2] = hsum(s_my);
-    sl[3] = hsum(s_ca);
-    sl[4] = hsum(s_cb);
-    sl[5] = hsum(s_cc);
+    sl[0] = e;
+    sl[1] = g.o * (g.a * ex + g.b * ey);
+    sl[2] = g.o * (g.b * ex + g.c * ey);
+    sl[3] = -0.5f * g.o * exx;
+    sl[4] = -g.o * exy;
+    sl[5] = -0.5f * g.o * eyy;
     sl[6] = hsum(s_c0);
     sl[7] = hsum(s_c1);
     sl[8] = hsum(s_c2);
