@@ -7,6 +7,7 @@
 #if defined(SARESGS_RASTER_AVX2)
 #define SARESGS_KERNEL_NS avx2
 #define SARESGS_KERNEL_LANES 8
+#define SARESGS_KERNEL_FMA 1
 #include "splat/raster_kernels_impl.h"
 
 namespace saresgs::raster_kernels::avx2 {

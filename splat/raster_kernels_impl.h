@@ -10,6 +10,13 @@
 
 #include "splat/raster_kernels.h"
 
+#if SARESGS_KERNEL_FMA
+#include <immintrin.h>  // intrinsics are always-inline, no symbols of their own
+#endif
+
+#ifndef SARESGS_KERNEL_FMA
+#define SARESGS_KERNEL_FMA 0
+#endif
 #if !defined(SARESGS_KERNEL_NS) || !defined(SARESGS_KERNEL_LANES)
 #error "define SARESGS_KERNEL_NS and SARESGS_KERNEL_LANES before including raster_kernels_impl.h"
 #endif
@@ -28,6 +35,16 @@ constexpr int kSlot = 9;
 
 typedef float vf __attribute__((vector_size(4 * L)));
 typedef std::int32_t vi __attribute__((vector_size(4 * L)));
+
+// a b + c: one fused rounding where the kernels are built for FMA, else two.
+inline vf fma(vf a, vf b, vf c) {
+#if SARESGS_KERNEL_FMA
+  return reinterpret_cast<vf>(_mm256_fmadd_ps(reinterpret_cast<__m256>(a), reinterpret_cast<__m256>(b),
+                                              reinterpret_cast<__m256>(c)));
+#else
+  return a * b + c;
+#endif
+}
 
 inline vf vs(float x) {
   vf v;
@@ -67,14 +84,18 @@ inline vf expNonPositive(vf x) {
   const vf t = xc * vs(1.4426950408889634f);
   const vi ni = __builtin_convertvector(t - vs(0.5f), vi);  // t <= 0: rounds to nearest
   const vf n = __builtin_convertvector(ni, vf);
+#if SARESGS_KERNEL_FMA
+  const vf r = fma(n, vs(-1.428606765330187e-06f), fma(n, vs(-0.693145751953125f), xc));
+#else
   const vf r = (xc - n * vs(0.693145751953125f)) - n * vs(1.428606765330187e-06f);
+#endif
   vf p = vs(1.0f / 720.0f);
-  p = p * r + vs(1.0f / 120.0f);
-  p = p * r + vs(1.0f / 24.0f);
-  p = p * r + vs(1.0f / 6.0f);
-  p = p * r + vs(0.5f);
-  p = p * r + vs(1.0f);
-  p = p * r + vs(1.0f);
+  p = fma(p, r, vs(1.0f / 120.0f));
+  p = fma(p, r, vs(1.0f / 24.0f));
+  p = fma(p, r, vs(1.0f / 6.0f));
+  p = fma(p, r, vs(0.5f));
+  p = fma(p, r, vs(1.0f));
+  p = fma(p, r, vs(1.0f));
   const vf scale = reinterpret_cast<vf>((ni + 127) << 23);
   return x < lo ? vs(0.0f) : p * scale;
 }
@@ -96,7 +117,11 @@ inline Lanes evalLanes(vf dx, vf ha, vf qy, vf by, vf o, vf hx) {
   Lanes l;
   l.dx = dx;
   // ((-0.5 a) dx) dx + row_quad - row_cross dx.
+#if SARESGS_KERNEL_FMA
+  const vf power = fma(-by, dx, fma(ha * dx, dx, qy));
+#else
   const vf power = ha * dx * dx + qy - by * dx;
+#endif
   l.G = expNonPositive(power < vs(0.0f) ? power : vs(0.0f));
   l.oG = o * l.G;
   l.alpha = l.oG < vs(kMaxA) ? l.oG : vs(kMaxA);
@@ -164,10 +189,10 @@ void compositeTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1,
         const vi stop = ok & (next < vs(kMinT));
         const vi take = ok & ~stop;
         const vf wgt = take ? alpha * t : vs(0.0f);
-        store(C0 + k, load(C0 + k) + wgt * col0);
-        store(C1 + k, load(C1 + k) + wgt * col1);
-        store(C2 + k, load(C2 + k) + wgt * col2);
-        store(D + k, load(D + k) + wgt * dep);
+        store(C0 + k, fma(wgt, col0, load(C0 + k)));
+        store(C1 + k, fma(wgt, col1, load(C1 + k)));
+        store(C2 + k, fma(wgt, col2, load(C2 + k)));
+        store(D + k, fma(wgt, dep, load(D + k)));
         store(Tr + k, take ? next : (stop ? -t : t));
         store(walked + k, take ? jf : load(walked + k));
         store(contrib + k, load(contrib + k) + (take ? vs(1.0f) : vs(0.0f)));
@@ -250,27 +275,25 @@ void backwardTileImpl(const TileGaussian<float>* q, int x0, int y0, int x1, int 
           const vf a0 = load(acc0 + k), a1 = load(acc1 + k), a2 = load(acc2 + k);
           const vf d0 = col0 - a0, d1 = col1 - a1, d2 = col2 - a2;
           const vf ww0 = load(w0 + k), ww1 = load(w1 + k), ww2 = load(w2 + k);
-          vf dLda = d0 * ww0;
-          dLda += d1 * ww1;
-          dLda += d2 * ww2;
-          if constexpr (kBg) dLda = dLda * t - load(finalT + k) / (one - alpha) * load(bgdot + k);
-          else dLda = dLda * t;
-          store(acc0 + k, a0 + a_eff * d0);
-          store(acc1 + k, a1 + a_eff * d1);
-          store(acc2 + k, a2 + a_eff * d2);
+          const vf dLdc = fma(d2, ww2, fma(d1, ww1, d0 * ww0));
+          vf dLda = dLdc * t;
+          if constexpr (kBg) dLda = dLda - load(finalT + k) / (one - alpha) * load(bgdot + k);
+          store(acc0 + k, fma(a_eff, d0, a0));
+          store(acc1 + k, fma(a_eff, d1, a1));
+          store(acc2 + k, fma(a_eff, d2, a2));
           const vi gm = valid & (Ln.oG < vs(kMaxA));
           const vf e = gm ? Ln.G * dLda : zero;
           s_e += e;
           const vf ex = e * dx, ey = e * dy;
           s_x += ex;
           s_y += ey;
-          s_xx += ex * dx;
-          s_xy += ex * dy;
-          s_yy += ey * dy;
+          s_xx = fma(ex, dx, s_xx);
+          s_xy = fma(ex, dy, s_xy);
+          s_yy = fma(ey, dy, s_yy);
           const vf wcol = a_eff * t;  // 0 where not valid
-          s_c0 += wcol * ww0;
-          s_c1 += wcol * ww1;
-          s_c2 += wcol * ww2;
+          s_c0 = fma(wcol, ww0, s_c0);
+          s_c1 = fma(wcol, ww1, s_c1);
+          s_c2 = fma(wcol, ww2, s_c2);
         }
       }
     // dL/dpower = o e; power = -(a dx^2 + 2 b dx dy + c dy^2) / 2 with dx = px - mean.
