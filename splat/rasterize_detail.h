@@ -4,6 +4,7 @@
 // logic, and float-vs-double tests its rounding).
 #include <memory>
 #include <span>
+#include <string_view>
 #include <vector>
 
 #include "splat/rasterize.h"
@@ -44,5 +45,13 @@ void rasterizeSquaredGradientsT(const GaussiansT<T>& g, const Camera& cam, const
 // depend on it: every reduction runs in a fixed order.
 void setRasterThreads(int threads);
 int rasterThreads();
+
+// The float SIMD kernels: "baseline" (four lanes, any target) or "avx2" (eight lanes,
+// chosen by default when the CPU has AVX2 and FMA; SARESGS_RASTER_ISA=baseline in the
+// environment opts out). "default" restores the automatic choice. False (and no change)
+// when the name is unknown or the CPU cannot run it. A render's backward pass uses the
+// kernels its forward pass used.
+bool setRasterKernels(std::string_view name);
+const char* rasterKernels();
 
 }  // namespace saresgs

@@ -12,10 +12,21 @@
 #include <cmath>
 #include <cstring>
 #include <mutex>
+#include <cstdlib>
 #include <stdexcept>
+#include <string_view>
+#include <type_traits>
 
 #include "splat/projection.h"
+#include "splat/raster_kernels.h"
 #include "splat/rasterize_detail.h"
+
+// The baseline (four-lane) float kernels; the AVX2 ones are in raster_kernels_avx2.cpp.
+#define SARESGS_KERNEL_NS base4
+#define SARESGS_KERNEL_LANES 4
+#include "splat/raster_kernels_impl.h"
+#undef SARESGS_KERNEL_NS
+#undef SARESGS_KERNEL_LANES
 
 namespace saresgs {
 
@@ -34,6 +45,7 @@ struct RasterStateT {
   std::vector<std::uint32_t> entry_slot;   // per tile entry: its pair slot
   std::vector<T> final_T;                  // per pixel
   std::vector<std::uint32_t> n_walked;     // per pixel: tile entries walked (last contributor + 1)
+  int isa = 0;                             // the float kernels the forward pass used
 };
 
 namespace {
@@ -56,19 +68,51 @@ tbb::task_arena& arena() {
   return *a;
 }
 
+// The float kernels, per instruction set; index 0 is the baseline.
+struct KernelSet {
+  const char* name;
+  raster_kernels::CompositeFn composite;
+  raster_kernels::BackwardFn backward;
+};
+constexpr KernelSet kKernelSets[] = {
+    {"baseline", raster_kernels::base4::compositeTile, raster_kernels::base4::backwardTile},
+    {"avx2", raster_kernels::avx2::compositeTile, raster_kernels::avx2::backwardTile},
+};
+static_assert(raster_kernels::base4::kTile == kTileSize && raster_kernels::base4::kMinA == kMinAlpha &&
+              raster_kernels::base4::kMaxA == kMaxAlpha && raster_kernels::base4::kMinT == kMinTransmittance);
+
+bool cpuHasAvx2() {
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+  return raster_kernels::avx2::compiled() && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+#else
+  return false;
+#endif
+}
+
+// The best kernels this CPU runs, unless SARESGS_RASTER_ISA=baseline asks otherwise.
+int defaultIsa() {
+  const char* env = std::getenv("SARESGS_RASTER_ISA");
+  if (env && std::strcmp(env, "baseline") == 0) return 0;
+  return cpuHasAvx2() ? 1 : 0;
+}
+
+std::atomic<int> g_isa{-1};
+
+int currentIsa() {
+  int isa = g_isa.load();
+  if (isa < 0) {
+    isa = defaultIsa();
+    g_isa.store(isa);
+  }
+  return isa;
+}
+
 // Pixel range [lo, hi] whose centres (i + 0.5) lie within mean +- half, clipped to [0, n).
 template <typename T>
 void pixelRange(T mean, T half, int n, int& lo, int& hi) {
   lo = std::max(0, static_cast<int>(std::ceil(mean - half - T(0.5))));
   hi = std::min(n - 1, static_cast<int>(std::floor(mean + half - T(0.5))));
 }
-
-// One Gaussian's data gathered per tile, in the tile's order.
-template <typename T>
-struct TileGaussian {
-  T mx, my, a, b, c, o, hx, hy, depth;
-  T col[3];
-};
 
 template <typename T>
 void gatherTile(const RasterStateT<T>& st, int tile, std::vector<TileGaussian<T>>& out) {
@@ -228,138 +272,27 @@ void compositeTile(const std::vector<TileGaussian<T>>& q, int x0, int y0, int x1
     }
 }
 
-// The float kernel, four pixels at a time with GCC/Clang vector extensions. Every lane
-// performs exactly the scalar kernel's operations in the same order (no contraction in
-// ISO C++ mode), so results are bit-identical to compositeTile<double>'s logic in
-// float; the tests compare against the reference renderer. A stopped pixel keeps its
-// transmittance with the sign flipped (transmittance is >= 1e-4 while a pixel is
-// live), which needs no separate "active" array.
-typedef float v4f __attribute__((vector_size(16)));
-typedef std::int32_t v4i __attribute__((vector_size(16)));
-
-inline v4f v4(float x) { return v4f{x, x, x, x}; }
-
-inline v4f expNonPositive4(v4f x) {
-  const v4f xc = x < v4(-87.0f) ? v4(-87.0f) : x;
-  const v4f t = xc * v4(1.4426950408889634f);
-  const v4i ni = __builtin_convertvector(t - v4(0.5f), v4i);
-  const v4f n = __builtin_convertvector(ni, v4f);
-  const v4f r = (xc - n * v4(0.693145751953125f)) - n * v4(1.428606765330187e-06f);
-  v4f p = v4(1.0f / 720.0f);
-  p = p * r + v4(1.0f / 120.0f);
-  p = p * r + v4(1.0f / 24.0f);
-  p = p * r + v4(1.0f / 6.0f);
-  p = p * r + v4(0.5f);
-  p = p * r + v4(1.0f);
-  p = p * r + v4(1.0f);
-  const v4f scale = reinterpret_cast<v4f>((ni + 127) << 23);
-  return x < v4(-87.0f) ? v4(0.0f) : p * scale;
-}
-
-// One Gaussian at four pixel centres of a row: the quantities both SIMD kernels need,
-// computed in one place so that the forward and backward passes make identical
-// threshold decisions. `touches` is rule 4's rectangle test in x plus the alpha test
-// (o G >= 1/255 is alpha >= 1/255, as 0.99 > 1/255); the row's y test is the caller's.
-struct Lanes {
-  v4f dx, G, oG, alpha;
-  v4i touches;
-};
-
-inline Lanes evalLanes(v4f dx, v4f ha, v4f qy, v4f by, v4f o, v4f hx) {
-  Lanes l;
-  l.dx = dx;
-  // Same expression tree as powerAt(): ((-0.5 a) dx) dx + row_quad - row_cross dx.
-  const v4f power = ha * dx * dx + qy - by * dx;
-  l.G = expNonPositive4(power < v4(0.0f) ? power : v4(0.0f));
-  l.oG = o * l.G;
-  l.alpha = l.oG < v4(kMaxAlpha) ? l.oG : v4(kMaxAlpha);
-  const v4f adx = reinterpret_cast<v4f>(reinterpret_cast<v4i>(dx) & 0x7fffffff);
-  l.touches = (adx <= hx) & (power <= v4(0.0f)) & (l.oG >= v4(kMinAlpha));
-  return l;
-}
-
-template <>
-void compositeTile<float>(const std::vector<TileGaussian<float>>& q, int x0, int y0, int x1, int y1,
-                          const float bg[3], int W, RenderOutputT<float>& out, RasterStateT<float>& st) {
-  constexpr int P = kTileSize * kTileSize;
-  alignas(64) float Tr[P], C0[P], C1[P], C2[P], D[P], walked[P], contrib[P];
-  const int w = x1 - x0, h = y1 - y0;
-  for (int k = 0; k < P; ++k) {
-    const bool inside = (k % kTileSize) < w && (k / kTileSize) < h;
-    Tr[k] = inside ? 1.0f : -1.0f;  // pixels beyond the image never composite
-    C0[k] = C1[k] = C2[k] = D[k] = walked[k] = contrib[k] = 0.0f;
-  }
-  int n_active = w * h;
-  const v4f lane{0.5f, 1.5f, 2.5f, 3.5f};
-  const std::int32_t nq = static_cast<std::int32_t>(q.size());
-  for (std::int32_t j = 0; j < nq && n_active > 0; ++j) {
-    const TileGaussian<float>& g = q[j];
-    int c0, c1, r0, r1;
-    tileSpan(g.mx, g.hx, x0, x1, c0, c1);
-    tileSpan(g.my, g.hy, y0, y1, r0, r1);
-    const v4f mx = v4(g.mx), hx = v4(g.hx), o = v4(g.o), jf = v4(static_cast<float>(j + 1));
-    const v4f ha = v4(-0.5f) * v4(g.a);
-    v4i stopped = {0, 0, 0, 0};
-    for (int r = r0; r <= r1; ++r) {
-      const float dy = static_cast<float>(y0 + r) + 0.5f - g.my;
-      if (!(std::abs(dy) <= g.hy)) continue;
-      const v4f qy = v4(rowQuad(g, dy)), by = v4(rowCross(g, dy));
-      for (int cb = c0 & ~3; cb <= c1; cb += 4) {
-        const int k = r * kTileSize + cb;
-        const Lanes L = evalLanes((v4(static_cast<float>(x0 + cb)) + lane) - mx, ha, qy, by, o, hx);
-        const v4f alpha = L.alpha;
-        v4f t, c0v, c1v, c2v, dv, wv, cv;
-        std::memcpy(&t, Tr + k, 16);
-        const v4i ok = (t > v4(0.0f)) & L.touches;
-        const v4f next = t * (v4(1.0f) - alpha);
-        const v4i stop = ok & (next < v4(kMinTransmittance));
-        const v4i take = ok & ~stop;
-        const v4f wgt = take ? alpha * t : v4(0.0f);
-        std::memcpy(&c0v, C0 + k, 16);
-        std::memcpy(&c1v, C1 + k, 16);
-        std::memcpy(&c2v, C2 + k, 16);
-        std::memcpy(&dv, D + k, 16);
-        std::memcpy(&wv, walked + k, 16);
-        std::memcpy(&cv, contrib + k, 16);
-        c0v += wgt * v4(g.col[0]);
-        c1v += wgt * v4(g.col[1]);
-        c2v += wgt * v4(g.col[2]);
-        dv += wgt * v4(g.depth);
-        t = take ? next : (stop ? -t : t);
-        wv = take ? jf : wv;
-        cv += take ? v4(1.0f) : v4(0.0f);
-        stopped -= stop;  // masks are -1 where true
-        std::memcpy(Tr + k, &t, 16);
-        std::memcpy(C0 + k, &c0v, 16);
-        std::memcpy(C1 + k, &c1v, 16);
-        std::memcpy(C2 + k, &c2v, 16);
-        std::memcpy(D + k, &dv, 16);
-        std::memcpy(walked + k, &wv, 16);
-        std::memcpy(contrib + k, &cv, 16);
-      }
-    }
-    n_active -= stopped[0] + stopped[1] + stopped[2] + stopped[3];
-  }
-  for (int r = 0; r < h; ++r)
-    for (int c = 0; c < w; ++c) {
-      const int k = r * kTileSize + c;
-      const float T = std::abs(Tr[k]);
-      const std::size_t pix = static_cast<std::size_t>(y0 + r) * W + (x0 + c);
-      out.rgb[pix * 3] = C0[k] + T * bg[0];
-      out.rgb[pix * 3 + 1] = C1[k] + T * bg[1];
-      out.rgb[pix * 3 + 2] = C2[k] + T * bg[2];
-      out.alpha[pix] = 1.0f - T;
-      out.depth[pix] = (1.0f - T) >= 1e-6f ? D[k] / (1.0f - T) : 0.0f;
-      out.contributors[pix] = static_cast<int>(contrib[k]);
-      st.final_T[pix] = T;
-      st.n_walked[pix] = static_cast<std::uint32_t>(walked[k]);
-    }
-}
-
 }  // namespace
 
 void setRasterThreads(int threads) { g_threads.store(std::max(0, threads)); }
 int rasterThreads() { return arena().max_concurrency(); }
+
+bool setRasterKernels(std::string_view name) {
+  if (name == "default") {
+    g_isa.store(defaultIsa());
+    return true;
+  }
+  if (name == kKernelSets[0].name) {
+    g_isa.store(0);
+    return true;
+  }
+  if (name == kKernelSets[1].name && cpuHasAvx2()) {
+    g_isa.store(1);
+    return true;
+  }
+  return false;
+}
+const char* rasterKernels() { return kKernelSets[currentIsa()].name; }
 
 template <typename T>
 RenderOutputT<T> rasterizeT(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& s,
@@ -368,6 +301,7 @@ RenderOutputT<T> rasterizeT(const GaussiansT<T>& g, const Camera& cam, const Ras
   const int W = cam.K.width, H = cam.K.height;
   auto st = std::make_shared<RasterStateT<T>>();
   st->settings = s;
+  st->isa = currentIsa();
   st->settings.sh_degree = std::clamp(s.sh_degree, 0, g.max_sh_degree);
   const RasterSettings& rs = st->settings;
   const CameraT<T> camT(cam, T(s.guard_band));
@@ -465,11 +399,22 @@ RenderOutputT<T> rasterizeT(const GaussiansT<T>& g, const Camera& cam, const Ras
         st->entry_slot[k] = entries[k - b].slot;
       }
 
-      std::vector<TileGaussian<T>> q;
+      thread_local std::vector<TileGaussian<T>> q;
       gatherTile(*st, tile, q);
       int x0, y0, x1, y1;
       tilePixels(*st, tile, W, H, x0, y0, x1, y1);
-      compositeTile(q, x0, y0, x1, y1, bg, W, out, *st);
+      if constexpr (std::is_same_v<T, float>) {
+        const raster_kernels::ForwardOut fo{W,
+                                            out.rgb.data(),
+                                            out.alpha.data(),
+                                            out.depth.data(),
+                                            out.contributors.data(),
+                                            st->final_T.data(),
+                                            st->n_walked.data()};
+        kKernelSets[st->isa].composite(q.data(), static_cast<int>(q.size()), x0, y0, x1, y1, bg, fo);
+      } else {
+        compositeTile(q, x0, y0, x1, y1, bg, W, out, *st);
+      }
     });
   });
   out.state = st;
@@ -563,111 +508,22 @@ void backwardSlots(const RasterStateT<T>& st, int W, int H, const T* dL_drgb, T*
       });
 }
 
-inline float hsum(v4f v) { return (v[0] + v[1]) + (v[2] + v[3]); }
-
+// The float version runs the SIMD kernels of the instruction set the forward pass used.
 template <>
 void backwardSlots<float>(const RasterStateT<float>& st, int W, int H, const float* dL_drgb, float* slots) {
-  constexpr int kSlot = 9;
-  constexpr int P = kTileSize * kTileSize;
   const RasterSettings& rs = st.settings;
   const float bg[3] = {rs.background[0], rs.background[1], rs.background[2]};
+  const raster_kernels::BackwardIn in{W, st.final_T.data(), st.n_walked.data(), dL_drgb};
+  const raster_kernels::BackwardFn kernel = kKernelSets[st.isa].backward;
   arena().execute([&] {
     tbb::parallel_for(0, st.tiles_x * st.tiles_y, [&](int tile) {
-      std::vector<TileGaussian<float>> q;
+      thread_local std::vector<TileGaussian<float>> q;
       gatherTile(st, tile, q);
       if (q.empty()) return;
-      const std::uint32_t base = st.tile_start[tile];
       int x0, y0, x1, y1;
       tilePixels(st, tile, W, H, x0, y0, x1, y1);
-      const int w = x1 - x0, h = y1 - y0;
-      // Per-pixel state of the back-to-front walk (see walkBack for the scalar form).
-      alignas(64) float Tr[P], finalT[P], walked[P], acc0[P], acc1[P], acc2[P], la[P], lc0[P], lc1[P], lc2[P],
-          w0[P], w1[P], w2[P], bgdot[P];
-      std::uint32_t jmax = 0;
-      for (int k = 0; k < P; ++k) {
-        const int r = k / kTileSize, c = k % kTileSize;
-        const bool inside = c < w && r < h;
-        const std::size_t pix = inside ? static_cast<std::size_t>(y0 + r) * W + (x0 + c) : 0;
-        Tr[k] = finalT[k] = inside ? st.final_T[pix] : 1.0f;
-        walked[k] = inside ? static_cast<float>(st.n_walked[pix]) : 0.0f;
-        if (inside) jmax = std::max(jmax, st.n_walked[pix]);
-        acc0[k] = acc1[k] = acc2[k] = la[k] = lc0[k] = lc1[k] = lc2[k] = 0.0f;
-        w0[k] = inside ? dL_drgb[pix * 3] : 0.0f;
-        w1[k] = inside ? dL_drgb[pix * 3 + 1] : 0.0f;
-        w2[k] = inside ? dL_drgb[pix * 3 + 2] : 0.0f;
-        bgdot[k] = bg[0] * w0[k] + bg[1] * w1[k] + bg[2] * w2[k];
-      }
-      const v4f lane{0.5f, 1.5f, 2.5f, 3.5f};
-      auto load = [](const float* p) {
-        v4f v;
-        std::memcpy(&v, p, 16);
-        return v;
-      };
-      auto store = [](float* p, v4f v) { std::memcpy(p, &v, 16); };
-      for (std::uint32_t jj = jmax; jj-- > 0;) {
-        const TileGaussian<float>& g = q[jj];
-        int c0, c1, r0, r1;
-        tileSpan(g.mx, g.hx, x0, x1, c0, c1);
-        tileSpan(g.my, g.hy, y0, y1, r0, r1);
-        const v4f mx = v4(g.mx), hx = v4(g.hx), o = v4(g.o), jv = v4(static_cast<float>(jj));
-        const v4f ha = v4(-0.5f) * v4(g.a);
-        const v4f col0 = v4(g.col[0]), col1 = v4(g.col[1]), col2 = v4(g.col[2]);
-        v4f s_op = v4(0), s_mx = v4(0), s_my = v4(0), s_ca = v4(0), s_cb = v4(0), s_cc = v4(0), s_c0 = v4(0),
-            s_c1 = v4(0), s_c2 = v4(0);
-        for (int r = r0; r <= r1; ++r) {
-          const float dys = static_cast<float>(y0 + r) + 0.5f - g.my;
-          if (!(std::abs(dys) <= g.hy)) continue;
-          const v4f dy = v4(dys), qy = v4(rowQuad(g, dys)), by = v4(rowCross(g, dys));
-          for (int cb = c0 & ~3; cb <= c1; cb += 4) {
-            const int k = r * kTileSize + cb;
-            const Lanes L = evalLanes((v4(static_cast<float>(x0 + cb)) + lane) - mx, ha, qy, by, o, hx);
-            const v4f dx = L.dx, G = L.G, oG = L.oG, alpha = L.alpha;
-            const v4i valid = (jv < load(walked + k)) & L.touches;
-            const v4f a_eff = valid ? alpha : v4(0.0f);
-            const v4f t = load(Tr + k) / (v4(1.0f) - a_eff);  // transmittance in front of jj
-            const v4f lav = load(la + k);
-            v4f a0 = load(acc0 + k), a1 = load(acc1 + k), a2 = load(acc2 + k);
-            a0 = valid ? lav * load(lc0 + k) + (v4(1.0f) - lav) * a0 : a0;
-            a1 = valid ? lav * load(lc1 + k) + (v4(1.0f) - lav) * a1 : a1;
-            a2 = valid ? lav * load(lc2 + k) + (v4(1.0f) - lav) * a2 : a2;
-            const v4f ww0 = load(w0 + k), ww1 = load(w1 + k), ww2 = load(w2 + k);
-            v4f dLda = (col0 - a0) * ww0;
-            dLda += (col1 - a1) * ww1;
-            dLda += (col2 - a2) * ww2;
-            dLda = dLda * t - load(finalT + k) / (v4(1.0f) - alpha) * load(bgdot + k);
-            store(acc0 + k, a0);
-            store(acc1 + k, a1);
-            store(acc2 + k, a2);
-            store(la + k, valid ? alpha : lav);
-            store(lc0 + k, valid ? col0 : load(lc0 + k));
-            store(lc1 + k, valid ? col1 : load(lc1 + k));
-            store(lc2 + k, valid ? col2 : load(lc2 + k));
-            store(Tr + k, t);
-            const v4i gm = valid & (oG < v4(kMaxAlpha));
-            const v4f dG = o * dLda * G;
-            s_op += gm ? G * dLda : v4(0.0f);
-            s_mx += gm ? dG * (v4(g.a) * dx + v4(g.b) * dy) : v4(0.0f);
-            s_my += gm ? dG * (v4(g.b) * dx + v4(g.c) * dy) : v4(0.0f);
-            s_ca += gm ? dG * v4(-0.5f) * dx * dx : v4(0.0f);
-            s_cb += gm ? dG * (-dx * dy) : v4(0.0f);
-            s_cc += gm ? dG * v4(-0.5f) * dy * dy : v4(0.0f);
-            const v4f wcol = alpha * t;
-            s_c0 += valid ? wcol * ww0 : v4(0.0f);
-            s_c1 += valid ? wcol * ww1 : v4(0.0f);
-            s_c2 += valid ? wcol * ww2 : v4(0.0f);
-          }
-        }
-        float* sl = &slots[static_cast<std::size_t>(st.entry_slot[base + jj]) * kSlot];
-        sl[0] = hsum(s_op);
-        sl[1] = hsum(s_mx);
-        sl[2] = hsum(s_my);
-        sl[3] = hsum(s_ca);
-        sl[4] = hsum(s_cb);
-        sl[5] = hsum(s_cc);
-        sl[6] = hsum(s_c0);
-        sl[7] = hsum(s_c1);
-        sl[8] = hsum(s_c2);
-      }
+      kernel(q.data(), static_cast<int>(q.size()), x0, y0, x1, y1, bg, in, &st.entry_slot[st.tile_start[tile]],
+             slots);
     });
   });
 }

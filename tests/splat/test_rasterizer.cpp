@@ -96,9 +96,65 @@ struct FloatCase {
 
 class FloatPath : public ::testing::TestWithParam<FloatCase> {};
 
-// The float product path (SIMD kernels) against the same code in double.
+namespace {
+void checkFloatAgainstDouble(const FloatCase& fc);
+}  // namespace
+
+// The float product path (SIMD kernels, every instruction set this CPU runs) against
+// the same code in double.
 TEST_P(FloatPath, MatchesDoublePath) {
-  const FloatCase fc = GetParam();
+  for (const char* kernels : {"baseline", "avx2"}) {
+    if (!setRasterKernels(kernels)) continue;
+    SCOPED_TRACE(kernels);
+    checkFloatAgainstDouble(GetParam());
+  }
+  setRasterKernels("default");
+}
+
+// The two kernel sets differ only in rounding (FMA, the order lanes are summed).
+TEST(FloatPath, KernelSetsAgree) {
+  const Camera cam = test::smallCamera(72, 56);
+  const Gaussians g = test::randomScene<double>(300, 2, 9, 1.2).cast<float>();
+  RasterSettings s;
+  s.sh_degree = 2;
+  s.background = {0.1f, 0.2f, 0.3f};
+  const auto w = lossWeights(72, 56, 10);
+  const std::vector<float> wf(w.begin(), w.end());
+  auto run = [&](const char* kernels) {
+    EXPECT_TRUE(setRasterKernels(kernels));
+    const auto r = rasterizeT(g, cam, s);
+    Gaussians grad = g.zerosLike();
+    rasterizeBackwardT(g, cam, s, r, wf.data(), grad);
+    return std::make_pair(r, grad);
+  };
+  if (!setRasterKernels("avx2")) GTEST_SKIP() << "no AVX2 on this CPU";
+  const auto [ra, ga] = run("avx2");
+  const auto [rb, gb] = run("baseline");
+  setRasterKernels("default");
+  auto close = [](const std::vector<float>& a, const std::vector<float>& b) {
+    double scale = 0, diff = 0;
+    for (std::size_t k = 0; k < a.size(); ++k) {
+      scale = std::max(scale, static_cast<double>(std::abs(a[k])));
+      diff = std::max(diff, static_cast<double>(std::abs(a[k] - b[k])));
+    }
+    return diff <= 2e-3 * scale + 1e-6;
+  };
+  // A pixel may differ by one borderline contribution (the 1/255 and 1e-4 thresholds).
+  int differ = 0;
+  for (std::size_t k = 0; k < ra.contributors.size(); ++k) differ += ra.contributors[k] != rb.contributors[k];
+  EXPECT_LE(differ, static_cast<int>(ra.contributors.size() / 500));
+  int off = 0;
+  for (std::size_t k = 0; k < ra.rgb.size(); ++k) off += std::abs(ra.rgb[k] - rb.rgb[k]) > 1e-5f;
+  EXPECT_LE(off, static_cast<int>(ra.rgb.size() / 500));
+  EXPECT_TRUE(close(ga.means, gb.means));
+  EXPECT_TRUE(close(ga.log_scales, gb.log_scales));
+  EXPECT_TRUE(close(ga.rotations, gb.rotations));
+  EXPECT_TRUE(close(ga.opacities, gb.opacities));
+  EXPECT_TRUE(close(ga.sh, gb.sh));
+}
+
+namespace {
+void checkFloatAgainstDouble(const FloatCase& fc) {
   const Camera cam = test::smallCamera(64, 48);
   const GaussiansD gd = test::randomScene<double>(fc.gaussians, fc.sh_degree, fc.seed, fc.spread);
   const Gaussians gf = gd.cast<float>();
@@ -131,6 +187,7 @@ TEST_P(FloatPath, MatchesDoublePath) {
   compare(gradd.opacities, gradf.opacities, "opacities");
   compare(gradd.sh, gradf.sh, "sh");
 }
+}  // namespace
 
 INSTANTIATE_TEST_SUITE_P(Scenes, FloatPath,
                          ::testing::Values(FloatCase{60, 3, 0.9, 0.0f, 5}, FloatCase{300, 0, 0.6, 0.7f, 6},
@@ -151,10 +208,15 @@ TEST(Rasterizer, BitIdenticalAcrossRunsAndThreadCounts) {
     rasterizeSquaredGradientsT(g, cam, s, r, sq);
     return std::make_tuple(r.rgb, grad.means, grad.sh, sq.means);
   };
-  const auto a = run(2), b = run(2), c = run(1);
+  for (const char* kernels : {"baseline", "avx2"}) {
+    if (!setRasterKernels(kernels)) continue;
+    SCOPED_TRACE(kernels);
+    const auto a = run(2), b = run(2), c = run(1);
+    EXPECT_TRUE(a == b);
+    EXPECT_TRUE(a == c);
+  }
   setRasterThreads(0);
-  EXPECT_TRUE(a == b);
-  EXPECT_TRUE(a == c);
+  setRasterKernels("default");
 }
 
 TEST(Rasterizer, SubsetRenderEqualsZeroOpacity) {
