@@ -55,6 +55,7 @@ int runTrain(TrainArgs& a) {
   }
   std::cerr << "training on " << scene.train.size() << " views (" << scene.test.size() << " test), "
             << trainer.gaussians().size() << " initial Gaussians, " << a.iterations << " iterations\n";
+  trainer.planUntil(a.iterations);
   Progress progress;
   const int start = trainer.iteration();
   const auto t0 = std::chrono::steady_clock::now();

@@ -96,6 +96,7 @@ void applyPreset(const std::string& name, ActiveOptions& o) {
     o.trainer.densify.opacity_reset_interval = 1200;
     o.trainer.densify.until_iter = 6000;
     o.trainer.sh_interval = 400;
+    o.trainer.densify.min_iterations_after_reset = 200;
     return;
   }
   throw std::invalid_argument("preset '" + name + "': expected paper or quick");

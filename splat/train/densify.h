@@ -26,6 +26,10 @@ struct DensifyOptions {
   float max_world_scale = 0.1f;   // fraction of extent; likewise
   int split_count = 2;
   std::size_t max_gaussians = 0;  // 0: unlimited; otherwise no growth beyond it
+  // An opacity reset needs iterations after it to recover: it is skipped when fewer than
+  // this many remain in the trainer's plan (Trainer::planUntil, or the train() call) (3DGS resets at 3000 of 30000; a
+  // 3000-iteration run would otherwise end on a transparent model).
+  int min_iterations_after_reset = 500;
 };
 
 // Per-Gaussian statistics gathered between densification steps.

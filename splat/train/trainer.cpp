@@ -156,6 +156,7 @@ void Trainer::reset() {
   stats_.resize(g_.size());
   iteration_ = 0;
   loss_ema_ = 0;
+  planned_until_ = 0;
   view_stack_.clear();
 }
 
@@ -197,11 +198,13 @@ void Trainer::train(const std::vector<int>& views, int iterations,
   for (int v : views)
     if (v < 0 || v >= static_cast<int>(scene_.views.size()))
       throw std::invalid_argument("Trainer::train: view index " + std::to_string(v) + " is not in the scene");
+  plan_end_ = std::max(planned_until_, iteration_ + iterations);
   for (int k = 0; k < iterations; ++k) {
     const double loss = step(nextView(views));
     loss_ema_ = iteration_ == 1 ? loss : 0.4 * loss + 0.6 * loss_ema_;
     if (progress) progress({iteration_, k + 1, iterations, loss, loss_ema_, g_.size()});
   }
+  plan_end_ = 0;
 }
 
 double Trainer::step(int view) {
@@ -235,9 +238,11 @@ double Trainer::step(int view) {
     if (iteration_ > d.from_iter && d.interval > 0 && iteration_ % d.interval == 0)
       last_densify_ = densifyAndPrune(g_, adam_, stats_, d, ext, iteration_ > d.opacity_reset_interval, rng_);
     const bool white = s.background[0] == 1.0f && s.background[1] == 1.0f && s.background[2] == 1.0f;
-    if ((d.opacity_reset_interval > 0 && iteration_ % d.opacity_reset_interval == 0) ||
-        (white && iteration_ == d.from_iter))
-      resetOpacity(g_, adam_);
+    const bool due = (d.opacity_reset_interval > 0 && iteration_ % d.opacity_reset_interval == 0) ||
+                     (white && iteration_ == d.from_iter);
+    // Outside train() (a bare step()) there is no plan: the schedule applies as is.
+    const bool room = plan_end_ == 0 || plan_end_ - iteration_ >= d.min_iterations_after_reset;
+    if (due && room) resetOpacity(g_, adam_);
   }
   seconds_.densify += since(t0);
   return loss;

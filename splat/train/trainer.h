@@ -93,6 +93,10 @@ class Trainer {
   // called after each iteration.
   void train(const std::vector<int>& views, int iterations,
              const std::function<void(const TrainProgress&)>& progress = {});
+  // Declares that training will run until `iteration` even when it comes in several
+  // train() calls (checkpoint chunks), so schedule decisions near the end (the opacity
+  // reset guard) do not depend on the chunking. Cleared by reset().
+  void planUntil(int iteration) { planned_until_ = iteration; }
   // One iteration on view `view`; returns its loss.
   double step(int view);
 
@@ -130,6 +134,8 @@ class Trainer {
   DensifyReport last_densify_;
   std::mt19937_64 rng_;
   int iteration_ = 0;
+  int plan_end_ = 0;      // iteration at which the current training plan ends
+  int planned_until_ = 0; // planUntil()'s value; 0: none
   double loss_ema_ = 0;
   std::vector<int> view_set_, view_stack_;
   std::map<int, ImageF> targets_;  // float images of the views trained on

@@ -202,3 +202,38 @@ TEST(Trainer, ExtremeModelsTrainWithoutNanOrInf) {
 
 }  // namespace
 }  // namespace saresgs
+
+namespace saresgs {
+namespace {
+
+TEST(Trainer, NoOpacityResetRightBeforeTheEndOfThePlan) {
+  const Scene& s = tinyDataset();
+  TrainerOptions o;
+  o.max_sh_degree = 0;
+  o.densify.from_iter = 10;
+  o.densify.interval = 10;
+  o.densify.opacity_reset_interval = 30;
+  o.densify.min_iterations_after_reset = 20;
+  o.seed = 2;
+  auto maxOpacity = [](const Gaussians& g) {
+    float m = -1e30f;
+    for (float x : g.opacities) m = std::max(m, x);
+    return 1 / (1 + std::exp(-m));
+  };
+  // The plan ends at 30: the reset due at 30 is skipped, so opacities end above 0.01
+  // (the white background also resets at from_iter = 10, with 20 iterations to go).
+  Trainer a(s, o);
+  a.train(s.train, 30);
+  EXPECT_GT(maxOpacity(a.gaussians()), 0.0101f);
+  // Planned to 60 but run in two chunks: the reset at 30 happens, as in one 60-call.
+  Trainer b(s, o), c(s, o);
+  b.planUntil(60);
+  b.train(s.train, 30);
+  EXPECT_LE(maxOpacity(b.gaussians()), 0.0101f);
+  b.train(s.train, 30);
+  c.train(s.train, 60);
+  EXPECT_TRUE(bitIdentical(b.gaussians(), c.gaussians()));
+}
+
+}  // namespace
+}  // namespace saresgs
