@@ -112,7 +112,8 @@ class Trainer {
   void loadCheckpoint(const std::string& path);
 
   const Gaussians& gaussians() const { return g_; }
-  Gaussians& mutableGaussians() { return g_; }  // for tests and importers; resets Adam on next step
+  // For tests and importers; when the count changes, Adam and the statistics restart.
+  Gaussians& mutableGaussians() { return g_; }
   const Scene& scene() const { return scene_; }
   const TrainerOptions& options() const { return opt_; }
   int iteration() const { return iteration_; }
