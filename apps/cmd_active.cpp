@@ -28,11 +28,6 @@ struct ActiveArgs {
   ActiveOptions opt;
 };
 
-nlohmann::json secondsJson(const SelectionSeconds& s) {
-  return {{"lifting", s.lifting},   {"triangulation", s.triangulation}, {"prefilter", s.prefilter},
-          {"fisher", s.fisher},     {"training", s.training},           {"exhaustive_fisher", s.exhaustive_fisher}};
-}
-
 int runActive(ActiveArgs& a) {
   if (a.threads > 0) setRasterThreads(a.threads);
   applyPreset(a.preset, a.opt);
@@ -80,14 +75,14 @@ int runActive(ActiveArgs& a) {
   j["selected_views"] = names(std::vector<int>(r.selected_views.begin() + static_cast<long>(r.initial_views.size()),
                                                r.selected_views.end()));
   j["selected_view_indices"] = r.selected_views;
-  j["seconds"] = secondsJson(r.total_seconds);
+  j["seconds"] = toJson(r.total_seconds);
   j["seconds"]["end_to_end_this_process"] = r.seconds;
   j["gaussians"] = t.gaussians().size();
   j["threads"] = rasterThreads();
   for (const ViewMetrics& m : r.test.views)
     j["views"].push_back({{"name", scene.views[static_cast<std::size_t>(m.view)].name}, {"psnr", m.psnr}, {"ssim", m.ssim}});
   for (const SelectionLog& s : r.steps) {
-    nlohmann::json e = {{"views_before", s.views_before}, {"progress_psnr", s.progress_psnr}, {"seconds", secondsJson(s.seconds)}};
+    nlohmann::json e = {{"views_before", s.views_before}, {"progress_psnr", s.progress_psnr}, {"seconds", toJson(s.seconds)}};
     if (s.selected >= 0) {
       e["selected"] = scene.views[static_cast<std::size_t>(s.selected)].name;
       e["candidates"] = names(s.candidates);

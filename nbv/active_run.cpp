@@ -10,6 +10,7 @@
 
 #include "geometry/error.h"
 #include "geometry/io/atomic_file.h"
+#include "geometry/io/json_file.h"
 #include "nbv/ause.h"
 #include "nbv/initial_views.h"
 #include "splat/fisher.h"
@@ -30,10 +31,6 @@ void addSeconds(SelectionSeconds& a, const SelectionSeconds& b) {
   a.exhaustive_fisher += b.exhaustive_fisher;
 }
 
-nlohmann::json secondsJson(const SelectionSeconds& s) {
-  return {{"lifting", s.lifting},   {"triangulation", s.triangulation}, {"prefilter", s.prefilter},
-          {"fisher", s.fisher},     {"training", s.training},           {"exhaustive_fisher", s.exhaustive_fisher}};
-}
 SelectionSeconds secondsFrom(const nlohmann::json& j) {
   SelectionSeconds s;
   s.lifting = j.at("lifting");
@@ -46,6 +43,11 @@ SelectionSeconds secondsFrom(const nlohmann::json& j) {
 }
 
 }  // namespace
+
+nlohmann::json toJson(const SelectionSeconds& s) {
+  return {{"lifting", s.lifting},   {"triangulation", s.triangulation}, {"prefilter", s.prefilter},
+          {"fisher", s.fisher},     {"training", s.training},           {"exhaustive_fisher", s.exhaustive_fisher}};
+}
 
 Method parseMethod(const std::string& s) {
   for (Method m : {Method::kRandom, Method::kFvs, Method::kFisher, Method::kCoverage, Method::kSaHash, Method::kSaResgs,
@@ -244,7 +246,7 @@ void ActiveRun::saveCheckpoint() const {
   j["tag"] = tag;
   for (const SelectionLog& s : steps_)
     j["steps"].push_back({{"views_before", s.views_before}, {"selected", s.selected}, {"candidates", s.candidates},
-                          {"scores", s.scores}, {"prefiltered", s.prefiltered}, {"seconds", secondsJson(s.seconds)},
+                          {"scores", s.scores}, {"prefiltered", s.prefiltered}, {"seconds", toJson(s.seconds)},
                           {"progress_psnr", s.progress_psnr}});
   writeFileAtomic(checkpoint_, j.dump() + "\n");
   // Older companions are obsolete once the state that names the new ones is in place.
@@ -256,12 +258,7 @@ void ActiveRun::saveCheckpoint() const {
 
 bool ActiveRun::loadCheckpoint() {
   if (checkpoint_.empty() || !std::filesystem::exists(checkpoint_)) return false;
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(readFile(checkpoint_));
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(checkpoint_, "json", std::string("not valid JSON: ") + e.what());
-  }
+  const nlohmann::json j = readJsonFile(checkpoint_);
   auto field = [&](const char* name) -> const nlohmann::json& {
     if (!j.contains(name)) throw InputError(checkpoint_, name, "missing");
     return j[name];

@@ -5,6 +5,8 @@
 // rest of the iteration budget and evaluate. After each addition the model restarts from
 // its initial state (an option continues instead). A checkpoint after every added view
 // lets a killed run resume and end with the same numbers.
+#include <nlohmann/json.hpp>
+
 #include <functional>
 #include <memory>
 #include <optional>
@@ -37,6 +39,8 @@ struct SelectionSeconds {
   double lifting = 0, triangulation = 0, prefilter = 0, fisher = 0, training = 0;
   double exhaustive_fisher = 0;  // Fisher over all candidates, timed for comparison only
 };
+// The stage times as one JSON object (results.json and the checkpoint).
+nlohmann::json toJson(const SelectionSeconds& s);
 
 // The prefilter of the coverage methods: builds its state from the scene, learns what the
 // chosen views observe (SA-Points lifted against `render`: the trainer's renders in an

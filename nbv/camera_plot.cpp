@@ -16,13 +16,9 @@ struct Frame {
 };
 
 Frame sceneFrame(const Scene& s) {
-  Eigen::Vector3d up = Eigen::Vector3d::Zero(), fwd = Eigen::Vector3d::Zero();
-  for (const auto& v : s.views) {
-    up += -(v.camera.R.transpose() * Eigen::Vector3d::UnitY());
-    fwd += v.camera.viewDirection();
-  }
-  if (up.norm() < 1e-9) up = Eigen::Vector3d::UnitZ();
-  up.normalize();
+  const Eigen::Vector3d up = meanCameraUp(s);
+  Eigen::Vector3d fwd = Eigen::Vector3d::Zero();
+  for (const auto& v : s.views) fwd += v.camera.viewDirection();
   Eigen::Vector3d right = up.unitOrthogonal();
   fwd -= fwd.dot(up) * up;
   if (fwd.norm() > 1e-6) right = fwd.normalized().cross(up);
@@ -30,6 +26,12 @@ Frame sceneFrame(const Scene& s) {
 }
 
 }  // namespace
+
+Eigen::Vector3d meanCameraUp(const Scene& scene) {
+  Eigen::Vector3d up = Eigen::Vector3d::Zero();
+  for (const auto& v : scene.views) up += -(v.camera.R.transpose() * Eigen::Vector3d::UnitY());
+  return up.norm() > 1e-9 ? Eigen::Vector3d(up.normalized()) : Eigen::Vector3d::UnitZ();
+}
 
 Image8 plotCameras(const Scene& scene, const std::vector<int>& initial, const std::vector<int>& selected,
                    int panel_size) {

@@ -10,6 +10,10 @@
 
 namespace saresgs {
 
+// The mean up direction of the views (-y of each camera, in world), normalised; world z
+// when the views disagree completely. "Above" in both pictures is along it.
+Eigen::Vector3d meanCameraUp(const Scene& scene);
+
 Image8 plotCameras(const Scene& scene, const std::vector<int>& initial, const std::vector<int>& selected,
                    int panel_size = 480);
 

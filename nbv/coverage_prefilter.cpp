@@ -63,12 +63,12 @@ class SaPointPrefilter : public CoveragePrefilter {
       std::vector<Eigen::Vector3d> p = positions(r.points);
       grids_->addObserved(p);
       observed_points_.insert(observed_points_.end(), p.begin(), p.end());
-      last_report_.add(r.report);
+      report_.add(r.report);
     }
   }
 
   const OccupancyGrids& grids() const override { return *grids_; }
-  const LiftingReport& liftingReport() const override { return last_report_; }
+  const LiftingReport& liftingReport() const override { return report_; }
 
   std::vector<double> score(const std::vector<int>& candidates, SelectionSeconds& t) override {
     const auto t0 = std::chrono::steady_clock::now();
@@ -90,7 +90,8 @@ class SaPointPrefilter : public CoveragePrefilter {
   void load(const std::string& bytes) override {
     if (bytes.size() % sizeof(Eigen::Vector3d)) throw InputError("prefilter state", "points", "truncated");
     observed_points_.resize(bytes.size() / sizeof(Eigen::Vector3d));
-    if (!bytes.empty()) std::memcpy(observed_points_.data(), bytes.data(), bytes.size());
+    // Vector3d is three packed doubles: the bytes are the points as save() wrote them.
+    if (!bytes.empty()) std::memcpy(static_cast<void*>(observed_points_.data()), bytes.data(), bytes.size());
     grids_->clearObserved();
     grids_->addObserved(observed_points_);
   }
@@ -119,7 +120,7 @@ class SaPointPrefilter : public CoveragePrefilter {
   std::unique_ptr<VisibilityTracer> tracer_;
   std::map<int, VoxelSet> cache_;
   std::vector<Eigen::Vector3d> observed_points_;
-  LiftingReport last_report_;
+  LiftingReport report_;
 };
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <numeric>
 
 #include "geometry/occupancy/occupancy_grid.h"
+#include "nbv/camera_plot.h"
 
 namespace saresgs {
 
@@ -51,10 +52,7 @@ CoverageAnalysis analyzeCoverage(const Scene& scene, const std::vector<int>& vie
 
 Image8 plotCoverage(const Scene& scene, const CoverageAnalysis& a, int size) {
   const OccupancyGrids& g = a.prefilter->grids();
-  // "Above" is along the mean camera up (-y of the cameras), as in the camera plot.
-  Eigen::Vector3d up = Eigen::Vector3d::Zero();
-  for (const auto& v : scene.views) up += -(v.camera.R.transpose() * Eigen::Vector3d::UnitY());
-  up = up.norm() > 1e-9 ? up.normalized() : Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d up = meanCameraUp(scene);  // "above", as in the camera plot
   // Keep the room's walls upright on the page: x is the world axis closest to the plane.
   Eigen::Vector3d ax = up.unitOrthogonal();
   for (int k = 0; k < 3; ++k) {

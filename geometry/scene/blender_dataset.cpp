@@ -7,7 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "geometry/error.h"
-#include "geometry/io/atomic_file.h"
+#include "geometry/io/json_file.h"
 #include "geometry/scene/scene.h"
 
 namespace saresgs {
@@ -38,12 +38,7 @@ std::string resolveImage(const fs::path& root, const std::string& file_path) {
 void readSplit(const fs::path& root, const std::string& name, const DatasetOptions& opts,
                Scene& scene, std::vector<int>& split) {
   const std::string file = (root / name).string();
-  json j;
-  try {
-    j = json::parse(readFile(file));
-  } catch (const json::exception& e) {
-    throw InputError(file, "json", std::string("not valid JSON: ") + e.what());
-  }
+  const json j = readJsonFile(file);
   if (!j.contains("frames") || !j["frames"].is_array())
     throw InputError(file, "frames", "expected an array of frames");
   const int f = std::max(1, opts.load.downscale);

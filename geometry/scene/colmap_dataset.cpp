@@ -6,8 +6,8 @@
 #include <nlohmann/json.hpp>
 
 #include "geometry/error.h"
-#include "geometry/io/atomic_file.h"
 #include "geometry/io/colmap.h"
+#include "geometry/io/json_file.h"
 #include "geometry/scene/colmap_convert.h"
 #include "geometry/scene/scene.h"
 
@@ -38,12 +38,7 @@ std::string modelFile(const std::string& dir, const char* stem) {
 // {"train": [names], "test": [names]}); it wins over the every-N-th rule.
 bool readManifestSplit(const fs::path& manifest, Scene& scene) {
   if (!fs::exists(manifest)) return false;
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(readFile(manifest.string()));
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(manifest.string(), "json", std::string("not valid JSON: ") + e.what());
-  }
+  const nlohmann::json j = readJsonFile(manifest.string());
   if (j.contains("background")) {
     const auto& b = j["background"];
     if (!b.is_array() || b.size() != 3 || !b[0].is_number() || !b[1].is_number() || !b[2].is_number())

@@ -5,19 +5,14 @@
 #include <filesystem>
 
 #include "geometry/error.h"
-#include "geometry/io/atomic_file.h"
+#include "geometry/io/json_file.h"
 
 namespace saresgs {
 
 std::optional<SyntheticOptions> syntheticOptionsFromManifest(const std::string& folder) {
   const std::string path = (std::filesystem::path(folder) / "manifest.json").string();
   if (!std::filesystem::exists(path)) return std::nullopt;
-  nlohmann::json m;
-  try {
-    m = nlohmann::json::parse(readFile(path));
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(path, "json", std::string("not valid JSON: ") + e.what());
-  }
+  const nlohmann::json m = readJsonFile(path);
   if (!m.contains("layout") || !m.contains("objects") || !m["objects"].is_array()) return std::nullopt;
   for (const auto& o : m["objects"]) {
     const std::string mesh = o.value("mesh", ""), tex = o.value("texture", "");
