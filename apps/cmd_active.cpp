@@ -21,10 +21,13 @@ namespace {
 namespace fs = std::filesystem;
 
 struct ActiveArgs {
-  std::string dataset, out, method = "sa-resgs", preset = "quick", fvs_metric = "euclidean";
+  std::string dataset, out, method = "sa-resgs", preset = "quick", fvs_metric = "euclidean", ranking;
   int downscale = 1, threads = 0;
   bool resume = false;
   int max_views = 0, interval = 0, total = 0;
+  long long max_gaussians = -1;
+  double beta = -1;
+  bool sub_only = false;
   ActiveOptions opt;
 };
 
@@ -36,6 +39,10 @@ int runActive(ActiveArgs& a) {
   if (a.max_views > 0) a.opt.max_views = a.max_views;
   if (a.interval > 0) a.opt.interval = a.interval;
   if (a.total > 0) a.opt.total_iterations = a.total;
+  if (a.max_gaussians >= 0) a.opt.trainer.densify.max_gaussians = static_cast<std::size_t>(a.max_gaussians);
+  if (a.beta >= 0) a.opt.trainer.residual.beta = a.beta;
+  if (!a.ranking.empty()) a.opt.trainer.residual.ranking = parseUncertaintyRanking(a.ranking);
+  if (a.sub_only) a.opt.trainer.residual.sub_only = true;
   DatasetOptions dopt;
   dopt.load.downscale = a.downscale;
   const Scene scene = loadDataset(a.dataset, dopt);
@@ -63,6 +70,21 @@ int runActive(ActiveArgs& a) {
   j["method"] = a.method;
   j["seed"] = a.opt.seed;
   j["preset"] = a.preset;
+  const ResidualOptions& ro = a.opt.trainer.residual;
+  j["options"] = {{"interval", a.opt.interval},
+                  {"total_iterations", a.opt.total_iterations},
+                  {"max_views", a.opt.max_views},
+                  {"max_gaussians", a.opt.trainer.densify.max_gaussians},
+                  {"reset_after_add", a.opt.reset_after_add},
+                  {"residual", needsOf(a.opt.method).residual},
+                  {"residual_alpha", ro.alpha},
+                  {"residual_beta", ro.beta},
+                  {"residual_ranking", toString(ro.ranking)},
+                  {"residual_sub_only", ro.sub_only},
+                  {"prefilter_set", a.opt.prefilter.set},
+                  {"prefilter_encoding", a.opt.prefilter.encoding},
+                  {"prefilter_score", a.opt.prefilter.score},
+                  {"prefilter_keep", a.opt.prefilter.keep_fraction}};
   j["psnr"] = r.test.psnr;
   j["ssim"] = r.test.ssim;
   j["ause"] = r.ause ? nlohmann::json(*r.ause) : nlohmann::json(nullptr);
@@ -78,6 +100,7 @@ int runActive(ActiveArgs& a) {
   j["seconds"] = toJson(r.total_seconds);
   j["seconds"]["end_to_end_this_process"] = r.seconds;
   j["gaussians"] = t.gaussians().size();
+  j["iterations"] = r.iterations;
   j["threads"] = rasterThreads();
   for (const ViewMetrics& m : r.test.views)
     j["views"].push_back({{"name", scene.views[static_cast<std::size_t>(m.view)].name}, {"psnr", m.psnr}, {"ssim", m.ssim}});
@@ -115,6 +138,11 @@ void addActiveCommand(CLI::App& app, Action& action) {
   sub->add_option("--max-views", a->max_views, "Views at the end (default 20)");
   sub->add_option("--interval", a->interval, "Iterations per view held (preset's by default)");
   sub->add_option("--iterations", a->total, "Total iterations (preset's by default)");
+  sub->add_option("--max-gaussians", a->max_gaussians, "Cap on the model size (0: none; preset's by default)");
+  sub->add_option("--residual-beta", a->beta, "Uncertain fraction of the residual subset (default 0.1)")->check(CLI::Range(0.0, 1.0));
+  sub->add_option("--residual-ranking", a->ranking, "Uncertainty ranking: both | opacity | scale | random (default both)")
+      ->check(CLI::IsMember({"both", "opacity", "scale", "random"}));
+  sub->add_flag("--residual-sub-only", a->sub_only, "Ablation: subset loss only, no full-render loss");
   sub->add_flag("--continue-training", [a](std::int64_t) { a->opt.reset_after_add = false; },
                 "Keep training the same model after each addition instead of resetting it");
   sub->add_option("--fvs-metric", a->fvs_metric, "euclidean | great-circle")

@@ -13,5 +13,6 @@ void addTrainCommand(CLI::App& app, Action& action);  // apps/cmd_train.cpp
 void addBenchCommand(CLI::App& app, Action& action);  // apps/cmd_bench.cpp
 void addActiveCommand(CLI::App& app, Action& action);  // apps/cmd_active.cpp
 void addCoverageCommand(CLI::App& app, Action& action);  // apps/cmd_coverage.cpp
+void addAblateCommand(CLI::App& app, Action& action);  // apps/cmd_ablate.cpp
 
 }  // namespace saresgs::apps

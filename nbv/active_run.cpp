@@ -101,6 +101,11 @@ void applyPreset(const std::string& name, ActiveOptions& o) {
     o.trainer.densify.until_iter = 3750;
     o.trainer.densify.min_iterations_after_reset = 125;
     o.trainer.sh_interval = 250;
+    // Densification's 2e-4 threshold is sized for ~800-pixel images; at 256x192 an
+    // unbounded run grew room360 to 215k Gaussians (over 4 per pixel), which made training
+    // and Fisher scoring the whole cost. The cap keeps the model at a size the images
+    // can constrain.
+    o.trainer.densify.max_gaussians = 40000;
     return;
   }
   throw std::invalid_argument("preset '" + name + "': expected paper or quick");
@@ -220,6 +225,7 @@ ActiveResult ActiveRun::run(const std::function<void(const ActiveProgress&)>& pr
   r.selected_views = selected_;
   r.steps = steps_;
   for (const auto& s : steps_) addSeconds(r.total_seconds, s.seconds);
+  r.iterations = iterations_done_;
   r.test = trainer_->evaluate(scene_.test.empty() ? scene_.train : scene_.test);
   r.ause = depthAuse(*trainer_, selected_, scene_.test.empty() ? scene_.train : scene_.test, opt_.fisher_lambda);
   r.seconds = since(start);

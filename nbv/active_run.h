@@ -117,6 +117,7 @@ struct ActiveResult {
   Evaluation test;
   std::optional<double> ause;
   SelectionSeconds total_seconds;
+  int iterations = 0;  // training iterations over the whole run
   double seconds = 0;  // end to end, this process
 };
 

@@ -1,0 +1,225 @@
+// saresgs ablate: runs an ablation grid of active runs and prefilter sweeps as
+// independent jobs (listable, shardable, skipped when finished), and merges finished
+// jobs into tables and plots. The grid format is in nbv/ablation.h.
+#include <sys/file.h>
+#include <unistd.h>
+#include <fcntl.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+#include "apps/cli.h"
+#include "apps/commands.h"
+#include "geometry/error.h"
+#include "geometry/io/atomic_file.h"
+#include "geometry/synth/from_manifest.h"
+#include "nbv/ablation.h"
+#include "nbv/prefilter_sweep.h"
+
+namespace saresgs::apps {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct AblateArgs {
+  std::string config, out, shard, inputs;
+  bool list = false, allow_partial = false;
+};
+
+std::string commandLine(const std::vector<std::string>& args) {
+  std::string s = "saresgs";
+  for (const auto& a : args) s += " " + (a.find_first_of(" \"'") == std::string::npos ? a : "'" + a + "'");
+  return s;
+}
+
+std::vector<std::string> activeArgs(const AblationJob& j, const std::string& out) {
+  std::vector<std::string> a{"active"};
+  a.insert(a.end(), j.args.begin(), j.args.end());
+  a.insert(a.end(), {"--out", jobFolder(out, j)});
+  return a;
+}
+
+// Generates a missing synthetic dataset once, even when several shards start together:
+// an exclusive lock on DATASET.lock, then a second look.
+void ensureDataset(const AblationScene& sc) {
+  if (fs::exists(sc.dataset)) return;
+  if (sc.layout.empty()) throw InputError(sc.dataset, "dataset", "missing, and the grid gives no layout to generate it");
+  if (fs::path(sc.dataset).has_parent_path()) fs::create_directories(fs::path(sc.dataset).parent_path());
+  const std::string lock = sc.dataset + ".lock";
+  const int fd = ::open(lock.c_str(), O_CREAT | O_RDWR, 0644);
+  if (fd < 0) throw std::runtime_error("cannot open lock file " + lock);
+  ::flock(fd, LOCK_EX);
+  int rc = 0;
+  if (!fs::exists(sc.dataset)) {
+    std::cerr << "[ablate] generating " << sc.layout << " into " << sc.dataset << "\n";
+    rc = runCli({"scene", "--layout", sc.layout, "--out", sc.dataset});
+  }
+  ::flock(fd, LOCK_UN);
+  ::close(fd);
+  if (rc != 0) throw std::runtime_error("generating " + sc.dataset + " failed");
+}
+
+const AblationScene& sceneOf(const AblationGrid& g, const std::string& name) {
+  for (const auto& s : g.scenes)
+    if (s.name == name) return s;
+  throw std::logic_error("unknown scene " + name);
+}
+
+void runSweep(const AblationGrid& g, const AblationJob& j, const std::string& out) {
+  const AblationScene& sc = sceneOf(g, j.scene);
+  const Scene scene = loadDataset(sc.dataset, {});
+  const std::optional<SyntheticScene> truth = rebuildSyntheticScene(sc.dataset, scene);
+  if (!truth) throw InputError(sc.dataset, "manifest.json", "the prefilter sweep lifts SA-Points from ground-truth renders: needs a `saresgs scene` dataset");
+  const ViewRenderer render = [&](const Camera& c) { return truth->render(c); };
+  const DepthRenderer depth = [&](const Camera& c) { return truth->renderDepth(c); };
+  const std::vector<SweepRow> rows = prefilterSweep(scene, *g.sweep, render, depth, 0);
+  nlohmann::json res;
+  res["scene"] = j.scene;
+  res["dataset"] = sc.dataset;
+  res["lifting"] = g.sweep->lifting;
+  res["reference"] = "exact encoding of the Embree-visible sets, same score";
+  for (const SweepRow& r : rows)
+    res["rows"].push_back({{"set", r.set}, {"encoding", r.encoding}, {"score", r.score}, {"views", r.views},
+                           {"candidates", r.candidates}, {"overlap", r.overlap}, {"kendall_tau", r.kendall_tau},
+                           {"seconds_scoring", r.seconds_scoring}, {"seconds_sets", r.seconds_sets}});
+  fs::create_directories(jobFolder(out, j));
+  writeFileAtomic(jobResultFile(out, j), res.dump(2) + "\n");
+}
+
+// Tables, plots and an index page for every finished job of the grid.
+int writeSummary(const AblationGrid& g, const std::vector<AblationJob>& jobs, const std::string& out, bool allow_partial) {
+  const std::vector<JobResult> results = loadFinishedJobs(out, jobs);
+  std::vector<std::string> missing;
+  for (const auto& j : jobs)
+    if (!jobFinished(out, j)) missing.push_back(j.id);
+  fs::create_directories(out + "/tables");
+  fs::create_directories(out + "/plots");
+  std::ostringstream page;
+  page << "# Ablation results\n\nGrid: `" << g.source << "`, " << results.size() << " of " << jobs.size()
+       << " jobs finished. Made by `saresgs ablate --config " << g.source << " --out " << out
+       << "` (or its shards and `saresgs ablate merge`). Each job's own results are in `runs/<job>/`.\n\n";
+  if (!missing.empty()) {
+    page << "**Partial:** missing";
+    for (const auto& m : missing) page << " `" << m << "`";
+    page << "\n\n";
+  }
+  for (const Table& t : ablationTables(g, results)) {
+    writeFileAtomic(out + "/tables/" + t.name + ".md", t.markdown());
+    writeFileAtomic(out + "/tables/" + t.name + ".csv", t.csv());
+    page << t.markdown() << "\n(CSV: `tables/" << t.name << ".csv`)\n\n";
+  }
+  for (const NamedPlot& p : ablationPlots(g, results)) {
+    writeImage(out + "/plots/" + p.name + ".png", p.image);
+    page << "![" << p.name << "](plots/" << p.name << ".png)\n\n";
+  }
+  writeFileAtomic(out + "/README.md", page.str());
+  std::cerr << "[ablate] wrote " << out << "/README.md, tables/ and plots/ from " << results.size() << " of " << jobs.size()
+            << " jobs\n";
+  if (!missing.empty()) {
+    std::cerr << "[ablate] " << missing.size() << " jobs not finished";
+    if (!allow_partial) std::cerr << " (pass --allow-partial to accept)";
+    std::cerr << "\n";
+    return allow_partial ? 0 : 2;
+  }
+  return 0;
+}
+
+int runAblate(const AblateArgs& a) {
+  const AblationGrid g = readAblationGrid(a.config);
+  const std::vector<AblationJob> all = expandGrid(g);
+  int si = 0, sn = 1;
+  if (!a.shard.empty()) std::tie(si, sn) = parseShard(a.shard);
+  const std::vector<AblationJob> jobs = shardJobs(all, si, sn);
+  if (a.list) {
+    for (const auto& j : jobs) {
+      std::printf("%s %s\n", jobFinished(a.out, j) ? "[done]" : "[todo]", j.id.c_str());
+      if (j.kind == AblationJob::Kind::kActive) std::printf("    %s\n", commandLine(activeArgs(j, a.out)).c_str());
+      else std::printf("    prefilter sweep of %s (in-process)\n", j.scene.c_str());
+    }
+    return 0;
+  }
+  fs::create_directories(a.out + "/runs");
+  int failed = 0, done = 0;
+  for (std::size_t k = 0; k < jobs.size(); ++k) {
+    const AblationJob& j = jobs[k];
+    if (jobFinished(a.out, j)) {
+      std::cerr << "[ablate] " << k + 1 << "/" << jobs.size() << " " << j.id << ": finished before, skipped\n";
+      ++done;
+      continue;
+    }
+    std::cerr << "[ablate] " << k + 1 << "/" << jobs.size() << " " << j.id << "\n";
+    try {
+      ensureDataset(sceneOf(g, j.scene));
+      if (j.kind == AblationJob::Kind::kSweep) {
+        runSweep(g, j, a.out);
+      } else {
+        std::vector<std::string> args = activeArgs(j, a.out);
+        // A job killed midway continues from its last checkpoint.
+        if (fs::exists(jobFolder(a.out, j) + "/checkpoint.json")) args.push_back("--resume");
+        if (runCli(args) != 0) throw std::runtime_error(commandLine(args) + " failed");
+      }
+      ++done;
+    } catch (const std::exception& e) {
+      std::cerr << "[ablate] " << j.id << " failed: " << e.what() << "\n";
+      ++failed;
+    }
+  }
+  std::cerr << "[ablate] " << done << " of " << jobs.size() << " jobs finished" << (failed ? ", " + std::to_string(failed) + " failed" : "")
+            << "\n";
+  if (sn > 1) {
+    std::cerr << "[ablate] shard " << si << "/" << sn << " done; when every shard is, run: saresgs ablate merge --config "
+              << a.config << " --out " << a.out << " [--inputs OTHER_OUT,...]\n";
+    return failed ? 1 : 0;
+  }
+  const int rc = writeSummary(g, all, a.out, false);
+  return failed ? 1 : rc;
+}
+
+int runMerge(const AblateArgs& a) {
+  const AblationGrid g = readAblationGrid(a.config);
+  const std::vector<AblationJob> all = expandGrid(g);
+  std::stringstream ss(a.inputs);
+  for (std::string in; std::getline(ss, in, ',');) {
+    if (in.empty() || fs::equivalent(in, a.out)) continue;
+    if (!fs::is_directory(in)) throw InputError(in, "--inputs", "not a folder");
+    for (const auto& j : all) {
+      if (jobFinished(a.out, j) || !jobFinished(in, j)) continue;
+      // Copy beside, then rename: a merge cut short leaves no half-copied job behind.
+      const fs::path dst = jobFolder(a.out, j), tmp = dst.string() + ".merge-tmp";
+      fs::remove_all(tmp);
+      fs::remove_all(dst);
+      fs::create_directories(tmp.parent_path());
+      fs::copy(jobFolder(in, j), tmp, fs::copy_options::recursive);
+      fs::rename(tmp, dst);
+      std::cerr << "[ablate] merged " << j.id << " from " << in << "\n";
+    }
+  }
+  return writeSummary(g, all, a.out, a.allow_partial);
+}
+
+}  // namespace
+
+void addAblateCommand(CLI::App& app, Action& action) {
+  auto a = std::make_shared<AblateArgs>();
+  CLI::App* sub = app.add_subcommand("ablate", "Run an ablation grid of active runs and prefilter sweeps; `ablate merge` makes its tables");
+  sub->add_option("--config", a->config, "Grid JSON (format: nbv/ablation.h)");
+  sub->add_option("--out", a->out, "Output folder (runs/, tables/, plots/, README.md)");
+  sub->add_option("--shard", a->shard, "Run only jobs i, i+n, ... (i/n)");
+  sub->add_flag("--list", a->list, "Print the jobs (and their `saresgs active` command lines) and exit");
+  CLI::App* merge = sub->add_subcommand("merge", "Collect finished jobs (from --inputs) into OUT and write the tables and plots");
+  merge->add_option("--config", a->config, "Grid JSON")->required();
+  merge->add_option("--out", a->out, "Output folder")->required();
+  merge->add_option("--inputs", a->inputs, "Comma-separated shard output folders to copy finished jobs from");
+  merge->add_flag("--allow-partial", a->allow_partial, "Exit 0 even when some jobs are not finished");
+  merge->callback([&action, a] { action = [a] { return runMerge(*a); }; });
+  sub->callback([&action, a, sub, merge] {
+    if (merge->parsed()) return;
+    if (a->config.empty() || a->out.empty()) throw CLI::RequiredError("ablate needs --config and --out");
+    action = [a] { return runAblate(*a); };
+  });
+}
+
+}  // namespace saresgs::apps

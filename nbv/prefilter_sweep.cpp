@@ -1,0 +1,172 @@
+#include "nbv/prefilter_sweep.h"
+
+#include <algorithm>
+#include <chrono>
+#include <numeric>
+#include <random>
+#include <stdexcept>
+
+#include "geometry/occupancy/candidate_sets.h"
+#include "geometry/occupancy/coverage_score.h"
+#include "geometry/occupancy/occupancy_grid.h"
+#include "nbv/active_run.h"
+#include "nbv/initial_views.h"
+
+namespace saresgs {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+PrefilterOptions optionsFor(const std::string& encoding, const std::string& score, double keep_fraction) {
+  PrefilterOptions o;
+  o.keep_percent = 100.0 * keep_fraction;
+  if (score == "xor") o.criterion = CoverageCriterion::Hamming;
+  else if (score == "new") o.criterion = CoverageCriterion::NewCount;
+  else throw std::invalid_argument("sweep score '" + score + "': expected xor or new");
+  if (encoding == "exact") {
+    o.encoding = CoverageEncoding::Exact;
+  } else {
+    int bits = 0;
+    if (encoding.rfind("hash:", 0) == 0) bits = std::atoi(encoding.c_str() + 5);
+    if (bits < 2 || bits > 30) throw std::invalid_argument("sweep encoding '" + encoding + "': expected hash:K or exact");
+    o.encoding = CoverageEncoding::Hashed;
+    o.table_size = std::size_t{1} << bits;
+  }
+  return o;
+}
+
+// The protocol's initial views, then random train views (seeded), `count` in all.
+std::vector<int> observedOrder(const Scene& scene, int count, std::uint64_t seed) {
+  std::vector<Eigen::Vector3d> centers;
+  for (int v : scene.train) centers.push_back(scene.views[static_cast<std::size_t>(v)].camera.center());
+  std::vector<int> order;
+  for (int i : farthestPointSampling(centers, std::min(4, count), 0)) order.push_back(scene.train[static_cast<std::size_t>(i)]);
+  std::vector<int> rest;
+  for (int v : scene.train)
+    if (std::find(order.begin(), order.end(), v) == order.end()) rest.push_back(v);
+  std::mt19937_64 rng(seed);
+  std::shuffle(rest.begin(), rest.end(), rng);
+  for (int v : rest) {
+    if (static_cast<int>(order.size()) >= count) break;
+    order.push_back(v);
+  }
+  return order;
+}
+
+}  // namespace
+
+double kendallTauB(const std::vector<double>& a, const std::vector<double>& b) {
+  if (a.size() != b.size()) throw std::invalid_argument("kendallTauB: sizes differ");
+  long long concordant = 0, discordant = 0, ties_a = 0, ties_b = 0;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    for (std::size_t j = i + 1; j < a.size(); ++j) {
+      const double da = a[i] - a[j], db = b[i] - b[j];
+      if (da == 0 && db == 0) continue;  // tied in both: counted in neither denominator term
+      if (da == 0) ++ties_a;
+      else if (db == 0) ++ties_b;
+      else if ((da > 0) == (db > 0)) ++concordant;
+      else ++discordant;
+    }
+  const double n1 = static_cast<double>(concordant + discordant + ties_a);
+  const double n2 = static_cast<double>(concordant + discordant + ties_b);
+  if (n1 == 0 || n2 == 0) return n1 == n2 ? 1.0 : 0.0;
+  return static_cast<double>(concordant - discordant) / std::sqrt(n1 * n2);
+}
+
+double topOverlap(const std::vector<double>& a, const std::vector<double>& b, double fraction) {
+  std::vector<int> idx(a.size());
+  std::iota(idx.begin(), idx.end(), 0);
+  const std::vector<int> ta = topFraction(a, idx, fraction), tb = topFraction(b, idx, fraction);
+  std::vector<int> both;
+  std::set_intersection(ta.begin(), ta.end(), tb.begin(), tb.end(), std::back_inserter(both));
+  return tb.empty() ? 1.0 : static_cast<double>(both.size()) / static_cast<double>(tb.size());
+}
+
+std::vector<SweepRow> prefilterSweep(const Scene& scene, const SweepSpec& spec, const ViewRenderer& render,
+                                     const DepthRenderer& depth, std::uint64_t seed) {
+  if (spec.view_counts.empty()) throw std::invalid_argument("prefilter sweep: no view counts");
+  std::vector<int> counts = spec.view_counts;
+  std::sort(counts.begin(), counts.end());
+  const std::vector<int> order = observedOrder(scene, counts.back(), seed);
+
+  PrefilterChoice choice;
+  choice.lifting = spec.lifting;
+  choice.encoding = "exact";
+  std::unique_ptr<CoveragePrefilter> pf = makeCoveragePrefilter(scene, choice, seed);
+  const OccupancyGrids& grids = pf->grids();
+
+  // Every train view's candidate sets, once per kind, timed per view.
+  std::map<std::string, std::vector<VoxelSet>> sets;
+  std::map<std::string, std::vector<double>> set_seconds;
+  std::unique_ptr<VisibilityTracer> tracer;
+  for (const std::string& kind : spec.sets) {
+    if (kind != "frustum" && kind != "visible") throw std::invalid_argument("sweep set '" + kind + "': expected frustum or visible");
+    if (kind == "visible" && !tracer) tracer = std::make_unique<VisibilityTracer>(grids);
+    for (int v : scene.train) {
+      const Camera& cam = scene.views[static_cast<std::size_t>(v)].camera;
+      const auto t0 = Clock::now();
+      sets[kind].push_back(kind == "frustum" ? frustumSet(grids, cam) : tracer->visibleSet(cam, choice.visible_stride));
+      set_seconds[kind].push_back(since(t0));
+    }
+  }
+  if (!sets.count("visible")) {  // the reference always needs the visible sets
+    tracer = std::make_unique<VisibilityTracer>(grids);
+    for (int v : scene.train) sets["visible"].push_back(tracer->visibleSet(scene.views[static_cast<std::size_t>(v)].camera, choice.visible_stride));
+  }
+
+  std::vector<SweepRow> rows;
+  int observed = 0;
+  SelectionSeconds ignored;
+  for (int count : counts) {
+    pf->observe(std::vector<int>(order.begin() + observed, order.begin() + count), render, depth, ignored);
+    observed = count;
+    const VoxelSet obs = grids.observedSceneVoxels();
+    std::vector<std::size_t> cand;  // positions in scene.train
+    for (std::size_t i = 0; i < scene.train.size(); ++i)
+      if (std::find(order.begin(), order.begin() + count, scene.train[i]) == order.begin() + count) cand.push_back(i);
+    auto pick = [&](const std::string& kind) {
+      std::vector<VoxelSet> s;
+      for (std::size_t i : cand) s.push_back(sets.at(kind)[i]);
+      return s;
+    };
+    auto values = [&](const std::vector<VoxelSet>& s, const PrefilterOptions& o) {
+      std::vector<double> out;
+      for (const auto& c : scoreCandidates(obs, s, grids.sceneCount(), o)) out.push_back(criterionValue(c, o.criterion));
+      return out;
+    };
+    for (const std::string& score : spec.scores) {
+      const std::vector<double> ref = values(pick("visible"), optionsFor("exact", score, spec.keep_fraction));
+      for (const std::string& kind : spec.sets) {
+        const std::vector<VoxelSet> s = pick(kind);
+        double set_s = 0;
+        for (std::size_t i : cand) set_s += set_seconds.at(kind)[i];
+        for (const std::string& enc : spec.encodings) {
+          const PrefilterOptions o = optionsFor(enc, score, spec.keep_fraction);
+          std::vector<double> times, v;
+          for (int r = 0; r < std::max(1, spec.timing_repeats); ++r) {
+            const auto t0 = Clock::now();
+            v = values(s, o);
+            times.push_back(since(t0));
+          }
+          std::nth_element(times.begin(), times.begin() + static_cast<long>(times.size() / 2), times.end());
+          SweepRow row;
+          row.set = kind;
+          row.encoding = enc;
+          row.score = score;
+          row.views = count;
+          row.candidates = static_cast<int>(cand.size());
+          row.overlap = topOverlap(v, ref, spec.keep_fraction);
+          row.kendall_tau = kendallTauB(v, ref);
+          row.seconds_scoring = times[times.size() / 2];
+          row.seconds_sets = set_s;
+          rows.push_back(row);
+        }
+      }
+    }
+  }
+  return rows;
+}
+
+}  // namespace saresgs

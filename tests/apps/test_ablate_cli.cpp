@@ -1,0 +1,131 @@
+// `saresgs ablate` as a user runs it: two shard processes into two folders, a merge, the
+// tables and plots it writes, and a killed runner that restarts without redoing jobs.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sys/wait.h>
+
+#include "common/test_support.h"
+#include "geometry/image/image.h"
+
+using saresgs::test::TempDir;
+using saresgs::test::readBytes;
+using saresgs::test::writeBytes;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int code;
+  std::string output;
+};
+
+Result shell(const std::string& script) {
+  FILE* p = popen(("bash -c '" + script + "' 2>&1").c_str(), "r");
+  if (!p) return {-1, "popen failed"};
+  std::string out;
+  std::array<char, 4096> buf;
+  while (size_t n = fread(buf.data(), 1, buf.size(), p)) out.append(buf.data(), n);
+  const int status = pclose(p);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+std::string cli() { return SARESGS_CLI; }
+
+int count(const std::string& s, const std::string& what) {
+  int n = 0;
+  for (std::size_t p = s.find(what); p != std::string::npos; p = s.find(what, p + 1)) ++n;
+  return n;
+}
+
+// A grid small enough for a test: one generated 64x48 scene, two cheap methods, two
+// seeds, 5 views with a few iterations each, and a prefilter sweep.
+std::string writeGrid(const TempDir& d) {
+  const std::string grid = d.file("grid.json");
+  writeBytes(grid, R"({
+    "scenes": [{"name": "tiny", "dataset": ")" + d.file("tiny") + R"(", "layout": "object"}],
+    "methods": ["random", "fvs"],
+    "seeds": [0, 1],
+    "threads": 1,
+    "variants": [{"name": "default", "args": ["--max-views", "5", "--interval", "3", "--iterations", "30"]}],
+    "tables": [{"name": "criteria", "title": "Prefilter criteria", "methods": ["random", "fvs"]}],
+    "sweep": {"views": [4], "encodings": ["hash:11", "hash:16", "exact"], "lifting": "depth", "timing_repeats": 1}
+  })");
+  // Small images keep the generated scene and the runs fast.
+  const Result r = shell(cli() + " scene --layout object --views 12 --width 64 --height 48 --out " + d.file("tiny"));
+  EXPECT_EQ(r.code, 0) << r.output;
+  return grid;
+}
+
+}  // namespace
+
+TEST(AblateCli, TwoShardsAndAMergeMakeTablesAndPlots) {
+  TempDir d;
+  const std::string grid = writeGrid(d);
+  const std::string a = d.file("shard0"), b = d.file("shard1");
+  Result r = shell(cli() + " ablate --config " + grid + " --out " + a + " --list");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(count(r.output, "[todo]"), 5) << r.output;  // 1 sweep + 2 methods x 2 seeds
+  EXPECT_NE(r.output.find("saresgs active --dataset"), std::string::npos) << r.output;
+
+  // Two processes at once, each writing its own folder, as two machines would.
+  r = shell(cli() + " ablate --config " + grid + " --out " + a + " --shard 0/2 > " + d.file("log0") + " 2>&1 & " + cli() +
+            " ablate --config " + grid + " --out " + b + " --shard 1/2 > " + d.file("log1") + " 2>&1; s1=$?; wait $!; s0=$?; " +
+            "exit $((s0 + s1))");
+  ASSERT_EQ(r.code, 0) << readBytes(d.file("log0")) << readBytes(d.file("log1"));
+  EXPECT_NE(readBytes(d.file("log1")).find("ablate merge"), std::string::npos);  // the shard says what comes next
+
+  // Without the other shard's jobs the merge is partial and says so.
+  r = shell(cli() + " ablate merge --config " + grid + " --out " + a);
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("not finished"), std::string::npos) << r.output;
+  r = shell(cli() + " ablate merge --config " + grid + " --out " + a + " --inputs " + b);
+  ASSERT_EQ(r.code, 0) << r.output;
+
+  const std::string results = readBytes(a + "/tables/results.md");
+  EXPECT_NE(results.find("| tiny | random | 2 |"), std::string::npos) << results;
+  EXPECT_NE(results.find("| tiny | fvs | 2 |"), std::string::npos) << results;
+  const std::string csv = readBytes(a + "/tables/results.csv");
+  EXPECT_EQ(count(csv, "\n"), 3) << csv;  // header + 2 rows
+  EXPECT_NE(csv.find("PSNR_mean,PSNR_std"), std::string::npos) << csv;
+  EXPECT_TRUE(fs::exists(a + "/tables/criteria.md"));
+  EXPECT_TRUE(fs::exists(a + "/tables/time.csv"));
+  const std::string sweep = readBytes(a + "/tables/prefilter_sweep.md");
+  EXPECT_EQ(count(sweep, "| tiny |"), 2 * 2 * 3) << sweep;  // sets x scores x encodings
+  for (const char* p : {"psnr", "psnr_vs_views", "psnr_vs_selection_time", "prefilter_sweep_tiny"}) {
+    const saresgs::Image8 img = saresgs::readImage(a + "/plots/" + p + ".png");
+    EXPECT_GT(img.width, 100) << p;
+  }
+  EXPECT_NE(readBytes(a + "/README.md").find("plots/psnr.png"), std::string::npos);
+}
+
+TEST(AblateCli, AKilledRunnerRestartsWithoutRedoingFinishedJobs) {
+  TempDir d;
+  const std::string grid = writeGrid(d);
+  const std::string out = d.file("out");
+  // Kill the runner (SIGKILL, no clean-up) as soon as its second job has finished.
+  const std::string second = out + "/runs/tiny__random__default__s0/results.json";
+  Result r = shell(cli() + " ablate --config " + grid + " --out " + out + " > " + d.file("log") + " 2>&1 & pid=$!; " +
+                   "for i in $(seq 1 600); do [ -f " + second + " ] && break; sleep 0.1; done; kill -9 $pid; wait $pid; true");
+  ASSERT_TRUE(fs::exists(second)) << readBytes(d.file("log"));
+  const auto sweep_file = out + "/runs/tiny__prefilter-sweep/sweep.json";
+  ASSERT_TRUE(fs::exists(sweep_file));
+  const auto t_sweep = fs::last_write_time(sweep_file), t_second = fs::last_write_time(second);
+  const std::string sweep_bytes = readBytes(sweep_file), second_bytes = readBytes(second);
+
+  r = shell(cli() + " ablate --config " + grid + " --out " + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(count(r.output, "finished before, skipped"), 2) << r.output;
+  EXPECT_EQ(fs::last_write_time(sweep_file), t_sweep);
+  EXPECT_EQ(fs::last_write_time(second), t_second);
+  EXPECT_EQ(readBytes(sweep_file), sweep_bytes);
+  EXPECT_EQ(readBytes(second), second_bytes);
+  // A third start finds everything done and only rewrites the summary.
+  r = shell(cli() + " ablate --config " + grid + " --out " + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(count(r.output, "finished before, skipped"), 5) << r.output;
+  EXPECT_TRUE(fs::exists(out + "/tables/results.md"));
+}
