@@ -43,7 +43,7 @@ std::vector<double> linearTicks(double lo, double hi) {
 
 void drawPanel(cv::Mat& img, const PlotPanel& p) {
   const int W = img.cols, H = img.rows;
-  const int left = 62, right = 14, top = 30, bottom = 58;
+  const int left = 62, right = 14, top = 30, bottom = 78;
   const auto font = cv::FONT_HERSHEY_SIMPLEX;
   const cv::Scalar black(0, 0, 0), grey(225, 225, 225);
   auto fx = [&](double x) { return p.log_x ? std::log10(x) : x; };
@@ -93,11 +93,17 @@ void drawPanel(cv::Mat& img, const PlotPanel& p) {
       cv::putText(img, p.x_categories[i], cv::Point(a.x - sz.width / 2, top + ph + 16), font, 0.38, black, 1, cv::LINE_AA);
     }
   } else if (p.log_x) {
-    for (int e = static_cast<int>(std::ceil(x0)); e <= static_cast<int>(std::floor(x1)); ++e) {
-      const cv::Point a = Praw(e, y0), b = Praw(e, y1);
-      cv::line(img, a, b, grey, 1);
-      cv::putText(img, tick(std::pow(10.0, e)), cv::Point(a.x - 12, top + ph + 16), font, 0.38, black, 1, cv::LINE_AA);
-    }
+    // Decades, plus 2 and 5 within them when the axis spans less than two decades.
+    const bool fine = x1 - x0 < 2;
+    for (int e = static_cast<int>(std::floor(x0)); e <= static_cast<int>(std::ceil(x1)); ++e)
+      for (double m : {1.0, 2.0, 5.0}) {
+        if (m != 1.0 && !fine) continue;
+        const double lx = e + std::log10(m);
+        if (lx < x0 || lx > x1) continue;
+        const cv::Point a = Praw(lx, y0), b = Praw(lx, y1);
+        cv::line(img, a, b, grey, 1);
+        cv::putText(img, tick(m * std::pow(10.0, e)), cv::Point(a.x - 12, top + ph + 16), font, 0.38, black, 1, cv::LINE_AA);
+      }
   } else {
     for (double x : linearTicks(x0, x1)) {
       const cv::Point a = Praw(x, y0), b = Praw(x, y1);
@@ -106,16 +112,12 @@ void drawPanel(cv::Mat& img, const PlotPanel& p) {
     }
   }
   cv::rectangle(img, cv::Point(left, top), cv::Point(left + pw, top + ph), black, 1);
-  cv::putText(img, p.xlabel, cv::Point(left + pw / 2 - 4 * static_cast<int>(p.xlabel.size()), H - 22), font, 0.42, black, 1,
+  cv::putText(img, p.xlabel, cv::Point(left + pw / 2 - 4 * static_cast<int>(p.xlabel.size()), top + ph + 36), font, 0.42, black, 1,
               cv::LINE_AA);
   cv::putText(img, p.ylabel, cv::Point(4, top - 8 + 0), font, 0.38, black, 1, cv::LINE_AA);
-  // Legend box first (top left, white under the text), then the series over the grid.
-  int legend_w = 0;
-  for (const auto& s : p.series) legend_w = std::max(legend_w, cv::getTextSize(s.label, font, 0.4, 1, nullptr).width);
-  if (!p.series.empty())
-    cv::rectangle(img, cv::Point(left + 4, top + 2), cv::Point(left + 34 + legend_w, top + 6 + 15 * static_cast<int>(p.series.size())),
-                  cv::Scalar(255, 255, 255), cv::FILLED);
-  int legend_y = top + 14;
+  // The legend goes in a row under the axis label, where it hides no data.
+  int legend_x = left;
+
   for (std::size_t si = 0; si < p.series.size(); ++si) {
     const PlotSeries& s = p.series[si];
     const cv::Scalar c = kPalette[si % std::size(kPalette)];
@@ -134,9 +136,10 @@ void drawPanel(cv::Mat& img, const PlotPanel& p) {
       pts.push_back(q);
     }
     if (s.lines && pts.size() > 1) cv::polylines(img, pts, false, c, 2, cv::LINE_AA);
-    cv::line(img, cv::Point(left + 8, legend_y - 4), cv::Point(left + 26, legend_y - 4), c, 2, cv::LINE_AA);
-    cv::putText(img, s.label, cv::Point(left + 30, legend_y), font, 0.4, black, 1, cv::LINE_AA);
-    legend_y += 15;
+    const int ly = H - 10;
+    cv::line(img, cv::Point(legend_x, ly - 4), cv::Point(legend_x + 18, ly - 4), c, 2, cv::LINE_AA);
+    cv::putText(img, s.label, cv::Point(legend_x + 22, ly), font, 0.4, black, 1, cv::LINE_AA);
+    legend_x += 34 + cv::getTextSize(s.label, font, 0.4, 1, nullptr).width;
   }
 }
 
