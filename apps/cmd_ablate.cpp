@@ -183,8 +183,9 @@ int runMerge(const AblateArgs& a) {
   const std::vector<AblationJob> all = expandGrid(g);
   std::stringstream ss(a.inputs);
   for (std::string in; std::getline(ss, in, ',');) {
-    if (in.empty() || fs::equivalent(in, a.out)) continue;
+    if (in.empty()) continue;
     if (!fs::is_directory(in)) throw InputError(in, "--inputs", "not a folder");
+    if (fs::exists(a.out) && fs::equivalent(in, a.out)) continue;
     for (const auto& j : all) {
       if (jobFinished(a.out, j) || !jobFinished(in, j)) continue;
       // Copy beside, then rename: a merge cut short leaves no half-copied job behind.

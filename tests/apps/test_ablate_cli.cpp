@@ -2,12 +2,10 @@
 // tables and plots it writes, and a killed runner that restarts without redoing jobs.
 #include <gtest/gtest.h>
 
-#include <array>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <sys/wait.h>
 
+#include "common/run_command.h"
 #include "common/test_support.h"
 #include "geometry/image/image.h"
 
@@ -18,20 +16,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-  int code;
-  std::string output;
-};
+using Result = saresgs::test::CommandResult;
 
-Result shell(const std::string& script) {
-  FILE* p = popen(("bash -c '" + script + "' 2>&1").c_str(), "r");
-  if (!p) return {-1, "popen failed"};
-  std::string out;
-  std::array<char, 4096> buf;
-  while (size_t n = fread(buf.data(), 1, buf.size(), p)) out.append(buf.data(), n);
-  const int status = pclose(p);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
+Result shell(const std::string& script) { return saresgs::test::runCommand("bash -c '" + script + "'"); }
 
 std::string cli() { return SARESGS_CLI; }
 
@@ -82,6 +69,10 @@ TEST(AblateCli, TwoShardsAndAMergeMakeTablesAndPlots) {
   r = shell(cli() + " ablate merge --config " + grid + " --out " + a);
   EXPECT_EQ(r.code, 2) << r.output;
   EXPECT_NE(r.output.find("not finished"), std::string::npos) << r.output;
+  r = shell(cli() + " ablate merge --config " + grid + " --out " + a + " --inputs " + d.file("nowhere"));
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.output.find(d.file("nowhere")), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("not a folder"), std::string::npos) << r.output;
   r = shell(cli() + " ablate merge --config " + grid + " --out " + a + " --inputs " + b);
   ASSERT_EQ(r.code, 0) << r.output;
 

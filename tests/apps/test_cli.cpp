@@ -1,11 +1,9 @@
 // Runs the real `saresgs` binary as a user would: exit codes, messages, outputs.
 #include <gtest/gtest.h>
 
-#include <array>
-#include <cstdio>
 #include <filesystem>
-#include <sys/wait.h>
 
+#include "common/run_command.h"
 #include "common/test_support.h"
 #include "geometry/scene/scene.h"
 
@@ -14,21 +12,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-  int code;
-  std::string output;  // stdout and stderr together
-};
+using Result = saresgs::test::CommandResult;
 
-Result run(const std::string& args) {
-  const std::string cmd = std::string(SARESGS_CLI) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return {-1, "popen failed"};
-  std::string out;
-  std::array<char, 4096> buf;
-  while (size_t n = fread(buf.data(), 1, buf.size(), p)) out.append(buf.data(), n);
-  const int status = pclose(p);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
+Result run(const std::string& args) { return saresgs::test::runCommand(std::string(SARESGS_CLI) + " " + args); }
 
 }  // namespace
 
