@@ -11,6 +11,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <mutex>
 #include <cstdlib>
 #include <stdexcept>
@@ -38,6 +39,7 @@ template <typename T>
 struct RasterStateT {
   RasterSettings settings;
   std::vector<Projected<T>> proj;  // per Gaussian
+  std::vector<TileGaussian<T>> tile_data;  // per Gaussian: what the tile kernels read
   int tiles_x = 0, tiles_y = 0;
   std::vector<std::uint32_t> gauss_start;  // N + 1: each Gaussian's pair slots
   std::vector<std::uint32_t> tile_start;   // tiles + 1
@@ -114,14 +116,35 @@ void pixelRange(T mean, T half, int n, int& lo, int& hi) {
   hi = std::min(n - 1, static_cast<int>(std::floor(mean + half - T(0.5))));
 }
 
+// A projected Gaussian as the tile kernels read it. The chord terms (splat/raster_kernels.h):
+// a pixel at offset (dx, dy) can pass o G >= 1/255 only where a dx^2 + 2 b dx dy + c dy^2
+// <= k2 = 2 ln(255 o), i.e. |dx + (b/a) dy| <= sqrt(k2/a - (det/a^2) dy^2), det = ac - b^2.
+// The float test rounds each term of its exponent, so its boundary can move by a few ulp
+// of the terms' sizes, which are at most ~4 kappa k2 with kappa = (a + c)^2 / (4 det)
+// (1 for a circle); k2 is widened by 1% + 1e-4, far more than that for kappa <= 250.
+// Beyond (needle-like Gaussians) or for anything not finite, no chord: the loops then
+// cover the whole rectangle, as they would without these terms.
+template <typename T>
+TileGaussian<T> tileData(const Projected<T>& P) {
+  TileGaussian<T> q{P.mean2d[0], P.mean2d[1], P.conic[0], P.conic[1], P.conic[2], P.opacity, P.half[0],
+                    P.half[1], P.depth, {P.color[0], P.color[1], P.color[2]}, T(0),
+                    std::numeric_limits<T>::max(), T(0)};
+  const double a = P.conic[0], b = P.conic[1], c = P.conic[2], o = P.opacity;
+  const double det = a * c - b * b;
+  const double k2 = 2.0 * std::log(255.0 * o) * 1.01 + 1e-4;
+  if (a > 0 && det > 0 && std::isfinite(a + b + c + det + k2) && (a + c) * (a + c) <= 1000.0 * det) {
+    q.chord_slope = static_cast<T>(-b / a);
+    q.chord_k0 = static_cast<T>(k2 / a);
+    q.chord_k1 = static_cast<T>(det / (a * a));
+  }
+  return q;
+}
+
 template <typename T>
 void gatherTile(const RasterStateT<T>& st, int tile, std::vector<TileGaussian<T>>& out) {
-  out.clear();
-  for (std::uint32_t e = st.tile_start[tile]; e < st.tile_start[tile + 1]; ++e) {
-    const Projected<T>& P = st.proj[st.entry_gauss[e]];
-    out.push_back({P.mean2d[0], P.mean2d[1], P.conic[0], P.conic[1], P.conic[2], P.opacity, P.half[0],
-                   P.half[1], P.depth, {P.color[0], P.color[1], P.color[2]}});
-  }
+  const std::uint32_t b = st.tile_start[tile], e = st.tile_start[tile + 1];
+  out.resize(e - b);
+  for (std::uint32_t k = b; k < e; ++k) out[k - b] = st.tile_data[st.entry_gauss[k]];
 }
 
 // exp for x <= 0 in float without a libm call, so the pixel loops vectorise: Cody-Waite
@@ -321,6 +344,7 @@ RenderOutputT<T> rasterizeT(const GaussiansT<T>& g, const Camera& cam, const Ras
   st->final_T.assign(static_cast<std::size_t>(W) * H, T(1));
   st->n_walked.assign(static_cast<std::size_t>(W) * H, 0);
   st->proj.resize(n);
+  st->tile_data.resize(n);
   std::vector<std::uint32_t> count(n, 0);
   std::vector<std::array<int, 4>> tile_rect(n);  // tiles touched: x0, x1, y0, y1 (inclusive)
 
@@ -334,6 +358,7 @@ RenderOutputT<T> rasterizeT(const GaussiansT<T>& g, const Camera& cam, const Ras
         }
         Projected<T>& P = st->proj[i] = projection::project(g, i, camT, rs);
         if (!P.visible) continue;
+        st->tile_data[i] = tileData(P);
         out.visible[i] = 1;
         out.radii[i] = P.radius;
         int px0, px1, py0, py1;
