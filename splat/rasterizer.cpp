@@ -196,6 +196,46 @@ bool evalAlpha(const TileGaussian<T>& q, T px, T py, T& dx, T& dy, T& G, T& alph
   return alpha >= T(kMinAlpha);
 }
 
+// Rule 6 for every tile at once: the Gaussians with pairs, by camera z, ties by index.
+// Binning them in this order (a stable counting sort by tile) leaves every tile sorted,
+// which costs far less than sorting each tile. Float depths go through a stable LSD radix
+// sort on their bits (mapped so that unsigned order is float order); double uses
+// std::sort.
+template <typename T>
+std::vector<std::uint32_t> depthOrder(const std::vector<Projected<T>>& proj, const std::vector<std::uint32_t>& count) {
+  std::vector<std::uint32_t> order;
+  order.reserve(proj.size());
+  for (std::size_t i = 0; i < proj.size(); ++i)
+    if (count[i]) order.push_back(static_cast<std::uint32_t>(i));
+  if constexpr (std::is_same_v<T, float>) {
+    const std::size_t m = order.size();
+    std::vector<std::uint32_t> key(m), key2(m), order2(m);
+    for (std::size_t j = 0; j < m; ++j) {
+      // + 0 turns -0 into +0, which the comparison of rule 6 treats as equal.
+      const std::uint32_t b = std::bit_cast<std::uint32_t>(proj[order[j]].depth + 0.0f);
+      key[j] = (b & 0x80000000u) ? ~b : (b | 0x80000000u);
+    }
+    constexpr int kBits = 11, kBuckets = 1 << kBits;
+    for (int shift = 0; shift < 32; shift += kBits) {
+      std::array<std::uint32_t, kBuckets + 1> start{};
+      for (std::size_t j = 0; j < m; ++j) ++start[((key[j] >> shift) & (kBuckets - 1)) + 1];
+      for (int k = 0; k < kBuckets; ++k) start[k + 1] += start[k];
+      for (std::size_t j = 0; j < m; ++j) {
+        const std::uint32_t d = start[(key[j] >> shift) & (kBuckets - 1)]++;
+        key2[d] = key[j];
+        order2[d] = order[j];
+      }
+      key.swap(key2);
+      order.swap(order2);
+    }
+  } else {
+    std::sort(order.begin(), order.end(), [&](std::uint32_t x, std::uint32_t y) {
+      return proj[x].depth < proj[y].depth || (proj[x].depth == proj[y].depth && x < y);
+    });
+  }
+  return order;
+}
+
 template <typename T>
 void tilePixels(const RasterStateT<T>& st, int tile, int width, int height, int& x0, int& y0, int& x1,
                 int& y1) {
@@ -372,7 +412,8 @@ RenderOutputT<T> rasterizeT(const GaussiansT<T>& g, const Camera& cam, const Ras
     });
   });
 
-  // Pair slots, Gaussian-major, then a stable counting sort by tile.
+  // Pair slots, Gaussian-major, then a stable counting sort by tile of the Gaussians in
+  // depth order (depthOrder), so each tile comes out sorted by rule 6.
   st->gauss_start.assign(n + 1, 0);
   for (std::size_t i = 0; i < n; ++i) st->gauss_start[i + 1] = st->gauss_start[i] + count[i];
   const std::uint32_t pairs = st->gauss_start[n];
@@ -396,10 +437,10 @@ RenderOutputT<T> rasterizeT(const GaussiansT<T>& g, const Camera& cam, const Ras
   st->entry_slot.resize(pairs);
   {
     std::vector<std::uint32_t> fill(st->tile_start.begin(), st->tile_start.end() - 1);
-    for (std::size_t i = 0; i < n; ++i)
+    for (const std::uint32_t i : depthOrder(st->proj, count))
       for (std::uint32_t k = st->gauss_start[i]; k < st->gauss_start[i + 1]; ++k) {
         const std::uint32_t e = fill[slot_tile[k]]++;
-        st->entry_gauss[e] = static_cast<std::uint32_t>(i);
+        st->entry_gauss[e] = i;
         st->entry_slot[e] = k;
       }
   }
@@ -407,23 +448,6 @@ RenderOutputT<T> rasterizeT(const GaussiansT<T>& g, const Camera& cam, const Ras
   const T bg[3] = {T(s.background[0]), T(s.background[1]), T(s.background[2])};
   arena().execute([&] {
     tbb::parallel_for(0, tiles, [&](int tile) {
-      // Rule 6: by camera z, ties by index.
-      struct Entry {
-        T depth;
-        std::uint32_t gauss, slot;
-      };
-      const std::uint32_t b = st->tile_start[tile], e = st->tile_start[tile + 1];
-      std::vector<Entry> entries(e - b);
-      for (std::uint32_t k = b; k < e; ++k)
-        entries[k - b] = {st->proj[st->entry_gauss[k]].depth, st->entry_gauss[k], st->entry_slot[k]};
-      std::sort(entries.begin(), entries.end(), [](const Entry& x, const Entry& y) {
-        return x.depth < y.depth || (x.depth == y.depth && x.gauss < y.gauss);
-      });
-      for (std::uint32_t k = b; k < e; ++k) {
-        st->entry_gauss[k] = entries[k - b].gauss;
-        st->entry_slot[k] = entries[k - b].slot;
-      }
-
       thread_local std::vector<TileGaussian<T>> q;
       gatherTile(*st, tile, q);
       int x0, y0, x1, y1;
