@@ -11,11 +11,16 @@
 
 namespace saresgs {
 
-// One Gaussian's data gathered per tile, in the tile's order.
+// One Gaussian's data gathered per tile, in the tile's order. The chord terms bound, per
+// pixel row at offset dy from the mean, the columns where o G >= 1/255 can hold: centred
+// on mx + chord_slope dy with half width sqrt(chord_k0 - chord_k1 dy^2), widened so the
+// float per-pixel test never passes outside it (chordTerms in rasterizer.cpp). They only
+// shorten the kernels' loops; the per-pixel test decides.
 template <typename T>
 struct TileGaussian {
   T mx, my, a, b, c, o, hx, hy, depth;
   T col[3];
+  T chord_slope, chord_k0, chord_k1;
 };
 
 namespace raster_kernels {

@@ -46,14 +46,28 @@ inline vf fma(vf a, vf b, vf c) {
 #endif
 }
 
-inline vf vs(float x) {
+// x in every lane. Written as a scalar-vector operation so that GCC emits one broadcast
+// (a per-lane loop became a chain of inserts); x - (+0) is x exactly, -0 included.
+inline vf vs(float x) { return x - vf{}; }
+// A tile's pixels are stored in blocks of kBW x kBH pixels, one block per vector: four
+// columns by one row for four lanes, four by two for eight. The Gaussians are small
+// (a few pixels across), so a squarer block wastes fewer lanes on pixels they miss than
+// a row of eight would.
+constexpr int kBW = 4;
+constexpr int kBH = L / kBW;
+constexpr int kBX = kTile / kBW;  // blocks per block row
+static_assert(kTile % kBW == 0 && kTile % kBH == 0);
+// The tile row and column of storage index k.
+inline int blockRow(int k) { return (k / L) / kBX * kBH + (k % L) / kBW; }
+inline int blockCol(int k) { return (k / L) % kBX * kBW + (k % L) % kBW; }
+inline vf laneColCentres() {  // 0.5, 1.5, 2.5, 3.5, 0.5, ...
   vf v;
-  for (int i = 0; i < L; ++i) v[i] = x;
+  for (int i = 0; i < L; ++i) v[i] = static_cast<float>(i % kBW) + 0.5f;
   return v;
 }
-inline vf laneCentres() {  // 0.5, 1.5, ...
+inline vf laneRowCentres() {  // 0.5 x4, then 1.5 x4 for eight lanes
   vf v;
-  for (int i = 0; i < L; ++i) v[i] = static_cast<float>(i) + 0.5f;
+  for (int i = 0; i < L; ++i) v[i] = static_cast<float>(i / kBW) + 0.5f;
   return v;
 }
 inline vf load(const float* p) {
@@ -100,9 +114,10 @@ inline vf expNonPositive(vf x) {
   return x < lo ? vs(0.0f) : p * scale;
 }
 
-// The row terms of a Gaussian's exponent, hoisted out of the pixel loops.
-inline float rowQuad(const TileGaussian<float>& q, float dy) { return -0.5f * q.c * dy * dy; }
-inline float rowCross(const TileGaussian<float>& q, float dy) { return q.b * dy; }
+// The row terms of a Gaussian's exponent, hoisted out of the pixel loops; per lane, as a
+// block spans kBH rows, in the same operation order for every block shape.
+inline vf rowQuad(const TileGaussian<float>& q, vf dy) { return (vs(-0.5f * q.c) * dy) * dy; }
+inline vf rowCross(const TileGaussian<float>& q, vf dy) { return vs(q.b) * dy; }
 
 // One Gaussian at L pixel centres of a row: the quantities both kernels need, computed
 // in one place so that the forward and backward passes make identical threshold
@@ -113,7 +128,7 @@ struct Lanes {
   vi touches;
 };
 
-inline Lanes evalLanes(vf dx, vf ha, vf qy, vf by, vf o, vf hx) {
+inline Lanes evalLanes(vf dx, vf ha, vf qy, vf by, vf o, vf hx, vi row_in) {
   Lanes l;
   l.dx = dx;
   // ((-0.5 a) dx) dx + row_quad - row_cross dx.
@@ -126,7 +141,7 @@ inline Lanes evalLanes(vf dx, vf ha, vf qy, vf by, vf o, vf hx) {
   l.oG = o * l.G;
   l.alpha = l.oG < vs(kMaxA) ? l.oG : vs(kMaxA);
   const vf adx = reinterpret_cast<vf>(reinterpret_cast<vi>(dx) & 0x7fffffff);
-  l.touches = (adx <= hx) & (power <= vs(0.0f)) & (l.oG >= vs(kMinA));
+  l.touches = row_in & (adx <= hx) & (power <= vs(0.0f)) & (l.oG >= vs(kMinA));
   return l;
 }
 
@@ -147,6 +162,36 @@ inline void tileSpan(float mean, float half, int origin, int limit, int& lo, int
   hi = static_cast<int>(u);
 }
 
+// The columns [lo, hi] (tile offsets, within the Gaussian's span [c0, c1]) that the
+// Gaussian may touch in block row rb: its rows' alpha-ellipse chords
+// (TileGaussian::chord_*, widened against rounding) all lie within [min centre - widest
+// half, max centre + widest half], plus 0.01 px for the centres' own rounding. One square
+// root per block row; empty (lo > hi) when no row of the block meets the ellipse. Loop
+// bounds only: the per-pixel test decides.
+inline void blockRowSpan(const TileGaussian<float>& g, int x0, int y0, int rb, int c0, int c1, int& lo,
+                         int& hi) {
+  lo = c1 + 1;
+  hi = c0 - 1;
+  const float dy0 = static_cast<float>(y0 + rb * kBH) + 0.5f - g.my;
+  const float dy1 = dy0 + static_cast<float>(kBH - 1);
+  // The row nearest the centre has the widest chord.
+  const float dmin = dy0 > 0.0f ? dy0 : (dy1 < 0.0f ? dy1 : 0.0f);
+  const float t = g.chord_k0 - g.chord_k1 * (dmin * dmin);
+  if (t < 0.0f) return;
+  const float half = std::sqrt(t) + 0.01f;
+  const float xa = g.mx + g.chord_slope * dy0 - static_cast<float>(x0);
+  const float xb = g.mx + g.chord_slope * dy1 - static_cast<float>(x0);
+  float l = (xa < xb ? xa : xb) - half - 0.5f, u = (xa < xb ? xb : xa) + half - 0.5f;
+  if (!(l >= static_cast<float>(c0))) l = static_cast<float>(c0);  // NaN: no bound
+  if (!(u <= static_cast<float>(c1))) u = static_cast<float>(c1);
+  if (l > static_cast<float>(c1) || u < static_cast<float>(c0)) return;
+  lo = static_cast<int>(l);  // l >= 0: truncation, then up to the ceiling
+  if (static_cast<float>(lo) < l) ++lo;
+  hi = static_cast<int>(u);
+}
+
+inline vi absLe(vf v, vf bound) { return reinterpret_cast<vf>(reinterpret_cast<vi>(v) & 0x7fffffff) <= bound; }
+
 }  // namespace
 
 // Front-to-back compositing, Gaussian by Gaussian over the pixels of its rectangle, so
@@ -159,29 +204,33 @@ void compositeTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1,
   alignas(64) float Tr[P], C0[P], C1[P], C2[P], D[P], walked[P], contrib[P];
   const int w = x1 - x0, h = y1 - y0;
   for (int k = 0; k < P; ++k) {
-    const bool inside = (k % kTile) < w && (k / kTile) < h;
+    const bool inside = blockCol(k) < w && blockRow(k) < h;
     Tr[k] = inside ? 1.0f : -1.0f;  // pixels beyond the image never composite
     C0[k] = C1[k] = C2[k] = D[k] = walked[k] = contrib[k] = 0.0f;
   }
   int n_active = w * h;
-  const vf lane = laneCentres();
+  const vf lane_x = laneColCentres(), lane_y = laneRowCentres();
   for (int j = 0; j < nq && n_active > 0; ++j) {
     const TileGaussian<float>& g = q[j];
     int c0, c1, r0, r1;
     tileSpan(g.mx, g.hx, x0, x1, c0, c1);
     tileSpan(g.my, g.hy, y0, y1, r0, r1);
     if (c0 > c1) continue;
-    const vf mx = vs(g.mx), hx = vs(g.hx), o = vs(g.o), jf = vs(static_cast<float>(j + 1));
+    const vf mx = vs(g.mx), my = vs(g.my), hx = vs(g.hx), hy = vs(g.hy), o = vs(g.o);
+    const vf jf = vs(static_cast<float>(j + 1));
     const vf ha = vs(-0.5f) * vs(g.a);
     const vf col0 = vs(g.col[0]), col1 = vs(g.col[1]), col2 = vs(g.col[2]), dep = vs(g.depth);
     vi stopped = vi{} + 0;
-    for (int r = r0; r <= r1; ++r) {
-      const float dy = static_cast<float>(y0 + r) + 0.5f - g.my;
-      if (!(std::abs(dy) <= g.hy)) continue;
-      const vf qy = vs(rowQuad(g, dy)), by = vs(rowCross(g, dy));
-      for (int cb = c0 & ~(L - 1); cb <= c1; cb += L) {
-        const int k = r * kTile + cb;
-        const Lanes Ln = evalLanes((vs(static_cast<float>(x0 + cb)) + lane) - mx, ha, qy, by, o, hx);
+    for (int rb = r0 / kBH; rb <= r1 / kBH; ++rb) {
+      int lo, hi;
+      blockRowSpan(g, x0, y0, rb, c0, c1, lo, hi);
+      if (lo > hi) continue;
+      const vf dy = (vs(static_cast<float>(y0 + rb * kBH)) + lane_y) - my;
+      const vi row_in = absLe(dy, hy);
+      const vf qy = rowQuad(g, dy), by = rowCross(g, dy);
+      for (int cb = lo & ~(kBW - 1); cb <= hi; cb += kBW) {
+        const int k = (rb * kBX + cb / kBW) * L;
+        const Lanes Ln = evalLanes((vs(static_cast<float>(x0 + cb)) + lane_x) - mx, ha, qy, by, o, hx, row_in);
         const vf alpha = Ln.alpha;
         vf t = load(Tr + k);
         const vi ok = (t > vs(0.0f)) & Ln.touches;
@@ -201,20 +250,20 @@ void compositeTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1,
     }
     n_active -= hsumInt(stopped);
   }
-  for (int r = 0; r < h; ++r)
-    for (int c = 0; c < w; ++c) {
-      const int k = r * kTile + c;
-      const float T = std::abs(Tr[k]);
-      const std::size_t pix = static_cast<std::size_t>(y0 + r) * out.W + (x0 + c);
-      out.rgb[pix * 3] = C0[k] + T * bg[0];
-      out.rgb[pix * 3 + 1] = C1[k] + T * bg[1];
-      out.rgb[pix * 3 + 2] = C2[k] + T * bg[2];
-      out.alpha[pix] = 1.0f - T;
-      out.depth[pix] = (1.0f - T) >= 1e-6f ? D[k] / (1.0f - T) : 0.0f;
-      out.contributors[pix] = static_cast<int>(contrib[k]);
-      out.final_T[pix] = T;
-      out.n_walked[pix] = static_cast<std::uint32_t>(walked[k]);
-    }
+  for (int k = 0; k < P; ++k) {
+    const int r = blockRow(k), c = blockCol(k);
+    if (r >= h || c >= w) continue;
+    const float T = std::abs(Tr[k]);
+    const std::size_t pix = static_cast<std::size_t>(y0 + r) * out.W + (x0 + c);
+    out.rgb[pix * 3] = C0[k] + T * bg[0];
+    out.rgb[pix * 3 + 1] = C1[k] + T * bg[1];
+    out.rgb[pix * 3 + 2] = C2[k] + T * bg[2];
+    out.alpha[pix] = 1.0f - T;
+    out.depth[pix] = (1.0f - T) >= 1e-6f ? D[k] / (1.0f - T) : 0.0f;
+    out.contributors[pix] = static_cast<int>(contrib[k]);
+    out.final_T[pix] = T;
+    out.n_walked[pix] = static_cast<std::uint32_t>(walked[k]);
+  }
 }
 
 namespace {
@@ -230,7 +279,7 @@ void backwardTileImpl(const TileGaussian<float>* q, int x0, int y0, int x1, int 
   alignas(64) float Tr[P], finalT[P], walked[P], acc0[P], acc1[P], acc2[P], w0[P], w1[P], w2[P], bgdot[P];
   std::uint32_t jmax = 0;
   for (int k = 0; k < P; ++k) {
-    const int r = k / kTile, c = k % kTile;
+    const int r = blockRow(k), c = blockCol(k);
     const bool inside = c < w && r < h;
     const std::size_t pix = inside ? static_cast<std::size_t>(y0 + r) * in.W + (x0 + c) : 0;
     Tr[k] = finalT[k] = inside ? in.final_T[pix] : 1.0f;
@@ -243,13 +292,14 @@ void backwardTileImpl(const TileGaussian<float>* q, int x0, int y0, int x1, int 
     w2[k] = inside ? in.dL_drgb[pix * 3 + 2] : 0.0f;
     bgdot[k] = bg[0] * w0[k] + bg[1] * w1[k] + bg[2] * w2[k];
   }
-  const vf lane = laneCentres();
+  const vf lane_x = laneColCentres(), lane_y = laneRowCentres();
   for (std::uint32_t jj = jmax; jj-- > 0;) {
     const TileGaussian<float>& g = q[jj];
     int c0, c1, r0, r1;
     tileSpan(g.mx, g.hx, x0, x1, c0, c1);
     tileSpan(g.my, g.hy, y0, y1, r0, r1);
-    const vf mx = vs(g.mx), hx = vs(g.hx), o = vs(g.o), jv = vs(static_cast<float>(jj));
+    const vf mx = vs(g.mx), my = vs(g.my), hx = vs(g.hx), hy = vs(g.hy), o = vs(g.o);
+    const vf jv = vs(static_cast<float>(jj));
     const vf ha = vs(-0.5f) * vs(g.a);
     const vf col0 = vs(g.col[0]), col1 = vs(g.col[1]), col2 = vs(g.col[2]);
     const vf zero = vs(0.0f), one = vs(1.0f);
@@ -259,13 +309,16 @@ void backwardTileImpl(const TileGaussian<float>* q, int x0, int y0, int x1, int 
     vf s_e = zero, s_x = zero, s_y = zero, s_xx = zero, s_xy = zero, s_yy = zero, s_c0 = zero, s_c1 = zero,
        s_c2 = zero;
     if (c0 <= c1)
-      for (int r = r0; r <= r1; ++r) {
-        const float dys = static_cast<float>(y0 + r) + 0.5f - g.my;
-        if (!(std::abs(dys) <= g.hy)) continue;
-        const vf dy = vs(dys), qy = vs(rowQuad(g, dys)), by = vs(rowCross(g, dys));
-        for (int cb = c0 & ~(L - 1); cb <= c1; cb += L) {
-          const int k = r * kTile + cb;
-          const Lanes Ln = evalLanes((vs(static_cast<float>(x0 + cb)) + lane) - mx, ha, qy, by, o, hx);
+      for (int rb = r0 / kBH; rb <= r1 / kBH; ++rb) {
+        int lo, hi;
+        blockRowSpan(g, x0, y0, rb, c0, c1, lo, hi);
+        if (lo > hi) continue;
+        const vf dy = (vs(static_cast<float>(y0 + rb * kBH)) + lane_y) - my;
+        const vi row_in = absLe(dy, hy);
+        const vf qy = rowQuad(g, dy), by = rowCross(g, dy);
+        for (int cb = lo & ~(kBW - 1); cb <= hi; cb += kBW) {
+          const int k = (rb * kBX + cb / kBW) * L;
+          const Lanes Ln = evalLanes((vs(static_cast<float>(x0 + cb)) + lane_x) - mx, ha, qy, by, o, hx, row_in);
           const vf dx = Ln.dx, alpha = Ln.alpha;
           const vi valid = (jv < load(walked + k)) & Ln.touches;
           const vf a_eff = valid ? alpha : zero;

@@ -11,6 +11,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <mutex>
 #include <cstdlib>
 #include <stdexcept>
@@ -38,6 +39,7 @@ template <typename T>
 struct RasterStateT {
   RasterSettings settings;
   std::vector<Projected<T>> proj;  // per Gaussian
+  std::vector<TileGaussian<T>> tile_data;  // per Gaussian: what the tile kernels read
   int tiles_x = 0, tiles_y = 0;
   std::vector<std::uint32_t> gauss_start;  // N + 1: each Gaussian's pair slots
   std::vector<std::uint32_t> tile_start;   // tiles + 1
@@ -114,14 +116,35 @@ void pixelRange(T mean, T half, int n, int& lo, int& hi) {
   hi = std::min(n - 1, static_cast<int>(std::floor(mean + half - T(0.5))));
 }
 
+// A projected Gaussian as the tile kernels read it. The chord terms (splat/raster_kernels.h):
+// a pixel at offset (dx, dy) can pass o G >= 1/255 only where a dx^2 + 2 b dx dy + c dy^2
+// <= k2 = 2 ln(255 o), i.e. |dx + (b/a) dy| <= sqrt(k2/a - (det/a^2) dy^2), det = ac - b^2.
+// The float test rounds each term of its exponent, so its boundary can move by a few ulp
+// of the terms' sizes, which are at most ~4 kappa k2 with kappa = (a + c)^2 / (4 det)
+// (1 for a circle); k2 is widened by 1% + 1e-4, far more than that for kappa <= 250.
+// Beyond (needle-like Gaussians) or for anything not finite, no chord: the loops then
+// cover the whole rectangle, as they would without these terms.
+template <typename T>
+TileGaussian<T> tileData(const Projected<T>& P) {
+  TileGaussian<T> q{P.mean2d[0], P.mean2d[1], P.conic[0], P.conic[1], P.conic[2], P.opacity, P.half[0],
+                    P.half[1], P.depth, {P.color[0], P.color[1], P.color[2]}, T(0),
+                    std::numeric_limits<T>::max(), T(0)};
+  const double a = P.conic[0], b = P.conic[1], c = P.conic[2], o = P.opacity;
+  const double det = a * c - b * b;
+  const double k2 = 2.0 * std::log(255.0 * o) * 1.01 + 1e-4;
+  if (a > 0 && det > 0 && std::isfinite(a + b + c + det + k2) && (a + c) * (a + c) <= 1000.0 * det) {
+    q.chord_slope = static_cast<T>(-b / a);
+    q.chord_k0 = static_cast<T>(k2 / a);
+    q.chord_k1 = static_cast<T>(det / (a * a));
+  }
+  return q;
+}
+
 template <typename T>
 void gatherTile(const RasterStateT<T>& st, int tile, std::vector<TileGaussian<T>>& out) {
-  out.clear();
-  for (std::uint32_t e = st.tile_start[tile]; e < st.tile_start[tile + 1]; ++e) {
-    const Projected<T>& P = st.proj[st.entry_gauss[e]];
-    out.push_back({P.mean2d[0], P.mean2d[1], P.conic[0], P.conic[1], P.conic[2], P.opacity, P.half[0],
-                   P.half[1], P.depth, {P.color[0], P.color[1], P.color[2]}});
-  }
+  const std::uint32_t b = st.tile_start[tile], e = st.tile_start[tile + 1];
+  out.resize(e - b);
+  for (std::uint32_t k = b; k < e; ++k) out[k - b] = st.tile_data[st.entry_gauss[k]];
 }
 
 // exp for x <= 0 in float without a libm call, so the pixel loops vectorise: Cody-Waite
@@ -171,6 +194,46 @@ bool evalAlpha(const TileGaussian<T>& q, T px, T py, T& dx, T& dy, T& G, T& alph
   unclamped = oG < T(kMaxAlpha);
   alpha = unclamped ? oG : T(kMaxAlpha);
   return alpha >= T(kMinAlpha);
+}
+
+// Rule 6 for every tile at once: the Gaussians with pairs, by camera z, ties by index.
+// Binning them in this order (a stable counting sort by tile) leaves every tile sorted,
+// which costs far less than sorting each tile. Float depths go through a stable LSD radix
+// sort on their bits (mapped so that unsigned order is float order); double uses
+// std::sort.
+template <typename T>
+std::vector<std::uint32_t> depthOrder(const std::vector<Projected<T>>& proj, const std::vector<std::uint32_t>& count) {
+  std::vector<std::uint32_t> order;
+  order.reserve(proj.size());
+  for (std::size_t i = 0; i < proj.size(); ++i)
+    if (count[i]) order.push_back(static_cast<std::uint32_t>(i));
+  if constexpr (std::is_same_v<T, float>) {
+    const std::size_t m = order.size();
+    std::vector<std::uint32_t> key(m), key2(m), order2(m);
+    for (std::size_t j = 0; j < m; ++j) {
+      // + 0 turns -0 into +0, which the comparison of rule 6 treats as equal.
+      const std::uint32_t b = std::bit_cast<std::uint32_t>(proj[order[j]].depth + 0.0f);
+      key[j] = (b & 0x80000000u) ? ~b : (b | 0x80000000u);
+    }
+    constexpr int kBits = 11, kBuckets = 1 << kBits;
+    for (int shift = 0; shift < 32; shift += kBits) {
+      std::array<std::uint32_t, kBuckets + 1> start{};
+      for (std::size_t j = 0; j < m; ++j) ++start[((key[j] >> shift) & (kBuckets - 1)) + 1];
+      for (int k = 0; k < kBuckets; ++k) start[k + 1] += start[k];
+      for (std::size_t j = 0; j < m; ++j) {
+        const std::uint32_t d = start[(key[j] >> shift) & (kBuckets - 1)]++;
+        key2[d] = key[j];
+        order2[d] = order[j];
+      }
+      key.swap(key2);
+      order.swap(order2);
+    }
+  } else {
+    std::sort(order.begin(), order.end(), [&](std::uint32_t x, std::uint32_t y) {
+      return proj[x].depth < proj[y].depth || (proj[x].depth == proj[y].depth && x < y);
+    });
+  }
+  return order;
 }
 
 template <typename T>
@@ -321,6 +384,7 @@ RenderOutputT<T> rasterizeT(const GaussiansT<T>& g, const Camera& cam, const Ras
   st->final_T.assign(static_cast<std::size_t>(W) * H, T(1));
   st->n_walked.assign(static_cast<std::size_t>(W) * H, 0);
   st->proj.resize(n);
+  st->tile_data.resize(n);
   std::vector<std::uint32_t> count(n, 0);
   std::vector<std::array<int, 4>> tile_rect(n);  // tiles touched: x0, x1, y0, y1 (inclusive)
 
@@ -334,6 +398,7 @@ RenderOutputT<T> rasterizeT(const GaussiansT<T>& g, const Camera& cam, const Ras
         }
         Projected<T>& P = st->proj[i] = projection::project(g, i, camT, rs);
         if (!P.visible) continue;
+        st->tile_data[i] = tileData(P);
         out.visible[i] = 1;
         out.radii[i] = P.radius;
         int px0, px1, py0, py1;
@@ -347,7 +412,8 @@ RenderOutputT<T> rasterizeT(const GaussiansT<T>& g, const Camera& cam, const Ras
     });
   });
 
-  // Pair slots, Gaussian-major, then a stable counting sort by tile.
+  // Pair slots, Gaussian-major, then a stable counting sort by tile of the Gaussians in
+  // depth order (depthOrder), so each tile comes out sorted by rule 6.
   st->gauss_start.assign(n + 1, 0);
   for (std::size_t i = 0; i < n; ++i) st->gauss_start[i + 1] = st->gauss_start[i] + count[i];
   const std::uint32_t pairs = st->gauss_start[n];
@@ -371,10 +437,10 @@ RenderOutputT<T> rasterizeT(const GaussiansT<T>& g, const Camera& cam, const Ras
   st->entry_slot.resize(pairs);
   {
     std::vector<std::uint32_t> fill(st->tile_start.begin(), st->tile_start.end() - 1);
-    for (std::size_t i = 0; i < n; ++i)
+    for (const std::uint32_t i : depthOrder(st->proj, count))
       for (std::uint32_t k = st->gauss_start[i]; k < st->gauss_start[i + 1]; ++k) {
         const std::uint32_t e = fill[slot_tile[k]]++;
-        st->entry_gauss[e] = static_cast<std::uint32_t>(i);
+        st->entry_gauss[e] = i;
         st->entry_slot[e] = k;
       }
   }
@@ -382,23 +448,6 @@ RenderOutputT<T> rasterizeT(const GaussiansT<T>& g, const Camera& cam, const Ras
   const T bg[3] = {T(s.background[0]), T(s.background[1]), T(s.background[2])};
   arena().execute([&] {
     tbb::parallel_for(0, tiles, [&](int tile) {
-      // Rule 6: by camera z, ties by index.
-      struct Entry {
-        T depth;
-        std::uint32_t gauss, slot;
-      };
-      const std::uint32_t b = st->tile_start[tile], e = st->tile_start[tile + 1];
-      std::vector<Entry> entries(e - b);
-      for (std::uint32_t k = b; k < e; ++k)
-        entries[k - b] = {st->proj[st->entry_gauss[k]].depth, st->entry_gauss[k], st->entry_slot[k]};
-      std::sort(entries.begin(), entries.end(), [](const Entry& x, const Entry& y) {
-        return x.depth < y.depth || (x.depth == y.depth && x.gauss < y.gauss);
-      });
-      for (std::uint32_t k = b; k < e; ++k) {
-        st->entry_gauss[k] = entries[k - b].gauss;
-        st->entry_slot[k] = entries[k - b].slot;
-      }
-
       thread_local std::vector<TileGaussian<T>> q;
       gatherTile(*st, tile, q);
       int x0, y0, x1, y1;
