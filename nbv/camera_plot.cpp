@@ -75,7 +75,8 @@ Image8 plotCameras(const Scene& scene, const std::vector<int>& initial, const st
                 cv::FONT_HERSHEY_SIMPLEX, 0.55, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
   }
   cv::line(img, cv::Point(panel_size, 0), cv::Point(panel_size, H), cv::Scalar(0, 0, 0), 1);
-  cv::putText(img, "red: initial  green: selected  grey: candidates  hollow: test", cv::Point(W - 470, 20),
+  // The legend sits at the bottom right, clear of the panel titles.
+  cv::putText(img, "red: initial  green: selected  grey: candidates  hollow: test", cv::Point(W - 470, H - 10),
               cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(60, 60, 60), 1, cv::LINE_AA);
   Image8 out;
   out.width = W;
