@@ -116,7 +116,7 @@ int runActive(ActiveArgs& a) {
   }
   writeFileAtomic(a.out + "/results.json", j.dump(2) + "\n");
   std::printf("\n%-10s %-8s %8s %8s %8s %10s %10s %10s\n", "method", "views", "PSNR", "SSIM", "AUSE", "select s", "train s", "total s");
-  const double select_s = r.total_seconds.lifting + r.total_seconds.triangulation + r.total_seconds.prefilter + r.total_seconds.fisher;
+  const double select_s = r.total_seconds.selection();
   std::printf("%-10s %-8zu %8.2f %8.4f %8s %10.1f %10.1f %10.1f\n", a.method.c_str(), r.selected_views.size(), r.test.psnr,
               r.test.ssim, r.ause ? std::to_string(*r.ause).substr(0, 6).c_str() : "n/a", select_s, r.total_seconds.training,
               r.seconds);

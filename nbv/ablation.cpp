@@ -61,6 +61,29 @@ std::pair<double, double> meanStd(const std::vector<double>& v) {
   return {m, v.size() > 1 ? std::sqrt(s / static_cast<double>(v.size() - 1)) : 0.0};
 }
 
+bool variantApplies(const AblationVariant& v, const std::string& method) {
+  return v.methods.empty() || std::find(v.methods.begin(), v.methods.end(), method) != v.methods.end();
+}
+
+std::string runLabel(const std::string& method, const std::string& variant) {
+  return variant == "default" ? method : method + " (" + variant + ")";
+}
+
+double resultNumber(const nlohmann::json& j, const char* key) {
+  return j.contains(key) && j[key].is_number() ? j[key].get<double>() : NAN;
+}
+
+SelectionSeconds resultSeconds(const nlohmann::json& seconds) {
+  SelectionSeconds s;
+  s.lifting = resultNumber(seconds, "lifting");
+  s.triangulation = resultNumber(seconds, "triangulation");
+  s.prefilter = resultNumber(seconds, "prefilter");
+  s.fisher = resultNumber(seconds, "fisher");
+  s.training = resultNumber(seconds, "training");
+  s.exhaustive_fisher = resultNumber(seconds, "exhaustive_fisher");
+  return s;
+}
+
 AblationGrid readAblationGrid(const std::string& path) {
   const nlohmann::json j = readJsonFile(path);
   if (!j.is_object()) throw InputError(path, "json", "expected an object");
@@ -173,7 +196,7 @@ std::vector<AblationJob> expandGrid(const AblationGrid& g) {
   for (const AblationScene& sc : g.scenes)
     for (const std::string& m : g.methods)
       for (const AblationVariant& v : g.variants) {
-        if (!v.methods.empty() && std::find(v.methods.begin(), v.methods.end(), m) == v.methods.end()) continue;
+        if (!variantApplies(v, m)) continue;
         for (std::uint64_t seed : g.seeds) {
           AblationJob j;
           j.scene = sc.name;
@@ -267,10 +290,6 @@ std::string pm(const std::vector<double>& v, int digits) {
   return fmt(m, digits) + " \u00b1 " + fmt(s, digits);
 }
 
-double num(const nlohmann::json& j, const char* key) {
-  return j.contains(key) && j[key].is_number() ? j[key].get<double>() : NAN;
-}
-
 struct Key {
   std::string scene, method, variant;
   auto operator<=>(const Key&) const = default;
@@ -282,13 +301,9 @@ void forEachCombo(const AblationGrid& g, F&& f) {
   for (const auto& sc : g.scenes)
     for (const auto& m : g.methods)
       for (const auto& v : g.variants) {
-        if (!v.methods.empty() && std::find(v.methods.begin(), v.methods.end(), m) == v.methods.end()) continue;
+        if (!variantApplies(v, m)) continue;
         f(sc.name, m, v.name);
       }
-}
-
-std::string label(const std::string& method, const std::string& variant) {
-  return variant == "default" ? method : method + " (" + variant + ")";
 }
 
 }  // namespace
@@ -301,7 +316,7 @@ std::vector<Table> ablationTables(const AblationGrid& g, const std::vector<JobRe
     std::vector<double> v;
     if (auto it = by.find(k); it != by.end())
       for (const auto* j : it->second)
-        if (std::isfinite(num(*j, field))) v.push_back(num(*j, field));
+        if (std::isfinite(resultNumber(*j, field))) v.push_back(resultNumber(*j, field));
     return v;
   };
   std::vector<Table> tables;
@@ -313,7 +328,7 @@ std::vector<Table> ablationTables(const AblationGrid& g, const std::vector<JobRe
     const Key k{s, m, v};
     const auto p = values(k, "psnr");
     if (p.empty()) return;
-    main.rows.push_back({s, label(m, v), std::to_string(p.size()), pm(p, 2), pm(values(k, "ssim"), 4), pm(values(k, "ause"), 4)});
+    main.rows.push_back({s, runLabel(m, v), std::to_string(p.size()), pm(p, 2), pm(values(k, "ssim"), 4), pm(values(k, "ause"), 4)});
   });
   tables.push_back(main);
 
@@ -327,9 +342,9 @@ std::vector<Table> ablationTables(const AblationGrid& g, const std::vector<JobRe
     for (const auto& m : g.methods) {
       if (!spec.methods.empty() && std::find(spec.methods.begin(), spec.methods.end(), m) == spec.methods.end()) continue;
       for (const auto& v : g.variants) {
-        if (!v.methods.empty() && std::find(v.methods.begin(), v.methods.end(), m) == v.methods.end()) continue;
+        if (!variantApplies(v, m)) continue;
         if (!spec.variants.empty() && std::find(spec.variants.begin(), spec.variants.end(), v.name) == spec.variants.end()) continue;
-        std::vector<std::string> row{label(m, v.name)};
+        std::vector<std::string> row{runLabel(m, v.name)};
         bool any = false;
         for (const auto& sc : g.scenes) {
           const auto p = values({sc.name, m, v.name}, "psnr");
@@ -344,8 +359,8 @@ std::vector<Table> ablationTables(const AblationGrid& g, const std::vector<JobRe
           int n = 0;
           for (const JobResult& r : results)
             if (r.job.kind == AblationJob::Kind::kActive && r.job.method == m && r.job.variant == v.name && r.job.seed == seed) {
-              sp += num(r.result, "psnr");
-              ss += num(r.result, "ssim");
+              sp += resultNumber(r.result, "psnr");
+              ss += resultNumber(r.result, "ssim");
               ++n;
             }
           if (n == static_cast<int>(g.scenes.size())) {
@@ -379,7 +394,7 @@ std::vector<Table> ablationTables(const AblationGrid& g, const std::vector<JobRe
     forEachCombo(g, [&](const std::string& s, const std::string& m, const std::string& v) {
       auto it = by.find({s, m, v});
       if (it == by.end()) return;
-      std::vector<std::string> row{s, label(m, v)};
+      std::vector<std::string> row{s, runLabel(m, v)};
       for (int k = min_views; k <= max_views; ++k) {
         std::vector<double> p;
         for (const auto* j : it->second)
@@ -401,27 +416,28 @@ std::vector<Table> ablationTables(const AblationGrid& g, const std::vector<JobRe
              {}};
   for (const auto& m : g.methods)
     for (const auto& v : g.variants) {
-      if (!v.methods.empty() && std::find(v.methods.begin(), v.methods.end(), m) == v.methods.end()) continue;
+      if (!variantApplies(v, m)) continue;
       std::vector<double> li, tr, pf, fi, sel, ex, saved, it_ms, e2e;
       for (const JobResult& r : results) {
         if (r.job.kind != AblationJob::Kind::kActive || r.job.method != m || r.job.variant != v.name) continue;
         const auto& s = r.result["seconds"];
-        li.push_back(num(s, "lifting"));
-        tr.push_back(num(s, "triangulation"));
-        pf.push_back(num(s, "prefilter"));
-        fi.push_back(num(s, "fisher"));
-        sel.push_back(li.back() + tr.back() + pf.back() + fi.back());
-        if (num(s, "exhaustive_fisher") > 0) {
-          ex.push_back(num(s, "exhaustive_fisher"));
+        const SelectionSeconds st = resultSeconds(s);
+        li.push_back(st.lifting);
+        tr.push_back(st.triangulation);
+        pf.push_back(st.prefilter);
+        fi.push_back(st.fisher);
+        sel.push_back(st.selection());
+        if (st.exhaustive_fisher > 0) {
+          ex.push_back(st.exhaustive_fisher);
           saved.push_back(100.0 * (1.0 - sel.back() / ex.back()));
         }
-        const double its = num(r.result, "iterations");
-        if (its > 0) it_ms.push_back(1000.0 * num(s, "training") / its);
-        e2e.push_back(num(s, "end_to_end_this_process"));
+        const double its = resultNumber(r.result, "iterations");
+        if (its > 0) it_ms.push_back(1000.0 * st.training / its);
+        e2e.push_back(resultNumber(s, "end_to_end_this_process"));
       }
       if (li.empty()) continue;
       auto mean = [](const std::vector<double>& x, int d) { return x.empty() ? std::string("") : fmt(meanStd(x).first, d); };
-      time.rows.push_back({label(m, v.name), std::to_string(li.size()), mean(li, 2), mean(tr, 3), mean(pf, 3), mean(fi, 1),
+      time.rows.push_back({runLabel(m, v.name), std::to_string(li.size()), mean(li, 2), mean(tr, 3), mean(pf, 3), mean(fi, 1),
                            mean(sel, 1), mean(ex, 1), saved.empty() ? "" : mean(saved, 0) + " %", mean(it_ms, 1), mean(e2e, 0)});
     }
   if (!time.rows.empty()) tables.push_back(time);
@@ -445,10 +461,10 @@ std::vector<Table> ablationTables(const AblationGrid& g, const std::vector<JobRe
     for (const auto& k : order) {
       std::vector<double> ov, tau, sc, st;
       for (const auto* row : rows[k]) {
-        ov.push_back(num(*row, "overlap"));
-        tau.push_back(num(*row, "kendall_tau"));
-        sc.push_back(1000 * num(*row, "seconds_scoring"));
-        st.push_back(1000 * num(*row, "seconds_sets"));
+        ov.push_back(resultNumber(*row, "overlap"));
+        tau.push_back(resultNumber(*row, "kendall_tau"));
+        sc.push_back(1000 * resultNumber(*row, "seconds_scoring"));
+        st.push_back(1000 * resultNumber(*row, "seconds_sets"));
       }
       sweep.rows.push_back({r.job.scene, std::get<0>(k), std::get<1>(k), std::get<2>(k), fmt(meanStd(ov).first, 3),
                             fmt(meanStd(tau).first, 3), fmt(meanStd(sc).first, 2), fmt(meanStd(st).first, 1)});

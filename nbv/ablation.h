@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "geometry/image/image.h"
+#include "nbv/active_run.h"
 
 namespace saresgs {
 
@@ -91,6 +92,16 @@ std::vector<AblationJob> expandGrid(const AblationGrid& g);
 std::vector<AblationJob> shardJobs(const std::vector<AblationJob>& jobs, int i, int n);
 // Parses "i/n".
 std::pair<int, int> parseShard(const std::string& text);
+
+// Whether variant `v` runs for `method` (an empty method list: every method).
+bool variantApplies(const AblationVariant& v, const std::string& method);
+// How a run is named in tables and plots: "method", or "method (variant)".
+std::string runLabel(const std::string& method, const std::string& variant);
+// A number field of a result JSON; NaN when it is missing or not a number (null AUSE).
+double resultNumber(const nlohmann::json& j, const char* key);
+// The stage times of a result's "seconds" object, NaN where a stage is missing (unlike
+// the checkpoint's strict secondsFrom).
+SelectionSeconds resultSeconds(const nlohmann::json& seconds);
 
 std::string jobFolder(const std::string& out, const AblationJob& j);          // OUT/runs/<id>
 std::string jobResultFile(const std::string& out, const AblationJob& j);      // results.json or sweep.json

@@ -9,11 +9,7 @@ namespace saresgs {
 
 namespace {
 
-std::string label(const AblationJob& j) { return j.variant == "default" ? j.method : j.method + " (" + j.variant + ")"; }
-
-double num(const nlohmann::json& j, const char* key) {
-  return j.contains(key) && j[key].is_number() ? j[key].get<double>() : NAN;
-}
+std::string label(const AblationJob& j) { return runLabel(j.method, j.variant); }
 
 // Method labels in config order that have results for `scene`.
 std::vector<std::string> labelsFor(const std::vector<JobResult>& results, const std::string& scene) {
@@ -45,9 +41,8 @@ std::vector<NamedPlot> ablationPlots(const AblationGrid& g, const std::vector<Jo
         std::map<int, std::vector<double>> by_views;
         for (const JobResult& r : results) {
           if (r.job.kind != AblationJob::Kind::kActive || r.job.scene != sc.name || label(r.job) != labels[li]) continue;
-          p_runs.push_back(num(r.result, "psnr"));
-          const auto& s = r.result["seconds"];
-          sel_runs.push_back(num(s, "lifting") + num(s, "triangulation") + num(s, "prefilter") + num(s, "fisher"));
+          p_runs.push_back(resultNumber(r.result, "psnr"));
+          sel_runs.push_back(resultSeconds(r.result["seconds"]).selection());
           if (r.result.contains("steps"))
             for (const auto& st : r.result["steps"]) by_views[st.value("views_before", 0)].push_back(st.value("progress_psnr", NAN));
         }
@@ -97,9 +92,9 @@ std::vector<NamedPlot> ablationPlots(const AblationGrid& g, const std::vector<Jo
         if (it == groups[s].end()) continue;
         std::vector<double> t, k, o;
         for (const auto* row : it->second) {
-          t.push_back(1000 * num(*row, "seconds_scoring"));
-          k.push_back(num(*row, "kendall_tau"));
-          o.push_back(num(*row, "overlap"));
+          t.push_back(1000 * resultNumber(*row, "seconds_scoring"));
+          k.push_back(resultNumber(*row, "kendall_tau"));
+          o.push_back(resultNumber(*row, "overlap"));
         }
         const std::string pl = e == "exact" ? "ex" : e.substr(e.find(':') + 1);
         a.x.push_back(meanStd(t).first);

@@ -31,6 +31,8 @@ void addSeconds(SelectionSeconds& a, const SelectionSeconds& b) {
   a.exhaustive_fisher += b.exhaustive_fisher;
 }
 
+}  // namespace
+
 SelectionSeconds secondsFrom(const nlohmann::json& j) {
   SelectionSeconds s;
   s.lifting = j.at("lifting");
@@ -41,8 +43,6 @@ SelectionSeconds secondsFrom(const nlohmann::json& j) {
   s.exhaustive_fisher = j.at("exhaustive_fisher");
   return s;
 }
-
-}  // namespace
 
 nlohmann::json toJson(const SelectionSeconds& s) {
   return {{"lifting", s.lifting},   {"triangulation", s.triangulation}, {"prefilter", s.prefilter},

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "geometry/lifting/sa_points.h"
+#include "geometry/occupancy/coverage_score.h"
 #include "geometry/scene/scene.h"
 #include "nbv/selectors.h"
 #include "splat/train/trainer.h"
@@ -38,9 +39,13 @@ MethodNeeds needsOf(Method m);
 struct SelectionSeconds {
   double lifting = 0, triangulation = 0, prefilter = 0, fisher = 0, training = 0;
   double exhaustive_fisher = 0;  // Fisher over all candidates, timed for comparison only
+  // What choosing a view cost: every stage but training (and the comparison timing).
+  double selection() const { return lifting + triangulation + prefilter + fisher; }
 };
-// The stage times as one JSON object (results.json and the checkpoint).
+// The stage times as one JSON object (results.json and the checkpoint), and back; the
+// reader throws nlohmann::json::exception when a stage is missing.
 nlohmann::json toJson(const SelectionSeconds& s);
+SelectionSeconds secondsFrom(const nlohmann::json& j);
 
 // The prefilter of the coverage methods: builds its state from the scene, learns what the
 // chosen views observe (SA-Points lifted against `render`: the trainer's renders in an
@@ -74,6 +79,13 @@ struct PrefilterChoice {
   int min_points = 2;
   int upsample = 2;
 };
+
+// The coverage scoring options of an encoding ("hash:K", K in [min_bits, max_bits], or
+// "exact") and a score ("xor" or "new"), with keep_fraction as the kept share; throws
+// std::invalid_argument naming the value otherwise. The active loop takes the paper's
+// 2^11..2^19; the sweep's tests go beyond.
+PrefilterOptions prefilterOptions(const std::string& encoding, const std::string& score, double keep_fraction,
+                                  int min_bits = 11, int max_bits = 19);
 
 struct ActiveOptions {
   Method method = Method::kSaResgs;

@@ -22,24 +22,7 @@ class SaPointPrefilter : public CoveragePrefilter {
   SaPointPrefilter(const Scene& scene, const PrefilterChoice& o) : scene_(scene), choice_(o) {
     if (o.set != "frustum" && o.set != "visible") throw std::invalid_argument("prefilter set '" + o.set + "': expected frustum or visible");
     if (o.lifting != "flow" && o.lifting != "depth") throw std::invalid_argument("lifting '" + o.lifting + "': expected flow or depth");
-    if (o.score == "xor") opts_.criterion = CoverageCriterion::Hamming;
-    else if (o.score == "new") opts_.criterion = CoverageCriterion::NewCount;
-    else throw std::invalid_argument("prefilter score '" + o.score + "': expected xor or new");
-    if (o.encoding == "exact") {
-      opts_.encoding = CoverageEncoding::Exact;
-    } else if (o.encoding.rfind("hash:", 0) == 0) {
-      int bits = 0;
-      try {
-        bits = std::stoi(o.encoding.substr(5));
-      } catch (const std::exception&) {
-        bits = 0;
-      }
-      if (bits < 11 || bits > 19) throw std::invalid_argument("prefilter encoding '" + o.encoding + "': expected hash:11 .. hash:19 or exact");
-      opts_.encoding = CoverageEncoding::Hashed;
-      opts_.table_size = std::size_t{1} << bits;
-    } else {
-      throw std::invalid_argument("prefilter encoding '" + o.encoding + "': expected hash:K or exact");
-    }
+    opts_ = prefilterOptions(o.encoding, o.score, o.keep_fraction);
     if (scene.points.empty())
       throw InputError(scene.source, "points", "the coverage prefilter needs sparse SfM points for its occupancy grid");
     std::vector<Eigen::Vector3d> pts;
@@ -124,6 +107,33 @@ class SaPointPrefilter : public CoveragePrefilter {
 };
 
 }  // namespace
+
+PrefilterOptions prefilterOptions(const std::string& encoding, const std::string& score, double keep_fraction,
+                                  int min_bits, int max_bits) {
+  PrefilterOptions o;
+  o.keep_percent = 100.0 * keep_fraction;
+  if (score == "xor") o.criterion = CoverageCriterion::Hamming;
+  else if (score == "new") o.criterion = CoverageCriterion::NewCount;
+  else throw std::invalid_argument("prefilter score '" + score + "': expected xor or new");
+  if (encoding == "exact") {
+    o.encoding = CoverageEncoding::Exact;
+  } else if (encoding.rfind("hash:", 0) == 0) {
+    int bits = 0;
+    try {
+      bits = std::stoi(encoding.substr(5));
+    } catch (const std::exception&) {
+      bits = 0;
+    }
+    if (bits < min_bits || bits > max_bits)
+      throw std::invalid_argument("prefilter encoding '" + encoding + "': expected hash:" + std::to_string(min_bits) +
+                                  " .. hash:" + std::to_string(max_bits) + " or exact");
+    o.encoding = CoverageEncoding::Hashed;
+    o.table_size = std::size_t{1} << bits;
+  } else {
+    throw std::invalid_argument("prefilter encoding '" + encoding + "': expected hash:K or exact");
+  }
+  return o;
+}
 
 std::unique_ptr<CoveragePrefilter> makeCoveragePrefilter(const Scene& scene, const PrefilterChoice& o, std::uint64_t) {
   return std::make_unique<SaPointPrefilter>(scene, o);

@@ -19,24 +19,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-PrefilterOptions optionsFor(const std::string& encoding, const std::string& score, double keep_fraction) {
-  PrefilterOptions o;
-  o.keep_percent = 100.0 * keep_fraction;
-  if (score == "xor") o.criterion = CoverageCriterion::Hamming;
-  else if (score == "new") o.criterion = CoverageCriterion::NewCount;
-  else throw std::invalid_argument("sweep score '" + score + "': expected xor or new");
-  if (encoding == "exact") {
-    o.encoding = CoverageEncoding::Exact;
-  } else {
-    int bits = 0;
-    if (encoding.rfind("hash:", 0) == 0) bits = std::atoi(encoding.c_str() + 5);
-    if (bits < 2 || bits > 30) throw std::invalid_argument("sweep encoding '" + encoding + "': expected hash:K or exact");
-    o.encoding = CoverageEncoding::Hashed;
-    o.table_size = std::size_t{1} << bits;
-  }
-  return o;
-}
-
 // The protocol's initial views, then random train views (seeded), `count` in all.
 std::vector<int> observedOrder(const Scene& scene, int count, std::uint64_t seed) {
   std::vector<Eigen::Vector3d> centers;
@@ -97,23 +79,22 @@ std::vector<SweepRow> prefilterSweep(const Scene& scene, const SweepSpec& spec, 
   std::unique_ptr<CoveragePrefilter> pf = makeCoveragePrefilter(scene, choice, seed);
   const OccupancyGrids& grids = pf->grids();
 
-  // Every train view's candidate sets, once per kind, timed per view.
+  // Every train view's candidate sets, once per kind, timed per view; the reference
+  // always needs the visible sets, whether or not they are swept.
+  std::vector<std::string> kinds = spec.sets;
+  if (std::find(kinds.begin(), kinds.end(), "visible") == kinds.end()) kinds.push_back("visible");
   std::map<std::string, std::vector<VoxelSet>> sets;
   std::map<std::string, std::vector<double>> set_seconds;
   std::unique_ptr<VisibilityTracer> tracer;
-  for (const std::string& kind : spec.sets) {
+  for (const std::string& kind : kinds) {
     if (kind != "frustum" && kind != "visible") throw std::invalid_argument("sweep set '" + kind + "': expected frustum or visible");
-    if (kind == "visible" && !tracer) tracer = std::make_unique<VisibilityTracer>(grids);
+    if (kind == "visible") tracer = std::make_unique<VisibilityTracer>(grids);
     for (int v : scene.train) {
       const Camera& cam = scene.views[static_cast<std::size_t>(v)].camera;
       const auto t0 = Clock::now();
       sets[kind].push_back(kind == "frustum" ? frustumSet(grids, cam) : tracer->visibleSet(cam, choice.visible_stride));
       set_seconds[kind].push_back(since(t0));
     }
-  }
-  if (!sets.count("visible")) {  // the reference always needs the visible sets
-    tracer = std::make_unique<VisibilityTracer>(grids);
-    for (int v : scene.train) sets["visible"].push_back(tracer->visibleSet(scene.views[static_cast<std::size_t>(v)].camera, choice.visible_stride));
   }
 
   std::vector<SweepRow> rows;
@@ -137,13 +118,13 @@ std::vector<SweepRow> prefilterSweep(const Scene& scene, const SweepSpec& spec, 
       return out;
     };
     for (const std::string& score : spec.scores) {
-      const std::vector<double> ref = values(pick("visible"), optionsFor("exact", score, spec.keep_fraction));
+      const std::vector<double> ref = values(pick("visible"), prefilterOptions("exact", score, spec.keep_fraction));
       for (const std::string& kind : spec.sets) {
         const std::vector<VoxelSet> s = pick(kind);
         double set_s = 0;
         for (std::size_t i : cand) set_s += set_seconds.at(kind)[i];
         for (const std::string& enc : spec.encodings) {
-          const PrefilterOptions o = optionsFor(enc, score, spec.keep_fraction);
+          const PrefilterOptions o = prefilterOptions(enc, score, spec.keep_fraction, 2, 30);
           std::vector<double> times, v;
           for (int r = 0; r < std::max(1, spec.timing_repeats); ++r) {
             const auto t0 = Clock::now();
