@@ -109,6 +109,22 @@ struct Projected {
 };
 
 // Rules 1-5 for Gaussian i.
+// The SH basis along the unit view direction from the camera centre to Gaussian i's
+// mean (zero when they coincide), written to d and basis; returns the distance, which
+// the backward pass needs to chain through the normalisation. Forward, backward and the
+// Fisher pass share it, so all three see the same direction bit for bit.
+template <typename T>
+T viewBasis(const GaussiansT<T>& g, std::size_t i, const CameraT<T>& cam, int sh_degree, T d[3], T basis[16]) {
+  const T* m = &g.means[3 * i];
+  d[0] = m[0] - cam.center[0];
+  d[1] = m[1] - cam.center[1];
+  d[2] = m[2] - cam.center[2];
+  const T dn = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  for (int k = 0; k < 3; ++k) d[k] = dn > 0 ? d[k] / dn : T(0);
+  shBasis(sh_degree, d[0], d[1], d[2], basis);
+  return dn;
+}
+
 template <typename T>
 Projected<T> project(const GaussiansT<T>& g, std::size_t i, const CameraT<T>& cam,
                      const RasterSettings& s) {
@@ -173,11 +189,8 @@ Projected<T> project(const GaussiansT<T>& g, std::size_t i, const CameraT<T>& ca
     return P;
 
   // Rule 5: colour from SH along the view direction.
-  T d[3] = {m[0] - cam.center[0], m[1] - cam.center[1], m[2] - cam.center[2]};
-  const T dn = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-  for (T& v : d) v = dn > 0 ? v / dn : T(0);
-  T basis[16];
-  shBasis(s.sh_degree, d[0], d[1], d[2], basis);
+  T d[3], basis[16];
+  viewBasis(g, i, cam, s.sh_degree, d, basis);
   const int K = g.shCoeffs(), active = shCoeffCount(s.sh_degree);
   const T* sh = &g.sh[static_cast<std::size_t>(i) * K * 3];
   for (int c = 0; c < 3; ++c) {
@@ -234,11 +247,8 @@ void projectBackward(const GaussiansT<T>& g, std::size_t i, const CameraT<T>& ca
   // Colour -> SH coefficients and the view direction.
   T dm[3] = {0, 0, 0};
   {
-    T d[3] = {m[0] - cam.center[0], m[1] - cam.center[1], m[2] - cam.center[2]};
-    const T dn = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    for (T& v : d) v = dn > 0 ? v / dn : T(0);
-    T basis[16];
-    shBasis(s.sh_degree, d[0], d[1], d[2], basis);
+    T d[3], basis[16];
+    const T dn = viewBasis(g, i, cam, s.sh_degree, d, basis);
     const int K = g.shCoeffs(), active = shCoeffCount(s.sh_degree);
     const T* sh = &g.sh[i * K * 3];
     T dc[3];

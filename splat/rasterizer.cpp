@@ -690,12 +690,8 @@ void rasterizeSquaredGradientsT(const GaussiansT<T>& g, const Camera& cam, const
         sq.opacities[i] += acc[6];
         // SH: d C / d sh_kc = alpha T Y_k for unclamped channels.
         const Projected<T>& P = st.proj[i];
-        const T* m = &g.means[3 * i];
-        T d[3] = {m[0] - camT.center[0], m[1] - camT.center[1], m[2] - camT.center[2]};
-        const T dn = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-        for (T& v : d) v = dn > 0 ? v / dn : T(0);
-        T basis[16];
-        shBasis(rs.sh_degree, d[0], d[1], d[2], basis);
+        T d[3], basis[16];
+        projection::viewBasis(g, i, camT, rs.sh_degree, d, basis);
         for (int k = 0; k < active; ++k)
           for (int c = 0; c < 3; ++c)
             if (!P.clamped[c]) sq.sh[(i * K + k) * 3 + c] += acc[7] * basis[k] * basis[k];
