@@ -41,17 +41,11 @@ Image8 plotCameras(const Scene& scene, const std::vector<int>& initial, const st
   // Panel 0: above (right, forward); panel 1: side (right, up).
   for (int panel = 0; panel < 2; ++panel) {
     const Eigen::Vector3d ax = f.right, ay = panel == 0 ? f.forward : f.up;
-    double lo_x = 1e300, hi_x = -1e300, lo_y = 1e300, hi_y = -1e300;
-    auto extend = [&](const Eigen::Vector3d& p) {
-      lo_x = std::min(lo_x, p.dot(ax));
-      hi_x = std::max(hi_x, p.dot(ax));
-      lo_y = std::min(lo_y, p.dot(ay));
-      hi_y = std::max(hi_y, p.dot(ay));
-    };
-    for (const auto& v : scene.views) extend(v.camera.center());
-    for (const auto& p : scene.points) extend(p.xyz);
-    const double span = std::max({hi_x - lo_x, hi_y - lo_y, 1e-9}) * 1.1;
-    const double cx = 0.5 * (lo_x + hi_x), cy = 0.5 * (lo_y + hi_y);
+    PlaneBounds b{ax, ay};
+    for (const auto& v : scene.views) b.extend(v.camera.center());
+    for (const auto& p : scene.points) b.extend(p.xyz);
+    const double span = b.span() * 1.1;
+    const double cx = b.centerX(), cy = b.centerY();
     const double scale = (panel_size - 20) / span;
     auto px = [&](const Eigen::Vector3d& p) {
       return cv::Point(panel * panel_size + panel_size / 2 + static_cast<int>((p.dot(ax) - cx) * scale),

@@ -63,18 +63,12 @@ Image8 plotCoverage(const Scene& scene, const CoverageAnalysis& a, int size) {
     }
   }
   const Eigen::Vector3d ay = up.cross(ax);
-  double lo_x = 1e300, hi_x = -1e300, lo_y = 1e300, hi_y = -1e300;
-  auto extend = [&](const Eigen::Vector3d& p) {
-    lo_x = std::min(lo_x, p.dot(ax));
-    hi_x = std::max(hi_x, p.dot(ax));
-    lo_y = std::min(lo_y, p.dot(ay));
-    hi_y = std::max(hi_y, p.dot(ay));
-  };
+  PlaneBounds b{ax, ay};
   const std::vector<Voxel> occ = g.sceneVoxels().voxels();
-  for (const Voxel& v : occ) extend(g.voxelCenter(v));
-  for (const auto& v : scene.views) extend(v.camera.center());
-  const double span = std::max({hi_x - lo_x, hi_y - lo_y, 1e-9}) * 1.08;
-  const double cx = 0.5 * (lo_x + hi_x), cy = 0.5 * (lo_y + hi_y), scale = (size - 40) / span;
+  for (const Voxel& v : occ) b.extend(g.voxelCenter(v));
+  for (const auto& v : scene.views) b.extend(v.camera.center());
+  const double span = b.span() * 1.08;
+  const double cx = b.centerX(), cy = b.centerY(), scale = (size - 40) / span;
   const int top_margin = 30;
   cv::Mat img(size + top_margin, size, CV_8UC3, cv::Scalar(255, 255, 255));
   auto px = [&](const Eigen::Vector3d& p) {
