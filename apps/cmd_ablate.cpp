@@ -15,8 +15,8 @@
 #include "geometry/error.h"
 #include "geometry/io/atomic_file.h"
 #include "geometry/synth/from_manifest.h"
-#include "nbv/ablation.h"
-#include "nbv/prefilter_sweep.h"
+#include "nbv/eval/ablation.h"
+#include "nbv/eval/prefilter_sweep.h"
 
 namespace saresgs::apps {
 
@@ -75,18 +75,11 @@ void runSweep(const AblationGrid& g, const AblationJob& j, const std::string& ou
   if (!truth) throw InputError(sc.dataset, "manifest.json", "the prefilter sweep lifts SA-Points from ground-truth renders: needs a `saresgs scene` dataset");
   const ViewRenderer render = [&](const Camera& c) { return truth->render(c); };
   const DepthRenderer depth = [&](const Camera& c) { return truth->renderDepth(c); };
-  const std::vector<SweepRow> rows = prefilterSweep(scene, *g.sweep, render, depth, 0);
-  nlohmann::json res;
-  res["scene"] = j.scene;
-  res["dataset"] = sc.dataset;
-  res["lifting"] = g.sweep->lifting;
-  res["reference"] = "exact encoding of the Embree-visible sets, same score";
-  for (const SweepRow& r : rows)
-    res["rows"].push_back({{"set", r.set}, {"encoding", r.encoding}, {"score", r.score}, {"views", r.views},
-                           {"candidates", r.candidates}, {"overlap", r.overlap}, {"kendall_tau", r.kendall_tau},
-                           {"seconds_scoring", r.seconds_scoring}, {"seconds_sets", r.seconds_sets}});
+  const SweepReport report{j.scene, sc.dataset, toString(g.sweep->lifting),
+                           "exact encoding of the Embree-visible sets, same score",
+                           prefilterSweep(scene, *g.sweep, render, depth, 0)};
   fs::create_directories(jobFolder(out, j));
-  writeFileAtomic(jobResultFile(out, j), res.dump(2) + "\n");
+  writeFileAtomic(jobResultFile(out, j), toJson(report).dump(2) + "\n");
 }
 
 // Tables, plots and an index page for every finished job of the grid.

@@ -1,17 +1,32 @@
-// saresgs bench step: the time of one training step (forward + loss + backward + Adam)
-// on a reproducible random scene, as one JSON line. Not a test: speed is measured here.
+// saresgs bench: benchmarks, each printing one JSON line (timings, machine, peak memory).
+// Not tests: speed is measured here.
+//   step       one training step (forward + loss + backward + Adam) on a reproducible
+//              random scene;
+//   occupancy  the prefilter's parts on a room360 scene with simulated SfM points: grid
+//              build, observed dilation, frustum vs visible sets, exact vs hashed scoring,
+//              grid memory.
 #include <nlohmann/json.hpp>
 #include <sys/resource.h>
+#include <tbb/global_control.h>
+#include <tbb/info.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <iostream>
+#include <optional>
 #include <random>
 
 #include "apps/commands.h"
-#include "splat/rasterize_detail.h"
+#include "geometry/occupancy/candidate_sets.h"
+#include "geometry/occupancy/coverage_score.h"
+#include "geometry/occupancy/occupancy_grid.h"
+#include "geometry/synth/simulated_sfm.h"
+#include "geometry/synth/synthetic_scene.h"
+#include "geometry/synth/write_dataset.h"
+#include "splat/raster_execution.h"
 #include "splat/train/trainer.h"
 
 namespace saresgs::apps {
@@ -76,6 +91,12 @@ std::string cpuName() {
   return "unknown";
 }
 
+double peakRssMb() {
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  return ru.ru_maxrss / 1024.0;
+}
+
 struct StepTimes {
   double median_ms = 0;
   StageSeconds stages;  // summed over the timed steps
@@ -90,6 +111,7 @@ StepTimes timeSteps(const BenchArgs& a, const Camera& cam, const ImageF& target,
   std::vector<float> grad2d;
   RasterSettings s;
   s.sh_degree = a.sh_degree;
+  s.execution.threads = a.threads;
   ResidualOptions res;
   res.enabled = residual;
   std::mt19937_64 rng(a.seed);
@@ -129,10 +151,10 @@ nlohmann::json stageJson(const StageSeconds& s, int steps) {
 }
 
 int runBench(const BenchArgs& a) {
-  if (a.threads > 0) setRasterThreads(a.threads);
   const Camera cam = benchCamera(a);
   RasterSettings s;
   s.sh_degree = a.sh_degree;
+  s.execution.threads = a.threads;
   // The target is another random scene's render: gradients of a realistic size.
   const ImageF target = rasterize(benchScene(a, a.seed + 1000, cam), cam, s).rgb;
   const StepTimes plain = timeSteps(a, cam, target, false);
@@ -144,7 +166,8 @@ int runBench(const BenchArgs& a) {
   j["sh_degree"] = a.sh_degree;
   j["coverage"] = a.coverage;
   j["mean_contributors_per_pixel"] = plain.mean_contributors;
-  j["threads"] = rasterThreads();
+  j["threads"] = rasterThreadCount(s.execution);
+  j["kernels"] = rasterKernelName(s.execution);
   j["steps"] = a.steps;
   j["residual"] = a.residual;
   if (a.residual) {
@@ -158,9 +181,143 @@ int runBench(const BenchArgs& a) {
     j["median_ms"] = plain.median_ms;
     j["stage_ms"] = stageJson(plain.stages, a.steps);
   }
-  rusage ru{};
-  getrusage(RUSAGE_SELF, &ru);
-  j["peak_rss_mb"] = ru.ru_maxrss / 1024.0;
+  j["peak_rss_mb"] = peakRssMb();
+  j["cpu"] = cpuName();
+  std::cout << j.dump() << std::endl;
+  return 0;
+}
+
+struct OccupancyBenchArgs {
+  int width = 256, height = 192;  // the synthetic views (their depth maps give SA-Points)
+  std::size_t points = 12000;     // simulated SfM points at most
+  int resolution = 128;           // coarse voxels along the box's longest side
+  int upsample = 2;
+  int min_points = 2;
+  int threads = 0;
+  std::uint64_t seed = 5;
+};
+
+double medianMs(int reps, const std::function<void()>& f) {
+  std::vector<double> t;
+  for (int i = 0; i < reps; ++i) {
+    const auto a = std::chrono::steady_clock::now();
+    f();
+    t.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - a).count());
+  }
+  std::sort(t.begin(), t.end());
+  return t[t.size() / 2];
+}
+
+int runOccupancyBench(const OccupancyBenchArgs& a) {
+  std::optional<tbb::global_control> limit;
+  if (a.threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(a.threads));
+  const int threads = std::min<int>(tbb::info::default_concurrency(),
+      static_cast<int>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)));
+
+  // A room360 scene and what COLMAP would give for it.
+  SyntheticOptions so;
+  so.layout = "room360";
+  so.width = a.width;
+  so.height = a.height;
+  so.seed = a.seed;
+  const SyntheticScene scene = makeSyntheticScene(so);
+  ColmapModel model = colmapModelOf(scene);
+  SimulatedSfmOptions sim;
+  sim.max_points = a.points;
+  sim.candidates = 4 * a.points;
+  sim.seed = a.seed;
+  simulateSfm(scene, model, sim);
+  std::vector<Eigen::Vector3d> sfm;
+  for (const auto& [id, p] : model.points) sfm.push_back(p.xyz);
+  const std::vector<Camera>& cams = scene.cameras;
+
+  OccupancyOptions o;
+  o.resolution = a.resolution;
+  o.min_points = a.min_points;
+  o.upsample = a.upsample;
+  std::optional<OccupancyGrids> g;
+  const double t_build = medianMs(7, [&] { g.emplace(OccupancyGrids::fromSfm(sfm, o)); });
+  // Observed: depth-map points of 8 train views spread over the split (stand-ins for
+  // SA-Points), every second pixel.
+  std::vector<Eigen::Vector3d> sa;
+  const std::size_t views = std::min<std::size_t>(8, scene.train.size());
+  for (std::size_t k = 0; k < views; ++k) {
+    const Camera& cam = cams[scene.train[k * scene.train.size() / views]];
+    const ImageF depth = scene.renderDepth(cam);
+    for (int v = 0; v < depth.height; v += 2)
+      for (int u = 0; u < depth.width; u += 2)
+        if (depth.at(u, v) > 0) sa.push_back(cam.unproject(Eigen::Vector2d(u + 0.5, v + 0.5), depth.at(u, v)));
+  }
+  const double t_obs = medianMs(5, [&] {
+    g->clearObserved();
+    g->addObserved(sa);
+  });
+  const VoxelSet obs = g->observedSceneVoxels();
+  std::optional<VisibilityTracer> tracer;
+  const double t_tracer = medianMs(3, [&] { tracer.emplace(*g); });
+
+  // Per candidate: every camera of the scene is a candidate.
+  const double n = static_cast<double>(cams.size());
+  std::vector<VoxelSet> fr(cams.size()), vis(cams.size());
+  const double t_fr = medianMs(3, [&] {
+    for (std::size_t j = 0; j < cams.size(); ++j) fr[j] = frustumSet(*g, cams[j]);
+  }) / n;
+  const double t_vis4 = medianMs(3, [&] {
+    for (std::size_t j = 0; j < cams.size(); ++j) vis[j] = tracer->visibleSet(cams[j], 4);
+  }) / n;
+  const double t_vis1 = medianMs(1, [&] {
+    for (std::size_t j = 0; j < cams.size(); ++j) tracer->visibleSet(cams[j], 1);
+  }) / n;
+  double mean_fr = 0, mean_vis = 0;
+  for (std::size_t j = 0; j < cams.size(); ++j) {
+    mean_fr += static_cast<double>(fr[j].size());
+    mean_vis += static_cast<double>(vis[j].size());
+  }
+
+  CoverageScoring p;
+  p.encoding = CoverageEncoding::Exact;
+  const double t_exact = medianMs(5, [&] { scoreCandidates(obs, fr, g->sceneCount(), p); }) / n;
+  p.encoding = CoverageEncoding::Hashed;
+  p.table_size = std::size_t{1} << 19;
+  const double t_h19 = medianMs(5, [&] { scoreCandidates(obs, fr, g->sceneCount(), p); }) / n;
+  p.table_size = std::size_t{1} << 11;
+  const double t_h11 = medianMs(5, [&] { scoreCandidates(obs, fr, g->sceneCount(), p); }) / n;
+  // The dense path, on one thread: encode each candidate into T bits, XOR/popcount all T.
+  const HashedBits ho = HashedBits::encode(obs, std::size_t{1} << 19);
+  const double t_dense19 = medianMs(5, [&] {
+    for (const VoxelSet& c : fr) scoreHashed(ho, HashedBits::encode(c, std::size_t{1} << 19));
+  }) / n;
+  const GridMemory m = g->memory();
+
+  nlohmann::json j;
+  j["benchmark"] = "occupancy";
+  j["layout"] = "room360";
+  j["width"] = a.width;
+  j["height"] = a.height;
+  j["sfm_points"] = sfm.size();
+  j["cameras"] = cams.size();
+  j["resolution"] = a.resolution;
+  j["upsample"] = a.upsample;
+  j["min_points"] = a.min_points;
+  j["threads"] = threads;
+  j["coarse_voxels"] = g->coarseCount();
+  j["scene_voxels"] = g->sceneCount();
+  j["voxel_size"] = g->voxelSize();
+  j["observed_points"] = sa.size();
+  j["observed_voxels"] = g->observedCount();
+  j["observed_scene_voxels"] = obs.size();
+  j["observed_fraction"] = g->observedFraction();
+  j["mean_frustum_voxels"] = mean_fr / n;
+  j["mean_visible_voxels"] = mean_vis / n;
+  j["stage_ms"] = {{"scene_grid", t_build}, {"add_observed", t_obs}, {"embree_bvh", t_tracer}};
+  j["per_candidate_ms"] = {{"frustum_set", t_fr},        {"visible_set_stride4", t_vis4},
+                           {"visible_set_stride1", t_vis1}, {"score_exact", t_exact},
+                           {"score_hashed_2pow19", t_h19},  {"score_hashed_2pow11", t_h11},
+                           {"score_dense_2pow19_1thread", t_dense19}};
+  j["memory_kb"] = {{"scene_vdb", m.scene_vdb / 1024.0},
+                    {"observed_vdb", m.observed_vdb / 1024.0},
+                    {"scene_index", m.scene_index / 1024.0}};
+  j["peak_rss_mb"] = peakRssMb();
   j["cpu"] = cpuName();
   std::cout << j.dump() << std::endl;
   return 0;
@@ -184,6 +341,21 @@ void addBenchCommand(CLI::App& app, Action& action) {
   step->add_option("--seed", a->seed, "Scene seed")->capture_default_str();
   step->add_flag("--residual", a->residual, "Time residual-supervision steps too, and their ratio to plain ones");
   step->callback([&action, a] { action = [a] { return runBench(*a); }; });
+
+  auto o = std::make_shared<OccupancyBenchArgs>();
+  CLI::App* occ = bench->add_subcommand(
+      "occupancy", "Time the prefilter's parts (grids, candidate sets, scoring) on a room360 scene");
+  occ->add_option("--width", o->width, "Image width of the views")->check(CLI::Range(8, 16384))->capture_default_str();
+  occ->add_option("--height", o->height, "Image height of the views")->check(CLI::Range(8, 16384))->capture_default_str();
+  occ->add_option("--points", o->points, "Simulated SfM points at most")->check(CLI::Range(1, 10000000))->capture_default_str();
+  occ->add_option("--resolution", o->resolution, "Coarse voxels along the longest box side")
+      ->check(CLI::Range(1, 4096))->capture_default_str();
+  occ->add_option("--upsample", o->upsample, "Fine voxels per coarse voxel per axis")->check(CLI::Range(1, 16))->capture_default_str();
+  occ->add_option("--min-points", o->min_points, "SfM points for an occupied coarse voxel")
+      ->check(CLI::Range(1, 1000000))->capture_default_str();
+  occ->add_option("--threads", o->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
+  occ->add_option("--seed", o->seed, "Scene and SfM seed")->capture_default_str();
+  occ->callback([&action, o] { action = [o] { return runOccupancyBench(*o); }; });
 }
 
 }  // namespace saresgs::apps

@@ -9,10 +9,11 @@
 #include <sstream>
 
 #include "apps/commands.h"
+#include "apps/prefilter_flags.h"
 #include "geometry/error.h"
 #include "geometry/io/atomic_file.h"
 #include "geometry/synth/from_manifest.h"
-#include "nbv/coverage_report.h"
+#include "nbv/eval/coverage_report.h"
 #include "splat/ply.h"
 #include "splat/rasterize.h"
 
@@ -22,7 +23,8 @@ namespace {
 
 struct CoverageArgs {
   std::string dataset, out, views, model;
-  PrefilterChoice choice;
+  PrefilterConfig config;  // numeric options; the textual ones are in `flags`
+  PrefilterFlags flags;
   int downscale = 1;
 };
 
@@ -54,6 +56,7 @@ std::vector<int> parseViews(const std::string& text, const Scene& scene) {
 }
 
 int runCoverage(const CoverageArgs& a) {
+  const PrefilterConfig config = parsePrefilterFlags(a.flags, a.config, "--");
   DatasetOptions dopt;
   dopt.load.downscale = a.downscale;
   const Scene scene = loadDataset(a.dataset, dopt);
@@ -80,16 +83,16 @@ int runCoverage(const CoverageArgs& a) {
                      "not a rebuildable synthetic scene: give a trained model with --model to render extrapolated views");
   }
   std::cerr << "coverage of " << views.size() << " views from " << source << "\n";
-  const CoverageAnalysis c = analyzeCoverage(scene, views, a.choice, render, depth);
+  const CoverageAnalysis c = analyzeCoverage(scene, views, config, render, depth);
 
   std::filesystem::create_directories(a.out);
   nlohmann::json j;
   j["dataset"] = a.dataset;
   j["source"] = source;
-  j["set"] = a.choice.set;
-  j["encoding"] = a.choice.encoding;
-  j["score"] = a.choice.score;
-  j["lifting"] = a.choice.lifting;
+  j["set"] = toString(config.set);
+  j["encoding"] = encodingName(config.scoring);
+  j["score"] = toString(config.scoring.criterion);
+  j["lifting"] = toString(config.lifting);
   auto name = [&](int v) { return scene.views[static_cast<std::size_t>(v)].name; };
   for (int v : views) j["views"].push_back(name(v));
   j["observed_fraction"] = c.observed_fraction;
@@ -113,7 +116,7 @@ int runCoverage(const CoverageArgs& a) {
   std::printf("observed %zu of %zu scene voxels (%.1f %%) from %zu SA-Points; kept %zu of %zu candidates\n",
               c.observed_voxels, c.scene_voxels, 100 * c.observed_fraction, c.lifting.kept, c.top.size(),
               c.candidates.size());
-  std::printf("%-16s %12s %6s\n", "candidate", a.choice.score == "new" ? "new voxels" : "hamming", "rank");
+  std::printf("%-16s %12s %6s\n", "candidate", config.scoring.criterion == CoverageCriterion::NewCount ? "new voxels" : "hamming", "rank");
   std::vector<CandidateCoverage> by_rank = c.candidates;
   std::sort(by_rank.begin(), by_rank.end(), [](const auto& x, const auto& y) { return x.rank < y.rank; });
   for (std::size_t i = 0; i < by_rank.size() && i < 10; ++i)
@@ -134,15 +137,15 @@ void addCoverageCommand(CLI::App& app, Action& action) {
   sub->add_option("--views", a->views, "Observed train views: indices into the train list or image names, comma-separated")->required();
   sub->add_option("--out", a->out, "Output folder")->required();
   sub->add_option("--model", a->model, "Trained .ply to render extrapolated views (datasets without ground truth)");
-  sub->add_option("--set", a->choice.set, "frustum | visible")->check(CLI::IsMember({"frustum", "visible"}))->capture_default_str();
-  sub->add_option("--encoding", a->choice.encoding, "hash:K (K = 11..19) | exact")->capture_default_str();
-  sub->add_option("--score", a->choice.score, "xor | new")->check(CLI::IsMember({"xor", "new"}))->capture_default_str();
-  sub->add_option("--lifting", a->choice.lifting, "flow | depth")->check(CLI::IsMember({"flow", "depth"}))->capture_default_str();
-  sub->add_option("--keep", a->choice.keep_fraction, "Fraction of candidates kept (top N %)")->check(CLI::Range(0.0, 1.0))->capture_default_str();
-  sub->add_option("--resolution", a->choice.resolution, "Grid resolution along the longest side")->check(CLI::Range(4, 4096))->capture_default_str();
-  sub->add_option("--min-points", a->choice.min_points, "SfM points per occupied voxel (paper: 2 outdoor, 5 indoor)")->check(CLI::Range(1, 1000))->capture_default_str();
-  sub->add_option("--upsample", a->choice.upsample, "Upsampling of the occupied voxels")->check(CLI::Range(1, 16))->capture_default_str();
-  sub->add_option("--stride", a->choice.visible_stride, "Pixel stride of visibility rays")->check(CLI::Range(1, 64))->capture_default_str();
+  sub->add_option("--set", a->flags.set, "frustum | visible")->capture_default_str();
+  sub->add_option("--encoding", a->flags.encoding, "hash:K (K = 11..19) | exact")->capture_default_str();
+  sub->add_option("--score", a->flags.score, "xor | new")->capture_default_str();
+  sub->add_option("--lifting", a->flags.lifting, "flow | depth")->capture_default_str();
+  sub->add_option("--keep", a->config.keep_fraction, "Fraction of candidates kept (top N %)")->check(CLI::Range(0.0, 1.0))->capture_default_str();
+  sub->add_option("--resolution", a->config.resolution, "Grid resolution along the longest side")->check(CLI::Range(4, 4096))->capture_default_str();
+  sub->add_option("--min-points", a->config.min_points, "SfM points per occupied voxel (paper: 2 outdoor, 5 indoor)")->check(CLI::Range(1, 1000))->capture_default_str();
+  sub->add_option("--upsample", a->config.upsample, "Upsampling of the occupied voxels")->check(CLI::Range(1, 16))->capture_default_str();
+  sub->add_option("--stride", a->config.visible_stride, "Pixel stride of visibility rays")->check(CLI::Range(1, 64))->capture_default_str();
   sub->add_option("--downscale", a->downscale, "Image downscale factor")->check(CLI::Range(1, 64))->capture_default_str();
   sub->callback([&action, a] { action = [a] { return runCoverage(*a); }; });
 }

@@ -12,7 +12,7 @@
 #include "geometry/io/atomic_file.h"
 #include "geometry/scene/scene.h"
 #include "splat/ply.h"
-#include "splat/rasterize_detail.h"
+#include "splat/raster_execution.h"
 #include "splat/train/test_renders.h"
 #include "splat/train/trainer.h"
 
@@ -41,7 +41,7 @@ std::string shortCount(std::size_t n) {
 }
 
 int runTrain(TrainArgs& a) {
-  if (a.threads > 0) setRasterThreads(a.threads);
+  a.opt.raster.execution.threads = a.threads;
   a.opt.residual.ranking = parseUncertaintyRanking(a.ranking);
   DatasetOptions dopt;
   dopt.load.downscale = a.downscale;
@@ -86,7 +86,7 @@ int runTrain(TrainArgs& a) {
   j["ssim"] = ev.ssim;
   j["gaussians"] = trainer.gaussians().size();
   j["train_seconds_this_run"] = train_seconds;
-  j["threads"] = rasterThreads();
+  j["threads"] = rasterThreadCount(a.opt.raster.execution);
   j["residual"] = a.opt.residual.enabled;
   const StageSeconds& s = trainer.seconds();
   j["stage_seconds"] = {{"render", s.render}, {"loss", s.loss}, {"backward", s.backward},

@@ -13,103 +13,20 @@
 #include "geometry/io/json_file.h"
 #include "nbv/ause.h"
 #include "nbv/initial_views.h"
+#include "nbv/run_report.h"
 #include "splat/fisher.h"
 
 namespace saresgs {
 
 namespace {
 
+// Version 2 stores the steps as the run report does (views by name).
+constexpr const char* kCheckpointFormat = "saresgs-active-checkpoint-2";
+
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-void addSeconds(SelectionSeconds& a, const SelectionSeconds& b) {
-  a.lifting += b.lifting;
-  a.triangulation += b.triangulation;
-  a.prefilter += b.prefilter;
-  a.fisher += b.fisher;
-  a.training += b.training;
-  a.exhaustive_fisher += b.exhaustive_fisher;
-}
-
 }  // namespace
-
-SelectionSeconds secondsFrom(const nlohmann::json& j) {
-  SelectionSeconds s;
-  s.lifting = j.at("lifting");
-  s.triangulation = j.at("triangulation");
-  s.prefilter = j.at("prefilter");
-  s.fisher = j.at("fisher");
-  s.training = j.at("training");
-  s.exhaustive_fisher = j.at("exhaustive_fisher");
-  return s;
-}
-
-nlohmann::json toJson(const SelectionSeconds& s) {
-  return {{"lifting", s.lifting},   {"triangulation", s.triangulation}, {"prefilter", s.prefilter},
-          {"fisher", s.fisher},     {"training", s.training},           {"exhaustive_fisher", s.exhaustive_fisher}};
-}
-
-Method parseMethod(const std::string& s) {
-  for (Method m : {Method::kRandom, Method::kFvs, Method::kFisher, Method::kCoverage, Method::kSaHash, Method::kSaResgs,
-                   Method::kResgs})
-    if (s == toString(m)) return m;
-  throw std::invalid_argument("method '" + s + "': expected random, fvs, fisher, coverage, sa-hash, sa-resgs or resgs");
-}
-
-const char* toString(Method m) {
-  switch (m) {
-    case Method::kRandom: return "random";
-    case Method::kFvs: return "fvs";
-    case Method::kFisher: return "fisher";
-    case Method::kCoverage: return "coverage";
-    case Method::kSaHash: return "sa-hash";
-    case Method::kSaResgs: return "sa-resgs";
-    case Method::kResgs: return "resgs";
-  }
-  return "?";
-}
-
-MethodNeeds needsOf(Method m) {
-  switch (m) {
-    case Method::kRandom:
-    case Method::kFvs: return {false, false, false};
-    case Method::kFisher: return {true, false, false};
-    case Method::kCoverage: return {false, true, false};
-    case Method::kSaHash: return {true, true, false};
-    case Method::kSaResgs: return {true, true, true};
-    case Method::kResgs: return {true, false, true};
-  }
-  return {};
-}
-
-void applyPreset(const std::string& name, ActiveOptions& o) {
-  if (name == "paper") {
-    o.interval = 100;
-    o.total_iterations = 20000;
-    return;
-  }
-  if (name == "quick") {
-    // Sized so that a 20-view run on a 256x192 scene takes at most ~10 minutes on 2 cores:
-    // 25 iterations per view held (the paper's 100), 5000 in all, densification and the
-    // SH schedule scaled alike. A 20-view sa-resgs run on room360 trained at ~10 it/s
-    // with selection included (40 per view, 8000 in all, measured: over 13 minutes).
-    o.interval = 25;
-    o.total_iterations = 5000;
-    o.trainer.densify.from_iter = 125;
-    o.trainer.densify.interval = 25;
-    o.trainer.densify.opacity_reset_interval = 750;
-    o.trainer.densify.until_iter = 3750;
-    o.trainer.densify.min_iterations_after_reset = 125;
-    o.trainer.sh_interval = 250;
-    // Densification's 2e-4 threshold is sized for ~800-pixel images; at 256x192 an
-    // unbounded run grew room360 to 215k Gaussians (over 4 per pixel), which made training
-    // and Fisher scoring the whole cost. The cap keeps the model at a size the images
-    // can constrain.
-    o.trainer.densify.max_gaussians = 40000;
-    return;
-  }
-  throw std::invalid_argument("preset '" + name + "': expected paper or quick");
-}
 
 ActiveRun::ActiveRun(const Scene& scene, const ActiveOptions& opt, std::string checkpoint)
     : scene_(scene), opt_(opt), checkpoint_(std::move(checkpoint)), rng_(opt.seed) {
@@ -121,7 +38,7 @@ ActiveRun::ActiveRun(const Scene& scene, const ActiveOptions& opt, std::string c
   to.seed = opt_.seed;
   to.residual.enabled = needs.residual;
   trainer_ = std::make_unique<Trainer>(scene_, to);
-  if (needs.coverage) prefilter_ = makeCoveragePrefilter(scene_, opt_.prefilter, opt_.seed);
+  if (needs.coverage) prefilter_ = makeCoveragePrefilter(scene_, opt_.prefilter);
 }
 
 int ActiveRun::selectNext(SelectionLog& log) {
@@ -224,7 +141,7 @@ ActiveResult ActiveRun::run(const std::function<void(const ActiveProgress&)>& pr
   r.initial_views = initial_;
   r.selected_views = selected_;
   r.steps = steps_;
-  for (const auto& s : steps_) addSeconds(r.total_seconds, s.seconds);
+  for (const auto& s : steps_) r.total_seconds += s.seconds;
   r.iterations = iterations_done_;
   r.test = trainer_->evaluate(scene_.test.empty() ? scene_.train : scene_.test);
   r.ause = depthAuse(*trainer_, selected_, scene_.test.empty() ? scene_.train : scene_.test, opt_.fisher_lambda);
@@ -238,7 +155,7 @@ void ActiveRun::saveCheckpoint() const {
   trainer_->saveCheckpoint(checkpoint_ + ".trainer." + tag);
   if (prefilter_) writeFileAtomic(checkpoint_ + ".prefilter." + tag, prefilter_->save());
   nlohmann::json j;
-  j["format"] = "saresgs-active-checkpoint-1";
+  j["format"] = kCheckpointFormat;
   j["method"] = toString(opt_.method);
   j["seed"] = opt_.seed;
   j["views"] = scene_.views.size();
@@ -250,10 +167,8 @@ void ActiveRun::saveCheckpoint() const {
   rs << rng_;
   j["rng"] = rs.str();
   j["tag"] = tag;
-  for (const SelectionLog& s : steps_)
-    j["steps"].push_back({{"views_before", s.views_before}, {"selected", s.selected}, {"candidates", s.candidates},
-                          {"scores", s.scores}, {"prefiltered", s.prefiltered}, {"seconds", toJson(s.seconds)},
-                          {"progress_psnr", s.progress_psnr}});
+  j["steps"] = nlohmann::json::array();
+  for (const SelectionLog& s : steps_) j["steps"].push_back(toJson(stepReport(scene_, s)));
   writeFileAtomic(checkpoint_, j.dump() + "\n");
   // Older companions are obsolete once the state that names the new ones is in place.
   const int previous = static_cast<int>(selected_.size()) - 1;
@@ -269,7 +184,7 @@ bool ActiveRun::loadCheckpoint() {
     if (!j.contains(name)) throw InputError(checkpoint_, name, "missing");
     return j[name];
   };
-  if (field("format") != "saresgs-active-checkpoint-1") throw InputError(checkpoint_, "format", "not an active-run checkpoint");
+  if (field("format") != kCheckpointFormat) throw InputError(checkpoint_, "format", "not an active-run checkpoint");
   if (field("method") != toString(opt_.method))
     throw InputError(checkpoint_, "method", "written by method " + j["method"].dump() + ", this run is " + toString(opt_.method));
   if (field("seed") != opt_.seed) throw InputError(checkpoint_, "seed", "written with seed " + j["seed"].dump());
@@ -281,61 +196,18 @@ bool ActiveRun::loadCheckpoint() {
     observed_upto_ = field("observed_upto");
     std::istringstream rs(field("rng").get<std::string>());
     rs >> rng_;
-    steps_.clear();
-    for (const auto& s : field("steps")) {
-      SelectionLog l;
-      l.views_before = s.at("views_before");
-      l.selected = s.at("selected");
-      l.candidates = s.at("candidates").get<std::vector<int>>();
-      l.scores = s.at("scores").get<std::vector<double>>();
-      l.prefiltered = s.at("prefiltered").get<std::vector<int>>();
-      l.seconds = secondsFrom(s.at("seconds"));
-      l.progress_psnr = s.at("progress_psnr");
-      steps_.push_back(std::move(l));
-    }
   } catch (const nlohmann::json::exception& e) {
-    throw InputError(checkpoint_, "steps", std::string("unexpected content: ") + e.what());
+    throw InputError(checkpoint_, "state", std::string("unexpected content: ") + e.what());
   }
+  steps_.clear();
+  const nlohmann::json& steps = field("steps");
+  if (!steps.is_array()) throw InputError(checkpoint_, "steps", "expected an array");
+  for (std::size_t i = 0; i < steps.size(); ++i)
+    steps_.push_back(selectionLog(scene_, stepReportFromJson(steps[i], checkpoint_, "steps[" + std::to_string(i) + "]"), checkpoint_));
   const std::string tag = field("tag");
   trainer_->loadCheckpoint(checkpoint_ + ".trainer." + tag);
   if (prefilter_) prefilter_->load(readFile(checkpoint_ + ".prefilter." + tag));
   return true;
-}
-
-std::optional<double> depthAuse(const Trainer& t, const std::vector<int>& train_views, const std::vector<int>& views,
-                                double lambda) {
-  const Scene& scene = t.scene();
-  bool any = false;
-  for (int v : views) any = any || scene.hasDepth(v);
-  if (!any) return std::nullopt;
-  const RasterSettings s = t.rasterSettings();
-  Gaussians H = t.gaussians().zerosLike();
-  for (int v : train_views) addViewInformation(t.gaussians(), scene.views[static_cast<std::size_t>(v)].camera, s, H);
-  const Gaussians unc = withScalarColor(t.gaussians(), gaussianGeometryVariance(H, lambda));
-  RasterSettings us = s;
-  us.sh_degree = 0;
-  us.background = {0, 0, 0};
-  double sum = 0;
-  int n = 0;
-  for (int v : views) {
-    if (!scene.hasDepth(v)) continue;
-    const Camera& cam = scene.views[static_cast<std::size_t>(v)].camera;
-    const ImageF gt = scene.depth(v);
-    const RenderResult r = t.render(cam);
-    const RenderResult u = rasterize(unc, cam, us);
-    std::vector<double> err, un;
-    for (std::size_t p = 0; p < gt.data.size(); ++p) {
-      if (!(gt.data[p] > 0)) continue;
-      err.push_back(std::abs(static_cast<double>(r.depth.data[p]) - gt.data[p]));
-      un.push_back(u.rgb.data[3 * p]);
-    }
-    if (const auto c = sparsification(err, un)) {
-      sum += c->ause;
-      ++n;
-    }
-  }
-  if (n == 0) return std::nullopt;
-  return sum / n;
 }
 
 }  // namespace saresgs

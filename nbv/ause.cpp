@@ -1,8 +1,11 @@
 #include "nbv/ause.h"
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 #include <stdexcept>
+
+#include "splat/fisher.h"
 
 namespace saresgs {
 
@@ -50,6 +53,42 @@ std::optional<SparsificationCurves> sparsification(const std::vector<double>& er
   }
   c.ause = area / steps;
   return c;
+}
+
+std::optional<double> depthAuse(const Trainer& t, const std::vector<int>& train_views, const std::vector<int>& views,
+                                double lambda) {
+  const Scene& scene = t.scene();
+  bool any = false;
+  for (int v : views) any = any || scene.hasDepth(v);
+  if (!any) return std::nullopt;
+  const RasterSettings s = t.rasterSettings();
+  Gaussians H = t.gaussians().zerosLike();
+  for (int v : train_views) addViewInformation(t.gaussians(), scene.views[static_cast<std::size_t>(v)].camera, s, H);
+  const Gaussians unc = withScalarColor(t.gaussians(), gaussianGeometryVariance(H, lambda));
+  RasterSettings us = s;
+  us.sh_degree = 0;
+  us.background = {0, 0, 0};
+  double sum = 0;
+  int n = 0;
+  for (int v : views) {
+    if (!scene.hasDepth(v)) continue;
+    const Camera& cam = scene.views[static_cast<std::size_t>(v)].camera;
+    const ImageF gt = scene.depth(v);
+    const RenderResult r = t.render(cam);
+    const RenderResult u = rasterize(unc, cam, us);
+    std::vector<double> err, un;
+    for (std::size_t p = 0; p < gt.data.size(); ++p) {
+      if (!(gt.data[p] > 0)) continue;
+      err.push_back(std::abs(static_cast<double>(r.depth.data[p]) - gt.data[p]));
+      un.push_back(u.rgb.data[3 * p]);
+    }
+    if (const auto c = sparsification(err, un)) {
+      sum += c->ause;
+      ++n;
+    }
+  }
+  if (n == 0) return std::nullopt;
+  return sum / n;
 }
 
 }  // namespace saresgs

@@ -8,6 +8,8 @@
 #include <optional>
 #include <vector>
 
+#include "splat/train/trainer.h"
+
 namespace saresgs {
 
 struct SparsificationCurves {
@@ -20,5 +22,11 @@ struct SparsificationCurves {
 // Ties in uncertainty break by pixel index, so the result is deterministic.
 std::optional<SparsificationCurves> sparsification(const std::vector<double>& error,
                                                    const std::vector<double>& uncertainty, int steps = 100);
+
+// AUSE of the trainer's depth against ground truth on `views` (mean over views with
+// depth), uncertainty rendered from the diagonal Fisher information of `train_views`;
+// nullopt when no view has depth.
+std::optional<double> depthAuse(const Trainer& t, const std::vector<int>& train_views, const std::vector<int>& views,
+                                double lambda = 1e-6);
 
 }  // namespace saresgs

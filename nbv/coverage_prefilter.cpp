@@ -1,17 +1,17 @@
-// The coverage prefilter: SA-Points (geometry/lifting) accumulate into the observed
-// occupancy grid (geometry/occupancy); each candidate's voxel set (frustum or
-// Embree-visible) is compared with it, hashed or exact, by the paper's normalised
-// Hamming distance or by the count of newly covered voxels.
+#include "nbv/coverage_prefilter.h"
+
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <map>
+#include <numeric>
 #include <stdexcept>
 
 #include "geometry/error.h"
 #include "geometry/occupancy/candidate_sets.h"
 #include "geometry/occupancy/coverage_score.h"
 #include "geometry/occupancy/occupancy_grid.h"
-#include "nbv/active_run.h"
 
 namespace saresgs {
 
@@ -19,10 +19,7 @@ namespace {
 
 class SaPointPrefilter : public CoveragePrefilter {
  public:
-  SaPointPrefilter(const Scene& scene, const PrefilterChoice& o) : scene_(scene), choice_(o) {
-    if (o.set != "frustum" && o.set != "visible") throw std::invalid_argument("prefilter set '" + o.set + "': expected frustum or visible");
-    if (o.lifting != "flow" && o.lifting != "depth") throw std::invalid_argument("lifting '" + o.lifting + "': expected flow or depth");
-    opts_ = prefilterOptions(o.encoding, o.score, o.keep_fraction);
+  SaPointPrefilter(const Scene& scene, const PrefilterConfig& o) : scene_(scene), config_(o) {
     if (scene.points.empty())
       throw InputError(scene.source, "points", "the coverage prefilter needs sparse SfM points for its occupancy grid");
     std::vector<Eigen::Vector3d> pts;
@@ -33,11 +30,12 @@ class SaPointPrefilter : public CoveragePrefilter {
     oo.min_points = o.min_points;
     oo.upsample = o.upsample;
     grids_ = std::make_unique<OccupancyGrids>(OccupancyGrids::fromSfm(pts, oo));
+    sets_ = std::make_unique<CandidateSetBuilder>(*grids_);
   }
 
   void observe(const std::vector<int>& views, const ViewRenderer& render, const DepthRenderer& depth,
                SelectionSeconds& t) override {
-    const LiftingModule module = choice_.lifting == "depth" ? depthModule(depth) : flowModule();
+    const LiftingModule module = config_.lifting == LiftingSource::kDepth ? depthModule(depth) : flowModule();
     for (int v : views) {
       const Camera& cam = scene_.views.at(static_cast<std::size_t>(v)).camera;
       const LiftingResult r = liftView(cam, scene_.imageFloat(v), scene_.extent, render, module, lifting_, v);
@@ -58,9 +56,9 @@ class SaPointPrefilter : public CoveragePrefilter {
     std::vector<VoxelSet> sets;
     sets.reserve(candidates.size());
     for (int c : candidates) sets.push_back(candidateSet(c));
-    const auto scores = scoreCandidates(grids_->observedSceneVoxels(), sets, grids_->sceneCount(), opts_);
+    const auto scores = scoreCandidates(grids_->observedSceneVoxels(), sets, grids_->sceneCount(), config_.scoring);
     std::vector<double> out;
-    for (const auto& s : scores) out.push_back(criterionValue(s, opts_.criterion));
+    for (const auto& s : scores) out.push_back(criterionValue(s, config_.scoring.criterion));
     t.prefilter += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return out;
   }
@@ -85,22 +83,14 @@ class SaPointPrefilter : public CoveragePrefilter {
     auto it = cache_.find(view);
     if (it != cache_.end()) return it->second;
     const Camera& cam = scene_.views.at(static_cast<std::size_t>(view)).camera;
-    VoxelSet s;
-    if (choice_.set == "frustum") {
-      s = frustumSet(*grids_, cam);
-    } else {
-      if (!tracer_) tracer_ = std::make_unique<VisibilityTracer>(*grids_);
-      s = tracer_->visibleSet(cam, choice_.visible_stride);
-    }
-    return cache_.emplace(view, std::move(s)).first->second;
+    return cache_.emplace(view, sets_->build(cam, config_.set, config_.visible_stride)).first->second;
   }
 
   const Scene& scene_;
-  PrefilterChoice choice_;
-  PrefilterOptions opts_;
+  PrefilterConfig config_;
   LiftingOptions lifting_;
   std::unique_ptr<OccupancyGrids> grids_;
-  std::unique_ptr<VisibilityTracer> tracer_;
+  std::unique_ptr<CandidateSetBuilder> sets_;
   std::map<int, VoxelSet> cache_;
   std::vector<Eigen::Vector3d> observed_points_;
   LiftingReport report_;
@@ -108,35 +98,83 @@ class SaPointPrefilter : public CoveragePrefilter {
 
 }  // namespace
 
-PrefilterOptions prefilterOptions(const std::string& encoding, const std::string& score, double keep_fraction,
-                                  int min_bits, int max_bits) {
-  PrefilterOptions o;
-  o.keep_percent = 100.0 * keep_fraction;
-  if (score == "xor") o.criterion = CoverageCriterion::Hamming;
-  else if (score == "new") o.criterion = CoverageCriterion::NewCount;
-  else throw std::invalid_argument("prefilter score '" + score + "': expected xor or new");
-  if (encoding == "exact") {
-    o.encoding = CoverageEncoding::Exact;
-  } else if (encoding.rfind("hash:", 0) == 0) {
-    int bits = 0;
-    try {
-      bits = std::stoi(encoding.substr(5));
-    } catch (const std::exception&) {
-      bits = 0;
-    }
-    if (bits < min_bits || bits > max_bits)
-      throw std::invalid_argument("prefilter encoding '" + encoding + "': expected hash:" + std::to_string(min_bits) +
-                                  " .. hash:" + std::to_string(max_bits) + " or exact");
-    o.encoding = CoverageEncoding::Hashed;
-    o.table_size = std::size_t{1} << bits;
-  } else {
-    throw std::invalid_argument("prefilter encoding '" + encoding + "': expected hash:K or exact");
-  }
-  return o;
+CandidateSetBuilder::CandidateSetBuilder(const OccupancyGrids& grids) : grids_(grids) {}
+CandidateSetBuilder::~CandidateSetBuilder() = default;
+
+void CandidateSetBuilder::prepare(CandidateSetKind kind) const {
+  if (kind == CandidateSetKind::kVisible && !tracer_) tracer_ = std::make_unique<VisibilityTracer>(grids_);
 }
 
-std::unique_ptr<CoveragePrefilter> makeCoveragePrefilter(const Scene& scene, const PrefilterChoice& o, std::uint64_t) {
-  return std::make_unique<SaPointPrefilter>(scene, o);
+VoxelSet CandidateSetBuilder::build(const Camera& cam, CandidateSetKind kind, int visible_stride) const {
+  if (kind == CandidateSetKind::kFrustum) return frustumSet(grids_, cam);
+  prepare(kind);
+  return tracer_->visibleSet(cam, visible_stride);
+}
+
+CandidateSetKind parseCandidateSet(std::string_view text) {
+  if (text == "frustum") return CandidateSetKind::kFrustum;
+  if (text == "visible") return CandidateSetKind::kVisible;
+  throw std::invalid_argument("prefilter set '" + std::string(text) + "': expected frustum or visible");
+}
+const char* toString(CandidateSetKind k) { return k == CandidateSetKind::kFrustum ? "frustum" : "visible"; }
+
+LiftingSource parseLiftingSource(std::string_view text) {
+  if (text == "flow") return LiftingSource::kFlow;
+  if (text == "depth") return LiftingSource::kDepth;
+  throw std::invalid_argument("lifting '" + std::string(text) + "': expected flow or depth");
+}
+const char* toString(LiftingSource s) { return s == LiftingSource::kFlow ? "flow" : "depth"; }
+
+CoverageCriterion parseCoverageCriterion(std::string_view text) {
+  if (text == "xor") return CoverageCriterion::Hamming;
+  if (text == "new") return CoverageCriterion::NewCount;
+  throw std::invalid_argument("prefilter score '" + std::string(text) + "': expected xor or new");
+}
+const char* toString(CoverageCriterion c) { return c == CoverageCriterion::Hamming ? "xor" : "new"; }
+
+void parseCoverageEncoding(std::string_view text, CoverageScoring& scoring, int min_bits, int max_bits) {
+  const std::string t(text);
+  if (t == "exact") {
+    scoring.encoding = CoverageEncoding::Exact;
+    return;
+  }
+  if (t.rfind("hash:", 0) != 0) throw std::invalid_argument("prefilter encoding '" + t + "': expected hash:K or exact");
+  int bits = 0;
+  const std::string digits = t.substr(5);
+  if (!digits.empty() && digits.size() <= 2 && std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
+    bits = std::stoi(digits);
+  if (bits < min_bits || bits > max_bits)
+    throw std::invalid_argument("prefilter encoding '" + t + "': expected hash:" + std::to_string(min_bits) + " .. hash:" +
+                                std::to_string(max_bits) + " or exact");
+  scoring.encoding = CoverageEncoding::Hashed;
+  scoring.table_size = std::size_t{1} << bits;
+}
+
+std::string encodingName(const CoverageScoring& s) {
+  if (s.encoding == CoverageEncoding::Exact) return "exact";
+  int bits = 0;
+  while ((std::size_t{1} << bits) < s.table_size) ++bits;
+  return "hash:" + std::to_string(bits);
+}
+
+std::vector<int> topFraction(const std::vector<double>& scores, const std::vector<int>& candidates, double fraction) {
+  if (scores.size() != candidates.size()) throw std::invalid_argument("topFraction: bad sizes");
+  std::vector<std::size_t> order(scores.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    const double sa = std::isnan(scores[a]) ? -INFINITY : scores[a], sb = std::isnan(scores[b]) ? -INFINITY : scores[b];
+    return sa != sb ? sa > sb : candidates[a] < candidates[b];
+  });
+  const std::size_t k = std::clamp<std::size_t>(
+      static_cast<std::size_t>(std::ceil(fraction * static_cast<double>(scores.size()) - 1e-9)), 1, std::max<std::size_t>(1, scores.size()));
+  std::vector<int> out;
+  for (std::size_t i = 0; i < std::min(k, order.size()); ++i) out.push_back(candidates[order[i]]);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::unique_ptr<CoveragePrefilter> makeCoveragePrefilter(const Scene& scene, const PrefilterConfig& config) {
+  return std::make_unique<SaPointPrefilter>(scene, config);
 }
 
 }  // namespace saresgs

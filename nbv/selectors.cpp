@@ -66,20 +66,4 @@ std::size_t argmaxScore(const std::vector<double>& scores, const std::vector<int
   return best;
 }
 
-std::vector<int> topFraction(const std::vector<double>& scores, const std::vector<int>& candidates, double fraction) {
-  if (scores.size() != candidates.size()) throw std::invalid_argument("topFraction: bad sizes");
-  std::vector<std::size_t> order(scores.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    const double sa = std::isnan(scores[a]) ? -INFINITY : scores[a], sb = std::isnan(scores[b]) ? -INFINITY : scores[b];
-    return sa != sb ? sa > sb : candidates[a] < candidates[b];
-  });
-  const std::size_t k = std::clamp<std::size_t>(
-      static_cast<std::size_t>(std::ceil(fraction * static_cast<double>(scores.size()) - 1e-9)), 1, std::max<std::size_t>(1, scores.size()));
-  std::vector<int> out;
-  for (std::size_t i = 0; i < std::min(k, order.size()); ++i) out.push_back(candidates[order[i]]);
-  std::sort(out.begin(), out.end());
-  return out;
-}
-
 }  // namespace saresgs

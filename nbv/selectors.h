@@ -34,8 +34,4 @@ std::vector<double> fisherScores(const Gaussians& g, const RasterSettings& s, co
 // Index (into candidates) of the highest score; ties to the lowest view index.
 std::size_t argmaxScore(const std::vector<double>& scores, const std::vector<int>& candidates);
 
-// The candidates in the top `fraction` (at least one) by score, in view order.
-std::vector<int> topFraction(const std::vector<double>& scores, const std::vector<int>& candidates,
-                             double fraction);
-
 }  // namespace saresgs

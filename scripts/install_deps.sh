@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   # toolchain
   g++ cmake ninja-build pkg-config
-  # libraries (STACK_NOTES.md); OpenVDB's find module needs boost-iostreams too
+  # libraries (one note each in third_party_notes/); OpenVDB's find module needs boost-iostreams too
   libembree-dev libopenvdb-dev libboost-iostreams-dev libtbb-dev libeigen3-dev
   libopencv-dev libcgal-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev libcli11-dev
   # COLMAP: the tests convert our models with `colmap model_converter`; `--sfm colmap`

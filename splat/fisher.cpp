@@ -2,7 +2,13 @@
 
 #include <stdexcept>
 
+#include "splat/fisher_detail.h"
+
 namespace saresgs {
+
+void addViewInformation(const Gaussians& g, const Camera& cam, const RasterSettings& s, Gaussians& H) {
+  addViewInformationT(g, cam, s, H);
+}
 
 std::vector<float> gaussianGeometryVariance(const Gaussians& H, double lambda) {
   std::vector<float> out(H.size());

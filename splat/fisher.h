@@ -1,26 +1,24 @@
 #pragma once
-// FisherRF's diagonal information (DESIGN.md). A view's information is, per parameter,
+// FisherRF's diagonal information (docs/DESIGN.md). A view's information is, per parameter,
 // the sum over its pixels of the squared gradient of the rendered colour (channels
 // summed), over means, log-scales, opacity logits and SH (DC and rest); rotations are
 // excluded. H_train is the sum over the current train views; a candidate v scores
 //   sum_p H_v[p] / (H_train[p] + lambda),
-// the trace form of the expected information gain. Templated so that the tests can run
-// the same code in double against finite differences.
+// the trace form of the expected information gain. The view information is also
+// templated on the scalar (splat/fisher_detail.h), so that the tests can run the same
+// code in double against finite differences.
+#include <algorithm>
 #include <cstddef>
 #include <vector>
 
 #include "geometry/camera/camera.h"
 #include "splat/gaussians.h"
-#include "splat/rasterize_detail.h"
+#include "splat/rasterize.h"
 
 namespace saresgs {
 
 // Adds view `cam`'s information to `H` (same shape as g; rotations untouched).
-template <typename T>
-void addViewInformation(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& s, GaussiansT<T>& H) {
-  const RenderOutputT<T> fwd = rasterizeT(g, cam, s);
-  rasterizeSquaredGradientsT(g, cam, s, fwd, H);
-}
+void addViewInformation(const Gaussians& g, const Camera& cam, const RasterSettings& s, Gaussians& H);
 
 // sum over the included parameters of Hv / (Htrain + lambda), accumulated in double in a
 // fixed order (deterministic).

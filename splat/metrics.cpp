@@ -1,6 +1,6 @@
 #include "splat/metrics.h"
 
-#include "splat/ssim_detail.h"
+#include "splat/ssim.h"
 
 #include <algorithm>
 #include <cmath>
@@ -35,14 +35,14 @@ double psnr(const ImageF& a, const ImageF& b) {
 
 double ssim(const ImageF& a, const ImageF& b) {
   checkSameShape(a, b);
-  // The same kernel as the training loss (splat/ssim_detail.h), on clamped copies.
+  // The same kernel as the training loss (splat/ssim.h), on clamped copies.
   std::vector<float> x(a.data.size()), y(b.data.size());
   for (size_t i = 0; i < x.size(); ++i) {
     x[i] = clamp01(a.data[i]);
     y[i] = clamp01(b.data[i]);
   }
-  const detail::SsimL1Sums s =
-      detail::ssimL1(x.data(), y.data(), a.width, a.height, a.channels, nullptr, 0.0, 0.0);
+  const SsimL1Sums s =
+      ssimL1(x.data(), y.data(), a.width, a.height, a.channels, nullptr, 0.0, 0.0);
   return 1.0 - s.one_minus_ssim / (static_cast<double>(a.width) * a.height * a.channels);
 }
 

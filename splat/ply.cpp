@@ -92,24 +92,68 @@ std::string stripCr(std::string s) {
   return s;
 }
 
-Header parseHeader(std::istream& in, const std::string& path) {
-  Header h;
-  std::string line;
-  // The magic: read at most a few bytes so that a large binary file is not read as a line.
+// The magic line "ply": read at most a few bytes, so that a large binary file is not
+// read as a line.
+void readMagic(std::istream& in, const std::string& path) {
   char magic[4] = {};
   in.read(magic, 4);
   if (in.gcount() < 3 || std::string(magic, 3) != "ply" ||
       (in.gcount() == 4 && magic[3] != '\n' && magic[3] != '\r'))
     throw InputError(path, "header", "not a PLY file (does not start with the line 'ply')");
   if (magic[3] == '\r' && in.peek() == '\n') in.get();  // "\r\n" line ending
+}
 
+// "element NAME COUNT" (after the key).
+Element parseElement(std::istringstream& ls, const std::string& line, const std::string& path) {
+  Element e;
+  std::string count;
+  ls >> e.name >> count;
+  if (e.name.empty() || count.empty() || count.find_first_not_of("0123456789") != std::string::npos)
+    throw InputError(path, "header", "bad element line '" + line + "'");
+  try {
+    e.count = std::stoull(count);
+  } catch (const std::exception&) {
+    throw InputError(path, "element " + e.name, "count '" + count + "' out of range");
+  }
+  return e;
+}
+
+// "property TYPE NAME" or "property list COUNT_TYPE ITEM_TYPE NAME" (after the key),
+// added to element `e`.
+void addProperty(std::istringstream& ls, const std::string& line, const std::string& path, Element& e) {
+  Property p;
+  std::string type;
+  ls >> type;
+  if (type == "list") {
+    std::string count_type, item_type;
+    ls >> count_type >> item_type >> p.name;
+    if (!parseType(count_type) || !parseType(item_type) || p.name.empty())
+      throw InputError(path, "header", "bad property line '" + line + "'");
+    p.is_list = true;
+    e.has_list = true;
+  } else {
+    const auto t = parseType(type);
+    ls >> p.name;
+    if (!t || p.name.empty()) throw InputError(path, "header", "bad property line '" + line + "'");
+    p.type = *t;
+    p.type_name = type;
+    p.offset = e.stride;
+    e.stride += typeSize(p.type);
+  }
+  for (const auto& q : e.props)
+    if (q.name == p.name) throw InputError(path, "property " + p.name, "appears twice in element " + e.name);
+  e.props.push_back(std::move(p));
+}
+
+Header parseHeader(std::istream& in, const std::string& path) {
+  readMagic(in, path);
+  Header h;
   bool have_format = false, ended = false;
   std::size_t header_bytes = 4;
   constexpr std::size_t kMaxHeader = 1 << 20;
-  while (std::getline(in, line)) {
+  for (std::string line; std::getline(in, line);) {
     header_bytes += line.size() + 1;
-    if (header_bytes > kMaxHeader)
-      throw InputError(path, "header", "longer than 1 MiB without end_header");
+    if (header_bytes > kMaxHeader) throw InputError(path, "header", "longer than 1 MiB without end_header");
     line = stripCr(line);
     std::istringstream ls(line);
     std::string key;
@@ -124,58 +168,19 @@ Header parseHeader(std::istream& in, const std::string& path) {
       ls >> fmt >> version;
       if (fmt != "binary_little_endian")
         throw InputError(path, "format",
-                         "found '" + fmt + (version.empty() ? "" : " " + version) +
-                             "', expected binary_little_endian");
+                         "found '" + fmt + (version.empty() ? "" : " " + version) + "', expected binary_little_endian");
       have_format = true;
     } else if (key == "element") {
-      Element e;
-      std::string count;
-      ls >> e.name >> count;
-      if (e.name.empty() || count.empty() ||
-          count.find_first_not_of("0123456789") != std::string::npos)
-        throw InputError(path, "header", "bad element line '" + line + "'");
-      try {
-        e.count = std::stoull(count);
-      } catch (const std::exception&) {
-        throw InputError(path, "element " + e.name, "count '" + count + "' out of range");
-      }
-      h.elements.push_back(std::move(e));
+      h.elements.push_back(parseElement(ls, line, path));
     } else if (key == "property") {
-      if (h.elements.empty())
-        throw InputError(path, "header", "property before any element: '" + line + "'");
-      Element& e = h.elements.back();
-      Property p;
-      std::string type;
-      ls >> type;
-      if (type == "list") {
-        std::string count_type, item_type;
-        ls >> count_type >> item_type >> p.name;
-        if (!parseType(count_type) || !parseType(item_type) || p.name.empty())
-          throw InputError(path, "header", "bad property line '" + line + "'");
-        p.is_list = true;
-        e.has_list = true;
-      } else {
-        const auto t = parseType(type);
-        ls >> p.name;
-        if (!t || p.name.empty())
-          throw InputError(path, "header", "bad property line '" + line + "'");
-        p.type = *t;
-        p.type_name = type;
-        p.offset = e.stride;
-        e.stride += typeSize(p.type);
-      }
-      for (const auto& q : e.props)
-        if (q.name == p.name)
-          throw InputError(path, "property " + p.name,
-                           "appears twice in element " + e.name);
-      e.props.push_back(std::move(p));
+      if (h.elements.empty()) throw InputError(path, "header", "property before any element: '" + line + "'");
+      addProperty(ls, line, path, h.elements.back());
     } else {
       throw InputError(path, "header", "unknown header line '" + line + "'");
     }
   }
   if (!ended) throw InputError(path, "header", "no end_header line");
-  if (!have_format)
-    throw InputError(path, "format", "no format line, expected binary_little_endian");
+  if (!have_format) throw InputError(path, "format", "no format line, expected binary_little_endian");
   // end_header as the very last bytes (no newline, no data) leaves the stream at EOF.
   if (in.eof()) in.clear();
   const auto pos = in.tellg();

@@ -1,6 +1,6 @@
 #pragma once
 // The rasterization contract, one stateless entry point like gsplat's, with a slow
-// reference implementation (splat/reference_renderer.h) that the fast tiled path is
+// reference implementation (splat/raster/reference_renderer.h) that the fast tiled path is
 // tested against. Both follow these rules exactly:
 //
 //  1. Projection. Camera-frame mean p = R m + t. Culled when p.z < near_plane, or when
@@ -38,6 +38,7 @@
 #include "geometry/camera/camera.h"
 #include "geometry/image/image.h"
 #include "splat/gaussians.h"
+#include "splat/raster_execution.h"
 
 namespace saresgs {
 
@@ -50,6 +51,7 @@ struct RasterSettings {
   float eps2d = 0.3f;
   ExtentRule extent = ExtentRule::kOpacityAware;
   std::array<float, 3> background{0.0f, 0.0f, 0.0f};
+  RasterExecution execution;  // threads and SIMD kernels (splat/raster_execution.h)
 };
 
 inline constexpr float kMinAlpha = 1.0f / 255.0f;

@@ -76,7 +76,7 @@ FlowPreset parseFlowPreset(const std::string& name);
 const char* flowPresetName(FlowPreset p);
 
 struct FlowOptions {
-  // STACK_NOTES: medium 0.09 px on a simple motion; on SA-Points pairs plain DIS is far
+  // Medium preset: 0.09 px on a simple motion; on SA-Points pairs plain DIS is far
   // worse (third_party_notes/opencv.md), which the refinement below repairs.
   FlowPreset preset = FlowPreset::kMedium;
   // A pixel p is kept when |F(p) + B(p + F(p))| < this, F the flow real -> extrapolated,

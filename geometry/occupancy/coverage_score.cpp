@@ -72,7 +72,7 @@ CoverageScore scoreExact(const VoxelSet& observed, const VoxelSet& candidate,
 
 std::vector<CoverageScore> scoreCandidates(const VoxelSet& observed,
                                            std::span<const VoxelSet> candidates,
-                                           std::size_t universe, const PrefilterOptions& opts) {
+                                           std::size_t universe, const CoverageScoring& opts) {
   std::vector<CoverageScore> out(candidates.size());
   if (opts.encoding == CoverageEncoding::Exact) {
     tbb::parallel_for(std::size_t{0}, candidates.size(), [&](std::size_t j) {
@@ -111,37 +111,6 @@ std::vector<CoverageScore> scoreCandidates(const VoxelSet& observed,
 
 double criterionValue(const CoverageScore& s, CoverageCriterion c) {
   return c == CoverageCriterion::Hamming ? s.hamming : static_cast<double>(s.new_count);
-}
-
-std::vector<int> topPercent(std::span<const double> scores, double percent) {
-  if (!(percent > 0.0 && percent <= 100.0))
-    throw InputError("prefilter", "keep_percent", "expected a percentage in (0, 100]");
-  for (std::size_t i = 0; i < scores.size(); ++i)
-    if (std::isnan(scores[i]))
-      throw InputError("prefilter", "score " + std::to_string(i), "expected a number, got NaN");
-  const std::size_t m = scores.size();
-  if (m == 0) return {};
-  // M * percent is exact for integer percentages; the tiny slack keeps 150 x 20 % at 30.
-  const double want = std::ceil(static_cast<double>(m) * percent / 100.0 - 1e-9);
-  const std::size_t k = std::clamp<std::size_t>(static_cast<std::size_t>(std::max(want, 1.0)), 1, m);
-  std::vector<int> idx(m);
-  std::iota(idx.begin(), idx.end(), 0);
-  std::partial_sort(idx.begin(), idx.begin() + static_cast<std::ptrdiff_t>(k), idx.end(),
-                    [&](int a, int b) {
-                      if (scores[a] != scores[b]) return scores[a] > scores[b];
-                      return a < b;
-                    });
-  idx.resize(k);
-  return idx;
-}
-
-std::vector<int> prefilterCandidates(const VoxelSet& observed, std::span<const VoxelSet> candidates,
-                                     std::size_t universe, const PrefilterOptions& opts) {
-  const std::vector<CoverageScore> scores = scoreCandidates(observed, candidates, universe, opts);
-  std::vector<double> values;
-  values.reserve(scores.size());
-  for (const CoverageScore& s : scores) values.push_back(criterionValue(s, opts.criterion));
-  return topPercent(values, opts.keep_percent);
 }
 
 }  // namespace saresgs

@@ -10,12 +10,12 @@
 //               (the number of scene-occupied voxels: V in the paper).
 //   new_count   |cand \ obs|: "how many newly covered voxels a candidate adds", the
 //               paper's prose reading of d_j (for hashed bits: popcount(b_cand & ~b_obs)).
-// DESIGN.md asks for both so the ablation can tell them apart.
+// Both are kept so that the ablation can tell them apart.
 // Typical use (the paper's V_obs is a subset of the scene voxels V):
 //   observed = grids.observedSceneVoxels(); universe = grids.sceneCount();
 //   candidates[j] = frustumSet(grids, cam_j) or tracer.visibleSet(cam_j, stride);
-//   scores = scoreCandidates(observed, candidates, universe, opts);
-//   kept = topPercent(values of criterionValue(scores[j], opts.criterion), opts.keep_percent).
+//   scores = scoreCandidates(observed, candidates, universe, scoring);
+// and the prefilter (nbv/coverage_prefilter.h) keeps the top N % by criterionValue.
 // Observed voxels outside V would add the same count to every candidate's exact XOR
 // (no effect on the ranking) and only collision noise to the hashed one.
 #include <cstddef>
@@ -65,11 +65,11 @@ CoverageScore scoreExact(const VoxelSet& observed, const VoxelSet& candidate,
 enum class CoverageEncoding { Hashed, Exact };
 enum class CoverageCriterion { Hamming, NewCount };
 
-struct PrefilterOptions {
+// How candidate sets are encoded and scored against the observed set.
+struct CoverageScoring {
   CoverageEncoding encoding = CoverageEncoding::Hashed;
   CoverageCriterion criterion = CoverageCriterion::Hamming;
   std::size_t table_size = std::size_t{1} << 19;  // T for the hashed encoding
-  double keep_percent = 20.0;                     // N: top N % of candidates are kept
 };
 
 // Scores every candidate set against the observed set with the chosen encoding
@@ -77,19 +77,8 @@ struct PrefilterOptions {
 // into fixed slots; the result does not depend on the thread count.
 std::vector<CoverageScore> scoreCandidates(const VoxelSet& observed,
                                            std::span<const VoxelSet> candidates,
-                                           std::size_t universe, const PrefilterOptions& opts);
+                                           std::size_t universe, const CoverageScoring& opts);
 // The value ranked by the prefilter: hamming or new_count.
 double criterionValue(const CoverageScore& s, CoverageCriterion c);
-
-// Indices of the top `percent` % of `scores` (highest first), at least one when there
-// are any: k = max(1, ceil(M * percent / 100)). Ties keep the lower index first, so the
-// result is deterministic. Throws InputError("prefilter", ...) for percent outside
-// (0, 100] or a NaN score.
-std::vector<int> topPercent(std::span<const double> scores, double percent = 20.0);
-
-// scoreCandidates, then topPercent of criterionValue(opts.criterion) with
-// opts.keep_percent: the candidate indices kept for the Fisher stage, best first.
-std::vector<int> prefilterCandidates(const VoxelSet& observed, std::span<const VoxelSet> candidates,
-                                     std::size_t universe, const PrefilterOptions& opts);
 
 }  // namespace saresgs

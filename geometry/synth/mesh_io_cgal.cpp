@@ -1,5 +1,5 @@
 // CGAL lives in this file only: CGAL::CGAL adds -frounding-math to every file of the
-// target that links it (STACK_NOTES), so it is kept in a small library of its own.
+// target that links it (third_party_notes/cgal.md), so it is kept in a small library of its own.
 #include <CGAL/IO/polygon_soup_io.h>
 #include <CGAL/Simple_cartesian.h>
 

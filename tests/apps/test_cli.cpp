@@ -6,6 +6,7 @@
 #include "common/run_command.h"
 #include "common/test_support.h"
 #include "geometry/scene/scene.h"
+#include "nbv/method.h"
 
 using saresgs::test::TempDir;
 namespace fs = std::filesystem;
@@ -92,4 +93,23 @@ TEST(Cli, TrainCoverageAndActiveOnASmallScene) {
   r = run("coverage --dataset " + d.file("s") + " --views 0,99 --out " + d.file("c3"));
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.output.find("--views"), std::string::npos) << r.output;
+}
+
+// Adding a method means adding it to nbv/method.cpp's table: the command line takes every
+// method of allMethods() (the run then stops at the missing dataset, after the method was
+// accepted) and refuses a name that is not one, listing the choices.
+TEST(Cli, ActiveAcceptsEveryMethodOfTheList) {
+  TempDir d;
+  for (saresgs::Method m : saresgs::allMethods()) {
+    const std::string name = saresgs::toString(m);
+    const Result r = run("active --method " + name + " --dataset " + d.file("missing") + " --out " + d.file("o"));
+    EXPECT_NE(r.code, 0) << name;
+    EXPECT_NE(r.output.find(d.file("missing")), std::string::npos) << name << ": " << r.output;
+    EXPECT_EQ(r.output.find("--method"), std::string::npos) << name << ": " << r.output;
+  }
+  const Result bad = run("active --method oracle --dataset " + d.file("missing") + " --out " + d.file("o"));
+  EXPECT_NE(bad.code, 0);
+  EXPECT_NE(bad.output.find("--method"), std::string::npos) << bad.output;
+  const Result help = run("active --help");
+  EXPECT_NE(help.output.find(saresgs::methodChoices()), std::string::npos) << help.output;
 }

@@ -26,7 +26,7 @@ ActiveOptions tinyOptions(Method m) {
   o.trainer.max_sh_degree = 0;
   o.trainer.densify.from_iter = 10;
   o.trainer.densify.interval = 10;
-  o.prefilter.encoding = "exact";
+  o.prefilter.scoring.encoding = CoverageEncoding::Exact;
   o.prefilter.resolution = 24;
   o.progress_test_views = 1;
   o.seed = 5;
@@ -153,14 +153,14 @@ TEST(CoveragePrefilter, PrefersTheViewOfTheUnobservedSide) {
   for (const char* lifting : {"depth", "flow"}) {
     for (const char* score : {"new", "xor"}) {
       for (const char* enc : {"exact", "hash:15"}) {
-        PrefilterChoice pc;
-        pc.set = "visible";
+        PrefilterConfig pc;
+        pc.set = CandidateSetKind::kVisible;
         pc.visible_stride = 1;
-        pc.lifting = lifting;
-        pc.score = score;
-        pc.encoding = enc;
+        pc.lifting = parseLiftingSource(lifting);
+        pc.scoring.criterion = parseCoverageCriterion(score);
+        parseCoverageEncoding(enc, pc.scoring);
         pc.resolution = 32;
-        auto pf = makeCoveragePrefilter(s, pc, 0);
+        auto pf = makeCoveragePrefilter(s, pc);
         SelectionSeconds t;
         const auto before = pf->score({near, far}, t);
         pf->observe({seen}, render, depth, t);
@@ -175,9 +175,8 @@ TEST(CoveragePrefilter, PrefersTheViewOfTheUnobservedSide) {
       }
     }
   }
-  PrefilterChoice bad;
-  bad.encoding = "hash:40";
-  EXPECT_THROW(makeCoveragePrefilter(s, bad, 0), std::invalid_argument);
+  PrefilterConfig bad;
+  EXPECT_THROW(parseCoverageEncoding("hash:40", bad.scoring), std::invalid_argument);
 }
 
 }  // namespace

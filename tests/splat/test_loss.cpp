@@ -15,7 +15,7 @@
 
 #include "splat/loss.h"
 #include "splat/metrics.h"
-#include "splat/ssim_detail.h"
+#include "splat/ssim.h"
 
 using namespace saresgs;
 
@@ -372,16 +372,16 @@ TEST(PhotometricLoss, DeterministicAcrossCallsAndThreadCounts) {
 
 TEST(PhotometricLoss, Avx2AndBaselineLoopsGiveIdenticalBits) {
   // The same IEEE operations in the same order per value, 8 or 4 at a time.
-  if (!detail::ssimAvx2Available()) GTEST_SKIP() << "no AVX2 on this CPU";
+  if (!ssimAvx2Available()) GTEST_SKIP() << "no AVX2 on this CPU";
   for (const auto& [w, h] : std::vector<std::pair<int, int>>{{160, 123}, {13, 7}, {1, 1}}) {
     const ImageF render = randomImage(w, h, 111 + w, -0.1f, 1.1f);
     const ImageF target = perturbed(render, 112, 0.05f);
     for (double lambda : {0.0, 0.2}) {
       const LossResult fast = photometricLoss(render, target, lambda);
-      detail::ssimAllowAvx2(false);
+      ssimAllowAvx2(false);
       const LossResult base = photometricLoss(render, target, lambda);
       const double metric_base = ssim(render, target);
-      detail::ssimAllowAvx2(true);
+      ssimAllowAvx2(true);
       EXPECT_EQ(ssim(render, target), metric_base);
       EXPECT_EQ(std::memcmp(&fast.loss, &base.loss, sizeof(double)), 0);
       EXPECT_EQ(std::memcmp(&fast.ssim, &base.ssim, sizeof(double)), 0);

@@ -1,0 +1,133 @@
+#pragma once
+// The ablation grid (`saresgs ablate`): a JSON config expands into independent jobs,
+// (scene x method x variant x seed) active runs plus one prefilter sweep per scene; each
+// job owns a folder under OUT/runs/ and is finished when its result file is there, so a
+// restarted runner skips it and shards (every n-th job) can run anywhere and be merged.
+// The finished jobs' results turn into the tables (Markdown + CSV) and plots of the
+// results section.
+//
+// Config (paths relative to the working directory):
+//   {
+//     "preset": "quick", "threads": 0,
+//     "scenes": [{"name": "room360", "dataset": "out/builtin", "layout": "room360"}, ...],
+//     "methods": ["random", "fisher", "sa-hash", "sa-resgs"],
+//     "seeds": [0, 1],
+//     "method_args": {"sa-hash": ["--time-exhaustive-fisher"]},            (optional)
+//     "variants": [{"name": "beta0.05", "methods": ["sa-resgs"],             (optional)
+//                   "args": ["--residual-beta", "0.05"]}],
+//     "tables": [{"name": "components", "title": "...", "methods": [...],  (optional)
+//                 "variants": [...]}],
+//     "sweep": {"scenes": ["room360"], "views": [4, 8, 12], "lifting": "flow"} (optional)
+//   }
+// A scene with a "layout" is generated with `saresgs scene` when its dataset is missing.
+// Without "variants" every method runs once as variant "default".
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "geometry/image/image.h"
+#include "nbv/eval/prefilter_sweep.h"
+#include "nbv/run_report.h"
+
+namespace saresgs {
+
+struct AblationScene {
+  std::string name, dataset, layout;  // layout: empty = the dataset must exist
+};
+
+struct AblationVariant {
+  std::string name = "default";
+  std::vector<std::string> methods;  // empty: every method
+  std::vector<std::string> args;     // extra `saresgs active` arguments
+};
+
+struct AblationTableSpec {
+  std::string name, title;
+  std::vector<std::string> methods, variants;  // empty: all
+};
+
+struct AblationGrid {
+  std::string source;  // the config file, for messages
+  std::string preset = "quick";
+  int threads = 0;
+  std::vector<AblationScene> scenes;
+  std::vector<std::string> methods;
+  std::vector<std::uint64_t> seeds;
+  std::map<std::string, std::vector<std::string>> method_args;
+  std::vector<AblationVariant> variants;
+  std::vector<AblationTableSpec> tables;
+  std::optional<SweepSpec> sweep;
+};
+
+// Throws InputError naming the file and the field on a malformed config; every method,
+// sweep set, encoding, score and lifting name is checked here, before any job runs.
+AblationGrid readAblationGrid(const std::string& path);
+
+struct AblationJob {
+  enum class Kind { kActive, kSweep };
+  Kind kind = Kind::kActive;
+  std::string id;  // folder name under OUT/runs
+  std::string scene, method, variant;
+  std::uint64_t seed = 0;
+  std::vector<std::string> args;  // `saresgs active` arguments, --out excluded
+};
+
+// Every job of the grid in a fixed order (sweeps first, then scene, method, variant, seed).
+std::vector<AblationJob> expandGrid(const AblationGrid& g);
+// Jobs i, i + n, i + 2n, ... of `jobs`. Throws std::invalid_argument unless 0 <= i < n.
+std::vector<AblationJob> shardJobs(const std::vector<AblationJob>& jobs, int i, int n);
+// Parses "i/n".
+std::pair<int, int> parseShard(const std::string& text);
+
+// Whether variant `v` runs for `method` (an empty method list: every method).
+bool variantApplies(const AblationVariant& v, const std::string& method);
+// How a run is named in tables and plots: "method", or "method (variant)".
+std::string runLabel(const std::string& method, const std::string& variant);
+
+std::string jobFolder(const std::string& out, const AblationJob& j);          // OUT/runs/<id>
+std::string jobResultFile(const std::string& out, const AblationJob& j);      // results.json or sweep.json
+bool jobFinished(const std::string& out, const AblationJob& j);
+
+// A finished job's result: the run report of an active job, the sweep report of a sweep.
+struct JobResult {
+  AblationJob job;
+  RunReport run;
+  SweepReport sweep;
+};
+// The finished jobs' result files, in job order; InputError names a malformed file.
+std::vector<JobResult> loadFinishedJobs(const std::string& out, const std::vector<AblationJob>& jobs);
+
+struct Table {
+  std::string name, title;
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;
+  std::string markdown() const;
+  std::string csv() const;
+};
+
+// The results tables (nbv/eval/ablation_tables.cpp), each left out when it would be
+// empty: PSNR/SSIM/AUSE per scene and method (mean +- std over seeds), the config's named
+// tables, PSNR against the number of views, the time breakdown, and the prefilter sweep.
+std::vector<Table> ablationTables(const AblationGrid& g, const std::vector<JobResult>& results);
+Table resultsTable(const AblationGrid& g, const std::vector<JobResult>& results);
+Table namedTable(const AblationGrid& g, const AblationTableSpec& spec, const std::vector<JobResult>& results);
+Table psnrVsViewsTable(const AblationGrid& g, const std::vector<JobResult>& results);
+Table timeTable(const AblationGrid& g, const std::vector<JobResult>& results);
+Table sweepTable(const std::vector<JobResult>& results);
+
+struct NamedPlot {
+  std::string name;  // file stem
+  Image8 image;
+};
+// PSNR per method and scene, PSNR against views, PSNR against selection time, and the
+// sweep's ranking error against scoring time (nbv/eval/ablation_plots.cpp).
+std::vector<NamedPlot> ablationPlots(const AblationGrid& g, const std::vector<JobResult>& results);
+
+// Mean and sample standard deviation (0 for one value); NaN-free for empty input (0, 0).
+std::pair<double, double> meanStd(const std::vector<double>& v);
+
+}  // namespace saresgs

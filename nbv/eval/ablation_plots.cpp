@@ -1,0 +1,121 @@
+// The ablation's pictures, drawn from the same finished-job results as its tables.
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "nbv/eval/ablation.h"
+#include "nbv/eval/plots.h"
+
+namespace saresgs {
+
+namespace {
+
+std::string label(const AblationJob& j) { return runLabel(j.method, j.variant); }
+
+// Method labels in config order that have results for `scene`.
+std::vector<std::string> labelsFor(const std::vector<JobResult>& results, const std::string& scene) {
+  std::vector<std::string> out;
+  for (const JobResult& r : results)
+    if (r.job.kind == AblationJob::Kind::kActive && r.job.scene == scene &&
+        std::find(out.begin(), out.end(), label(r.job)) == out.end())
+      out.push_back(label(r.job));
+  return out;
+}
+
+// PSNR per method, PSNR against views and PSNR against selection time: one panel per
+// scene in each.
+void addActivePlots(const AblationGrid& g, const std::vector<JobResult>& results, std::vector<NamedPlot>& plots) {
+  std::vector<PlotPanel> psnr, views, time;
+  for (const AblationScene& sc : g.scenes) {
+    const std::vector<std::string> labels = labelsFor(results, sc.name);
+    if (labels.empty()) continue;
+    PlotPanel p{sc.name + ": test PSNR (mean +- std over seeds)", "method", "PSNR dB", false, labels, {}};
+    PlotSeries ps{"PSNR", {}, {}, {}, {}, false};
+    PlotPanel v{sc.name + ": PSNR on progress views against views", "training views", "PSNR dB", false, {}, {}};
+    PlotPanel t{sc.name + ": PSNR against selection time", "selection seconds per run (log)", "PSNR dB", true, {}, {}};
+    for (std::size_t li = 0; li < labels.size(); ++li) {
+      std::vector<double> p_runs, sel_runs;
+      std::map<int, std::vector<double>> by_views;
+      for (const JobResult& r : results) {
+        if (r.job.kind != AblationJob::Kind::kActive || r.job.scene != sc.name || label(r.job) != labels[li]) continue;
+        p_runs.push_back(r.run.psnr);
+        sel_runs.push_back(r.run.seconds.selection());
+        for (const StepReport& st : r.run.steps) by_views[st.views_before].push_back(st.progress_psnr);
+      }
+      const auto [pm, pstd] = meanStd(p_runs);
+      ps.x.push_back(static_cast<double>(li));
+      ps.y.push_back(pm);
+      ps.err.push_back(pstd);
+      PlotSeries vs{labels[li], {}, {}, {}, {}, true};
+      for (const auto& [k, vals] : by_views) {
+        vs.x.push_back(k);
+        vs.y.push_back(meanStd(vals).first);
+      }
+      v.series.push_back(vs);
+      // Methods without a selection cost (random) sit at 1 ms so that the log axis shows them.
+      t.series.push_back({labels[li], {std::max(1e-3, meanStd(sel_runs).first)}, {pm}, {pstd}, {}, false});
+    }
+    p.series.push_back(ps);
+    psnr.push_back(p);
+    views.push_back(v);
+    time.push_back(t);
+  }
+  plots.push_back({"psnr", drawPlot(psnr)});
+  plots.push_back({"psnr_vs_views", drawPlot(views)});
+  plots.push_back({"psnr_vs_selection_time", drawPlot(time)});
+}
+
+// The sweep of one scene: ranking error (tau, overlap) against scoring time. One series
+// per (set, score); points are the encodings.
+NamedPlot sweepPlot(const JobResult& r) {
+  std::map<std::string, std::map<std::string, std::vector<const SweepRow*>>> groups;  // series -> encoding -> rows
+  std::vector<std::string> series_order, enc_order;
+  for (const SweepRow& row : r.sweep.rows) {
+    const std::string s = row.set + " " + row.score;
+    const std::string& e = row.encoding;
+    if (!groups.count(s)) series_order.push_back(s);
+    if (std::find(enc_order.begin(), enc_order.end(), e) == enc_order.end()) enc_order.push_back(e);
+    groups[s][e].push_back(&row);
+  }
+  // x: the scoring cost, which the encoding sets; building the candidates' sets (the
+  // same for every encoding of a set kind) is in the table's "sets ms".
+  const char* xl = "scoring ms per selection (log; set building not included)";
+  PlotPanel tau{r.job.scene + ": ranking vs exact visible (Kendall tau-b)", xl, "tau", true, {}, {}};
+  PlotPanel ov{r.job.scene + ": top-20% overlap with exact visible", xl, "overlap", true, {}, {}};
+  for (const std::string& s : series_order) {
+    PlotSeries a{s, {}, {}, {}, {}, true}, b{s, {}, {}, {}, {}, true};
+    for (const std::string& e : enc_order) {
+      auto it = groups[s].find(e);
+      if (it == groups[s].end()) continue;
+      std::vector<double> t, k, o;
+      for (const auto* row : it->second) {
+        t.push_back(1000 * row->seconds_scoring);
+        k.push_back(row->kendall_tau);
+        o.push_back(row->overlap);
+      }
+      const std::string pl = e == "exact" ? "ex" : e.substr(e.find(':') + 1);
+      a.x.push_back(meanStd(t).first);
+      a.y.push_back(meanStd(k).first);
+      a.point_labels.push_back(pl);
+      b.x.push_back(meanStd(t).first);
+      b.y.push_back(meanStd(o).first);
+      b.point_labels.push_back(pl);
+    }
+    tau.series.push_back(a);
+    ov.series.push_back(b);
+  }
+  return {"prefilter_sweep_" + r.job.scene, drawPlot({tau, ov})};
+}
+
+}  // namespace
+
+std::vector<NamedPlot> ablationPlots(const AblationGrid& g, const std::vector<JobResult>& results) {
+  std::vector<NamedPlot> plots;
+  if (std::any_of(results.begin(), results.end(), [](const JobResult& r) { return r.job.kind == AblationJob::Kind::kActive; }))
+    addActivePlots(g, results, plots);
+  for (const JobResult& r : results)
+    if (r.job.kind == AblationJob::Kind::kSweep) plots.push_back(sweepPlot(r));
+  return plots;
+}
+
+}  // namespace saresgs

@@ -1,0 +1,282 @@
+// The ablation's tables, from the finished jobs' typed reports.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <sstream>
+#include <tuple>
+
+#include "nbv/eval/ablation.h"
+
+namespace saresgs {
+
+std::string Table::markdown() const {
+  std::ostringstream s;
+  s << "### " << title << "\n\n|";
+  for (const auto& h : header) s << " " << h << " |";
+  s << "\n|";
+  for (std::size_t i = 0; i < header.size(); ++i) s << (i == 0 ? "---|" : "---:|");
+  s << "\n";
+  for (const auto& r : rows) {
+    s << "|";
+    for (const auto& c : r) s << " " << c << " |";
+    s << "\n";
+  }
+  return s.str();
+}
+
+std::string Table::csv() const {
+  auto cell = [](const std::string& c) {
+    // "24.59 ± 0.31" becomes two CSV fields; quotes where a comma would split a field.
+    const std::string pm = " \u00b1 ";
+    if (auto p = c.find(pm); p != std::string::npos) return c.substr(0, p) + "," + c.substr(p + pm.size());
+    if (c.find(',') != std::string::npos) return "\"" + c + "\"";
+    return c;
+  };
+  auto head = [&](const std::string& h, std::size_t col) {
+    for (const auto& r : rows)
+      if (col < r.size() && r[col].find(" \u00b1 ") != std::string::npos) return h + "_mean," + h + "_std";
+    return h;
+  };
+  std::ostringstream s;
+  for (std::size_t i = 0; i < header.size(); ++i) s << (i ? "," : "") << head(header[i], i);
+  s << "\n";
+  for (const auto& r : rows) {
+    for (std::size_t i = 0; i < r.size(); ++i) s << (i ? "," : "") << cell(r[i]);
+    s << "\n";
+  }
+  return s.str();
+}
+
+namespace {
+
+std::string fmt(double v, int digits) {
+  if (!std::isfinite(v)) return "n/a";
+  char b[64];
+  std::snprintf(b, sizeof b, "%.*f", digits, v);
+  return b;
+}
+
+std::string pm(const std::vector<double>& v, int digits) {
+  if (v.empty()) return "n/a";
+  const auto [m, s] = meanStd(v);
+  return fmt(m, digits) + " \u00b1 " + fmt(s, digits);
+}
+
+bool isActive(const JobResult& r) { return r.job.kind == AblationJob::Kind::kActive; }
+
+bool listed(const std::vector<std::string>& list, const std::string& name) {
+  return list.empty() || std::find(list.begin(), list.end(), name) != list.end();
+}
+
+struct Key {
+  std::string scene, method, variant;
+  auto operator<=>(const Key&) const = default;
+};
+
+// The active runs grouped by (scene, method, variant), in job order within a group.
+std::map<Key, std::vector<const RunReport*>> runsByKey(const std::vector<JobResult>& results) {
+  std::map<Key, std::vector<const RunReport*>> by;
+  for (const JobResult& r : results)
+    if (isActive(r)) by[{r.job.scene, r.job.method, r.job.variant}].push_back(&r.run);
+  return by;
+}
+
+// A metric over a group's runs, non-finite and missing values left out.
+template <class Get>
+std::vector<double> metric(const std::map<Key, std::vector<const RunReport*>>& by, const Key& k, Get&& get) {
+  std::vector<double> v;
+  if (auto it = by.find(k); it != by.end())
+    for (const RunReport* r : it->second)
+      if (const std::optional<double> x = get(*r); x && std::isfinite(*x)) v.push_back(*x);
+  return v;
+}
+
+std::optional<double> psnrOf(const RunReport& r) { return r.psnr; }
+std::optional<double> ssimOf(const RunReport& r) { return r.ssim; }
+std::optional<double> auseOf(const RunReport& r) { return r.ause; }
+
+// Config order for rows: scenes, methods, variants as listed.
+template <class F>
+void forEachCombo(const AblationGrid& g, F&& f) {
+  for (const auto& sc : g.scenes)
+    for (const auto& m : g.methods)
+      for (const auto& v : g.variants) {
+        if (!variantApplies(v, m)) continue;
+        f(sc.name, m, v.name);
+      }
+}
+
+}  // namespace
+
+Table resultsTable(const AblationGrid& g, const std::vector<JobResult>& results) {
+  const auto by = runsByKey(results);
+  Table t{"results", "PSNR, SSIM and AUSE on the test views (mean \u00b1 std over seeds)",
+          {"scene", "method", "seeds", "PSNR", "SSIM", "AUSE"}, {}};
+  forEachCombo(g, [&](const std::string& s, const std::string& m, const std::string& v) {
+    const Key k{s, m, v};
+    const auto p = metric(by, k, psnrOf);
+    if (p.empty()) return;
+    t.rows.push_back({s, runLabel(m, v), std::to_string(p.size()), pm(p, 2), pm(metric(by, k, ssimOf), 4),
+                      pm(metric(by, k, auseOf), 4)});
+  });
+  return t;
+}
+
+// One PSNR column per scene plus the mean over scenes (per seed, then mean +- std over
+// seeds), and the mean SSIM.
+Table namedTable(const AblationGrid& g, const AblationTableSpec& spec, const std::vector<JobResult>& results) {
+  const auto by = runsByKey(results);
+  Table t{spec.name, spec.title, {"method"}, {}};
+  for (const auto& sc : g.scenes) t.header.push_back(sc.name + " PSNR");
+  t.header.push_back("mean PSNR");
+  t.header.push_back("mean SSIM");
+  for (const auto& m : g.methods) {
+    if (!listed(spec.methods, m)) continue;
+    for (const auto& v : g.variants) {
+      if (!variantApplies(v, m) || !listed(spec.variants, v.name)) continue;
+      std::vector<std::string> row{runLabel(m, v.name)};
+      bool any = false;
+      for (const auto& sc : g.scenes) {
+        const auto p = metric(by, {sc.name, m, v.name}, psnrOf);
+        any = any || !p.empty();
+        row.push_back(pm(p, 2));
+      }
+      if (!any) continue;
+      // Scene-averaged values per seed, over seeds that have every scene.
+      std::vector<double> mp, ms;
+      for (std::uint64_t seed : g.seeds) {
+        double sp = 0, ss = 0;
+        int n = 0;
+        for (const JobResult& r : results)
+          if (isActive(r) && r.job.method == m && r.job.variant == v.name && r.job.seed == seed) {
+            sp += r.run.psnr;
+            ss += r.run.ssim;
+            ++n;
+          }
+        if (n == static_cast<int>(g.scenes.size())) {
+          mp.push_back(sp / n);
+          ms.push_back(ss / n);
+        }
+      }
+      row.push_back(pm(mp, 2));
+      row.push_back(pm(ms, 4));
+      t.rows.push_back(row);
+    }
+  }
+  return t;
+}
+
+// PSNR on the progress test views after training with k views (before selecting k+1);
+// no rows when no run has steps.
+Table psnrVsViewsTable(const AblationGrid& g, const std::vector<JobResult>& results) {
+  Table t{"psnr_vs_views",
+          "PSNR on the progress test views against the number of training views (mean over seeds; the "
+          "progress views are 3 of the test views, so these are noisier than the final table)",
+          {"scene", "method"}, {}};
+  int max_views = 0;
+  for (const JobResult& r : results)
+    if (isActive(r))
+      for (const StepReport& s : r.run.steps) max_views = std::max(max_views, s.views_before);
+  if (max_views == 0) return t;
+  int min_views = max_views;
+  for (const JobResult& r : results)
+    if (isActive(r))
+      for (const StepReport& s : r.run.steps) min_views = std::min(min_views, s.views_before);
+  for (int k = min_views; k <= max_views; ++k) t.header.push_back(std::to_string(k));
+  const auto by = runsByKey(results);
+  forEachCombo(g, [&](const std::string& s, const std::string& m, const std::string& v) {
+    auto it = by.find({s, m, v});
+    if (it == by.end()) return;
+    std::vector<std::string> row{s, runLabel(m, v)};
+    for (int k = min_views; k <= max_views; ++k) {
+      std::vector<double> p;
+      for (const RunReport* r : it->second)
+        for (const StepReport& st : r->steps)
+          if (st.views_before == k) p.push_back(st.progress_psnr);
+      row.push_back(p.empty() ? "" : fmt(meanStd(p).first, 2));
+    }
+    t.rows.push_back(row);
+  });
+  return t;
+}
+
+// Time breakdown per method over all scenes and seeds (seconds per run unless named).
+Table timeTable(const AblationGrid& g, const std::vector<JobResult>& results) {
+  Table t{"time",
+          "Time per run (mean over scenes and seeds, seconds): selection stages, training per iteration, end to "
+          "end; exhaustive Fisher = Fisher over all candidates timed in the same run",
+          {"method", "runs", "lifting", "triangulation", "prefilter", "Fisher", "selection", "exhaustive Fisher",
+           "selection saved", "train ms/it", "end to end"},
+          {}};
+  for (const auto& m : g.methods)
+    for (const auto& v : g.variants) {
+      if (!variantApplies(v, m)) continue;
+      std::vector<double> li, tr, pf, fi, sel, ex, saved, it_ms, e2e;
+      for (const JobResult& r : results) {
+        if (!isActive(r) || r.job.method != m || r.job.variant != v.name) continue;
+        const SelectionSeconds& st = r.run.seconds;
+        li.push_back(st.lifting);
+        tr.push_back(st.triangulation);
+        pf.push_back(st.prefilter);
+        fi.push_back(st.fisher);
+        sel.push_back(st.selection());
+        if (st.exhaustive_fisher > 0) {
+          ex.push_back(st.exhaustive_fisher);
+          saved.push_back(100.0 * (1.0 - sel.back() / ex.back()));
+        }
+        if (r.run.iterations > 0) it_ms.push_back(1000.0 * st.training / r.run.iterations);
+        e2e.push_back(r.run.end_to_end_seconds);
+      }
+      if (li.empty()) continue;
+      auto mean = [](const std::vector<double>& x, int d) { return x.empty() ? std::string("") : fmt(meanStd(x).first, d); };
+      t.rows.push_back({runLabel(m, v.name), std::to_string(li.size()), mean(li, 2), mean(tr, 3), mean(pf, 3), mean(fi, 1),
+                        mean(sel, 1), mean(ex, 1), saved.empty() ? "" : mean(saved, 0) + " %", mean(it_ms, 1), mean(e2e, 0)});
+    }
+  return t;
+}
+
+// Prefilter sweep: per (set, score, encoding), the mean over observed states.
+Table sweepTable(const std::vector<JobResult>& results) {
+  Table t{"prefilter_sweep",
+          "Prefilter variants against the exact visible-set reference (same score): top-N % overlap and Kendall "
+          "tau-b of the candidate ranking (mean over observed states), scoring time per selection (encode + "
+          "compare all candidates, median of repeats) and the time to build every candidate's voxel set once",
+          {"scene", "set", "score", "encoding", "top-N overlap", "Kendall tau", "scoring ms", "sets ms"},
+          {}};
+  for (const JobResult& r : results) {
+    if (r.job.kind != AblationJob::Kind::kSweep) continue;
+    using RowKey = std::tuple<std::string, std::string, std::string>;
+    std::map<RowKey, std::vector<const SweepRow*>> rows;
+    std::vector<RowKey> order;
+    for (const SweepRow& row : r.sweep.rows) {
+      const RowKey k{row.set, row.score, row.encoding};
+      if (!rows.count(k)) order.push_back(k);
+      rows[k].push_back(&row);
+    }
+    for (const auto& k : order) {
+      std::vector<double> ov, tau, sc, st;
+      for (const SweepRow* row : rows[k]) {
+        ov.push_back(row->overlap);
+        tau.push_back(row->kendall_tau);
+        sc.push_back(1000 * row->seconds_scoring);
+        st.push_back(1000 * row->seconds_sets);
+      }
+      t.rows.push_back({r.job.scene, std::get<0>(k), std::get<1>(k), std::get<2>(k), fmt(meanStd(ov).first, 3),
+                        fmt(meanStd(tau).first, 3), fmt(meanStd(sc).first, 2), fmt(meanStd(st).first, 1)});
+    }
+  }
+  return t;
+}
+
+std::vector<Table> ablationTables(const AblationGrid& g, const std::vector<JobResult>& results) {
+  std::vector<Table> tables{resultsTable(g, results)};
+  for (const AblationTableSpec& spec : g.tables) tables.push_back(namedTable(g, spec, results));
+  // The remaining tables are left out when there is nothing to put in them.
+  if (Table t = psnrVsViewsTable(g, results); t.header.size() > 2) tables.push_back(std::move(t));
+  if (Table t = timeTable(g, results); !t.rows.empty()) tables.push_back(std::move(t));
+  if (Table t = sweepTable(results); !t.rows.empty()) tables.push_back(std::move(t));
+  return tables;
+}
+
+}  // namespace saresgs

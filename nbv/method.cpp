@@ -1,0 +1,64 @@
+#include "nbv/method.h"
+
+#include <stdexcept>
+
+namespace saresgs {
+
+namespace {
+
+struct MethodRow {
+  Method method;
+  const char* name;
+  MethodNeeds needs;  // fisher, coverage, residual
+};
+
+// The list of methods (see method.h).
+constexpr MethodRow kMethodTable[] = {
+    {Method::kRandom, "random", {false, false, false}},
+    {Method::kFvs, "fvs", {false, false, false}},
+    {Method::kFisher, "fisher", {true, false, false}},
+    {Method::kCoverage, "coverage", {false, true, false}},
+    {Method::kSaHash, "sa-hash", {true, true, false}},
+    {Method::kSaResgs, "sa-resgs", {true, true, true}},
+    {Method::kResgs, "resgs", {true, false, true}},
+};
+
+const MethodRow& rowOf(Method m) {
+  for (const MethodRow& r : kMethodTable)
+    if (r.method == m) return r;
+  throw std::logic_error("method missing from kMethodTable");
+}
+
+}  // namespace
+
+const std::vector<Method>& allMethods() {
+  static const std::vector<Method> all = [] {
+    std::vector<Method> v;
+    for (const MethodRow& r : kMethodTable) v.push_back(r.method);
+    return v;
+  }();
+  return all;
+}
+
+const char* toString(Method m) { return rowOf(m).name; }
+MethodNeeds needsOf(Method m) { return rowOf(m).needs; }
+
+Method parseMethod(const std::string& s) {
+  for (const MethodRow& r : kMethodTable)
+    if (s == r.name) return r.method;
+  throw std::invalid_argument("method '" + s + "': expected one of " + methodChoices(", "));
+}
+
+std::vector<std::string> methodNames() {
+  std::vector<std::string> v;
+  for (const MethodRow& r : kMethodTable) v.push_back(r.name);
+  return v;
+}
+
+std::string methodChoices(const char* separator) {
+  std::string s;
+  for (const MethodRow& r : kMethodTable) s += (s.empty() ? "" : separator) + std::string(r.name);
+  return s;
+}
+
+}  // namespace saresgs

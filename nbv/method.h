@@ -1,0 +1,31 @@
+#pragma once
+// The view-selection methods of an active run. kMethodTable in method.cpp is the one
+// list: names, parsing, the CLI's choices, the ablation's checks and what each method
+// computes all come from it, so adding a method means adding its row (and its enum
+// value) there.
+#include <string>
+#include <vector>
+
+namespace saresgs {
+
+enum class Method { kRandom, kFvs, kFisher, kCoverage, kSaHash, kSaResgs, kResgs };
+
+// What a method computes; everything else is left out of its run.
+struct MethodNeeds {
+  bool fisher = false;    // renders and squared gradients of candidates
+  bool coverage = false;  // SA-Points, occupancy grids, prefilter
+  bool residual = false;  // residual supervision in training
+};
+
+// Every method, in the table's order.
+const std::vector<Method>& allMethods();
+const char* toString(Method m);
+// Throws std::invalid_argument naming the value and the accepted names.
+Method parseMethod(const std::string& s);
+MethodNeeds needsOf(Method m);
+// The names in table order ("random", "fvs", ...), and joined for help texts
+// ("random | fvs | ...").
+std::vector<std::string> methodNames();
+std::string methodChoices(const char* separator = " | ");
+
+}  // namespace saresgs

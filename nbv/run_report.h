@@ -1,0 +1,86 @@
+#pragma once
+// The report of one active run: what `saresgs active` writes as results.json, what the
+// ablation reads back, and (its steps) what the run's checkpoint stores. Views are named
+// as in the dataset; toJson and runReportFromJson are exact inverses on what they write.
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "geometry/scene/scene.h"
+#include "nbv/active_run.h"
+#include "nbv/selection_seconds.h"
+
+namespace saresgs {
+
+// One training phase and the selection after it. The final phase has no selection:
+// `selected` is empty and so are the candidate lists.
+struct StepReport {
+  int views_before = 0;
+  double progress_psnr = 0;  // on the progress test views, before selection
+  SelectionSeconds seconds;
+  std::string selected;
+  std::vector<std::string> candidates;   // what the final scorer saw
+  std::vector<double> scores;            // their scores
+  std::vector<std::string> prefiltered;  // coverage methods: the kept top N %
+};
+
+// The options that shaped the run, as the tables name them.
+struct RunOptionsReport {
+  int interval = 0, total_iterations = 0, max_views = 0;
+  std::size_t max_gaussians = 0;
+  bool reset_after_add = true, residual = false;
+  double residual_alpha = 0, residual_beta = 0;
+  std::string residual_ranking;
+  bool residual_sub_only = false;
+  std::string prefilter_set, prefilter_encoding, prefilter_score;
+  double prefilter_keep = 0;
+};
+
+struct ViewReport {
+  std::string name;
+  double psnr = 0, ssim = 0;
+};
+
+struct RunReport {
+  std::string dataset, method, preset;
+  std::uint64_t seed = 0;
+  RunOptionsReport options;
+  double psnr = 0, ssim = 0;       // mean over the test views
+  std::optional<double> ause;      // none without ground-truth depth
+  std::vector<std::string> initial_views;
+  std::vector<std::string> selected_views;  // the views added after the initial ones
+  std::vector<int> selected_view_indices;   // every view held at the end, initial first
+  SelectionSeconds seconds;                 // summed over steps
+  double end_to_end_seconds = 0;            // this process (a resumed run: since resuming)
+  std::size_t gaussians = 0;
+  int iterations = 0;
+  int threads = 0;
+  std::vector<ViewReport> views;  // per test view
+  std::vector<StepReport> steps;
+};
+
+// Where and how the run was made, which the loop itself does not know.
+struct RunContext {
+  std::string dataset, preset;
+  std::size_t gaussians = 0;
+  int threads = 0;
+};
+
+RunReport makeRunReport(const Scene& scene, const ActiveOptions& opt, const ActiveResult& r, const RunContext& c);
+
+nlohmann::json toJson(const RunReport& r);
+// Throws InputError naming `source` and the field when a field is missing or mistyped.
+RunReport runReportFromJson(const nlohmann::json& j, const std::string& source);
+
+nlohmann::json toJson(const StepReport& s);
+StepReport stepReportFromJson(const nlohmann::json& j, const std::string& source, const std::string& field);
+
+// The loop's step record with views named, and back (names are looked up among the train
+// views; an unknown name throws InputError naming `source`).
+StepReport stepReport(const Scene& scene, const SelectionLog& log);
+SelectionLog selectionLog(const Scene& scene, const StepReport& step, const std::string& source);
+
+}  // namespace saresgs

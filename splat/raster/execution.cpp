@@ -1,0 +1,74 @@
+// The rasterizer's execution settings resolved: arenas per thread count, kernels per CPU.
+#include "splat/raster/execution.h"
+
+#include <cstdlib>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <stdexcept>
+
+#include "splat/raster/raster_kernels.h"
+
+namespace saresgs {
+
+namespace {
+
+// The best kernels this CPU runs, unless SARESGS_RASTER_ISA=baseline asks otherwise; read
+// once, at the first render, like the process's other defaults.
+int defaultKernelIndex() {
+  static const int index = [] {
+    const char* env = std::getenv("SARESGS_RASTER_ISA");
+    if (env && std::strcmp(env, "baseline") == 0) return 0;
+    return rasterCpuHasAvx2() ? 1 : 0;
+  }();
+  return index;
+}
+
+}  // namespace
+
+namespace raster_execution {
+
+tbb::task_arena& arena(int threads) {
+  static std::mutex mutex;
+  static std::map<int, std::unique_ptr<tbb::task_arena>> arenas;
+  const int want = threads > 0 ? threads : 0;
+  std::lock_guard<std::mutex> lock(mutex);
+  std::unique_ptr<tbb::task_arena>& a = arenas[want];
+  if (!a) a = std::make_unique<tbb::task_arena>(want > 0 ? want : static_cast<int>(tbb::task_arena::automatic));
+  return *a;
+}
+
+int kernelIndex(RasterKernels kernels) {
+  switch (kernels) {
+    case RasterKernels::kBaseline: return 0;
+    case RasterKernels::kAvx2:
+      if (!rasterCpuHasAvx2()) throw std::invalid_argument("raster kernels avx2: this CPU or build has no AVX2 and FMA");
+      return 1;
+    case RasterKernels::kDefault: break;
+  }
+  return defaultKernelIndex();
+}
+
+}  // namespace raster_execution
+
+std::optional<RasterKernels> parseRasterKernels(std::string_view name) {
+  if (name == "default") return RasterKernels::kDefault;
+  if (name == "baseline") return RasterKernels::kBaseline;
+  if (name == "avx2") return RasterKernels::kAvx2;
+  return std::nullopt;
+}
+
+bool rasterCpuHasAvx2() {
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+  static const bool has =
+      raster_kernels::avx2::compiled() && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  return has;
+#else
+  return false;
+#endif
+}
+
+int rasterThreadCount(const RasterExecution& e) { return raster_execution::arena(e.threads).max_concurrency(); }
+
+}  // namespace saresgs

@@ -1,0 +1,18 @@
+#pragma once
+// Internal to the rasterizer: a RasterExecution (splat/raster_execution.h) resolved to
+// the TBB arena and the float kernels a pass runs on.
+#include <tbb/task_arena.h>
+
+#include "splat/raster_execution.h"
+
+namespace saresgs::raster_execution {
+
+// The arena of `threads` (<= 0: all cores), made on first use and kept for the process
+// (TBB keeps its worker threads alive between calls), one per thread count asked for.
+tbb::task_arena& arena(int threads);
+
+// The float kernels `kernels` resolves to, an index into the rasterizer's kernel table:
+// 0 baseline, 1 avx2. Throws std::invalid_argument for kAvx2 on a CPU without AVX2.
+int kernelIndex(RasterKernels kernels);
+
+}  // namespace saresgs::raster_execution

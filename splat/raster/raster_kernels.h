@@ -1,0 +1,73 @@
+#pragma once
+// The float tile kernels of the fast rasterizer (internal). They are compiled twice from
+// splat/raster/raster_kernels_impl.h: four lanes for the baseline target (in rasterizer.cpp) and
+// eight lanes with AVX2 (splat/raster/raster_kernels_avx2.cpp, its own compile flags), chosen
+// at run time. Each compilation lives in its own namespace and shares no code with the
+// other, so no function compiled for AVX2 can be picked by the linker for the baseline
+// path. No FMA contraction in either: every lane does the same operations in the same
+// order, so the two paths' forward outputs are bit-identical; the backward's per-pair
+// sums differ only in the order the lanes are added.
+#include <cstdint>
+
+namespace saresgs {
+
+// One Gaussian's data gathered per tile, in the tile's order. The chord terms bound, per
+// pixel row at offset dy from the mean, the columns where o G >= 1/255 can hold: centred
+// on mx + chord_slope dy with half width sqrt(chord_k0 - chord_k1 dy^2), widened so the
+// float per-pixel test never passes outside it (chordTerms in rasterizer.cpp). They only
+// shorten the kernels' loops; the per-pixel test decides.
+template <typename T>
+struct TileGaussian {
+  T mx, my, a, b, c, o, hx, hy, depth;
+  T col[3];
+  T chord_slope, chord_k0, chord_k1;
+};
+
+namespace raster_kernels {
+
+// Where the forward kernel writes a tile's pixels (whole-image arrays, row stride W).
+struct ForwardOut {
+  int W;
+  float* rgb;
+  float* alpha;
+  float* depth;
+  int* contributors;
+  float* final_T;
+  std::uint32_t* n_walked;
+};
+
+// What the backward kernel reads per pixel (whole-image arrays, row stride W).
+struct BackwardIn {
+  int W;
+  const float* final_T;
+  const std::uint32_t* n_walked;
+  const float* dL_drgb;  // 3 per pixel
+};
+
+// Pixels [x0, x1) x [y0, y1) composited front to back over q[0, nq) (rule 7).
+using CompositeFn = void (*)(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1,
+                             const float bg[3], const ForwardOut& out);
+// The back-to-front walk of a tile: for each tile entry jj its 9 gradient sums
+// (opacity, mean2d 2, conic 3, colour 3) go to slots[entry_slot[jj] * 9].
+using BackwardFn = void (*)(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1,
+                            const float bg[3], const BackwardIn& in, const std::uint32_t* entry_slot,
+                            float* slots);
+
+namespace base4 {
+void compositeTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
+                   const ForwardOut& out);
+void backwardTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
+                  const BackwardIn& in, const std::uint32_t* entry_slot, float* slots);
+}  // namespace base4
+
+namespace avx2 {
+// False when this build has no AVX2 kernels (not x86-64, or not GCC/Clang).
+bool compiled();
+void compositeTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
+                   const ForwardOut& out);
+void backwardTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
+                  const BackwardIn& in, const std::uint32_t* entry_slot, float* slots);
+}  // namespace avx2
+
+}  // namespace raster_kernels
+}  // namespace saresgs

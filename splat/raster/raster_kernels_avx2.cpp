@@ -1,0 +1,29 @@
+// The float tile kernels eight lanes wide for CPUs with AVX2 (splat/raster/raster_kernels.h).
+// Built with -mavx2 -mfma -ffp-contract=off on x86-64 (splat/CMakeLists.txt), which
+// defines SARESGS_RASTER_AVX2; elsewhere only compiled() exists and says false. The
+// rasterizer calls these only when the CPU reports AVX2 and FMA.
+#include "splat/raster/raster_kernels.h"
+
+#if defined(SARESGS_RASTER_AVX2)
+#define SARESGS_KERNEL_NS avx2
+#define SARESGS_KERNEL_LANES 8
+#define SARESGS_KERNEL_FMA 1
+#include "splat/raster/raster_kernels_impl.h"
+
+namespace saresgs::raster_kernels::avx2 {
+bool compiled() { return true; }
+}  // namespace saresgs::raster_kernels::avx2
+#else
+#include <cstdlib>
+
+namespace saresgs::raster_kernels::avx2 {
+bool compiled() { return false; }
+void compositeTile(const TileGaussian<float>*, int, int, int, int, int, const float*, const ForwardOut&) {
+  std::abort();
+}
+void backwardTile(const TileGaussian<float>*, int, int, int, int, int, const float*, const BackwardIn&,
+                  const std::uint32_t*, float*) {
+  std::abort();
+}
+}  // namespace saresgs::raster_kernels::avx2
+#endif

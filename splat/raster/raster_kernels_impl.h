@@ -1,0 +1,379 @@
+// The float tile kernels (see splat/raster/raster_kernels.h), SARESGS_KERNEL_LANES pixels at a
+// time with GCC/Clang vector extensions, defined in namespace
+// saresgs::raster_kernels::SARESGS_KERNEL_NS. Included once per instruction set; it
+// deliberately includes no library header with inline code of its own beyond <cmath>
+// and <cstring> builtins, so that the AVX2 compilation emits no function the linker
+// could share with the baseline one.
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+
+#include "splat/raster/raster_kernels.h"
+
+#if SARESGS_KERNEL_FMA
+#include <immintrin.h>  // intrinsics are always-inline, no symbols of their own
+#endif
+
+#ifndef SARESGS_KERNEL_FMA
+#define SARESGS_KERNEL_FMA 0
+#endif
+#if !defined(SARESGS_KERNEL_NS) || !defined(SARESGS_KERNEL_LANES)
+#error "define SARESGS_KERNEL_NS and SARESGS_KERNEL_LANES before including raster_kernels_impl.h"
+#endif
+
+namespace saresgs::raster_kernels::SARESGS_KERNEL_NS {
+namespace {
+
+constexpr int L = SARESGS_KERNEL_LANES;
+static_assert(L == 4 || L == 8);
+// The contract's constants (splat/rasterize.h; rasterizer.cpp checks they agree).
+constexpr int kTile = 16;
+constexpr float kMinA = 1.0f / 255.0f;
+constexpr float kMaxA = 0.99f;
+constexpr float kMinT = 1e-4f;
+constexpr int kSlot = 9;
+
+typedef float vf __attribute__((vector_size(4 * L)));
+typedef std::int32_t vi __attribute__((vector_size(4 * L)));
+
+// a b + c: one fused rounding where the kernels are built for FMA, else two.
+inline vf fma(vf a, vf b, vf c) {
+#if SARESGS_KERNEL_FMA
+  return reinterpret_cast<vf>(_mm256_fmadd_ps(reinterpret_cast<__m256>(a), reinterpret_cast<__m256>(b),
+                                              reinterpret_cast<__m256>(c)));
+#else
+  return a * b + c;
+#endif
+}
+
+// x in every lane. Written as a scalar-vector operation so that GCC emits one broadcast
+// (a per-lane loop became a chain of inserts); x - (+0) is x exactly, -0 included.
+inline vf vs(float x) { return x - vf{}; }
+// A tile's pixels are stored in blocks of kBW x kBH pixels, one block per vector: four
+// columns by one row for four lanes, four by two for eight. The Gaussians are small
+// (a few pixels across), so a squarer block wastes fewer lanes on pixels they miss than
+// a row of eight would.
+constexpr int kBW = 4;
+constexpr int kBH = L / kBW;
+constexpr int kBX = kTile / kBW;  // blocks per block row
+static_assert(kTile % kBW == 0 && kTile % kBH == 0);
+// The tile row and column of storage index k.
+inline int blockRow(int k) { return (k / L) / kBX * kBH + (k % L) / kBW; }
+inline int blockCol(int k) { return (k / L) % kBX * kBW + (k % L) % kBW; }
+inline vf laneColCentres() {  // 0.5, 1.5, 2.5, 3.5, 0.5, ...
+  vf v;
+  for (int i = 0; i < L; ++i) v[i] = static_cast<float>(i % kBW) + 0.5f;
+  return v;
+}
+inline vf laneRowCentres() {  // 0.5 x4, then 1.5 x4 for eight lanes
+  vf v;
+  for (int i = 0; i < L; ++i) v[i] = static_cast<float>(i / kBW) + 0.5f;
+  return v;
+}
+inline vf load(const float* p) {
+  vf v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline void store(float* p, vf v) { std::memcpy(p, &v, sizeof v); }
+// Lanes summed as a balanced tree ((v0 + v1) + (v2 + v3)) + ..., a fixed order.
+inline float hsum(vf v) {
+  float s[L];
+  std::memcpy(s, &v, sizeof v);
+  for (int n = L / 2; n >= 1; n /= 2)
+    for (int i = 0; i < n; ++i) s[i] = s[2 * i] + s[2 * i + 1];
+  return s[0];
+}
+inline int hsumInt(vi v) {
+  int s = 0;
+  for (int i = 0; i < L; ++i) s += v[i];
+  return s;
+}
+
+// exp for x <= 0 without a libm call: Cody-Waite range reduction x = n ln2 + r and a
+// degree-6 polynomial (relative error < 3e-7); 0 below -87 (far under every threshold).
+inline vf expNonPositive(vf x) {
+  const vf lo = vs(-87.0f);
+  const vf xc = x < lo ? lo : x;
+  const vf t = xc * vs(1.4426950408889634f);
+  const vi ni = __builtin_convertvector(t - vs(0.5f), vi);  // t <= 0: rounds to nearest
+  const vf n = __builtin_convertvector(ni, vf);
+#if SARESGS_KERNEL_FMA
+  const vf r = fma(n, vs(-1.428606765330187e-06f), fma(n, vs(-0.693145751953125f), xc));
+#else
+  const vf r = (xc - n * vs(0.693145751953125f)) - n * vs(1.428606765330187e-06f);
+#endif
+  vf p = vs(1.0f / 720.0f);
+  p = fma(p, r, vs(1.0f / 120.0f));
+  p = fma(p, r, vs(1.0f / 24.0f));
+  p = fma(p, r, vs(1.0f / 6.0f));
+  p = fma(p, r, vs(0.5f));
+  p = fma(p, r, vs(1.0f));
+  p = fma(p, r, vs(1.0f));
+  const vf scale = reinterpret_cast<vf>((ni + 127) << 23);
+  return x < lo ? vs(0.0f) : p * scale;
+}
+
+// The row terms of a Gaussian's exponent, hoisted out of the pixel loops; per lane, as a
+// block spans kBH rows, in the same operation order for every block shape.
+inline vf rowQuad(const TileGaussian<float>& q, vf dy) { return (vs(-0.5f * q.c) * dy) * dy; }
+inline vf rowCross(const TileGaussian<float>& q, vf dy) { return vs(q.b) * dy; }
+
+// One Gaussian at L pixel centres of a row: the quantities both kernels need, computed
+// in one place so that the forward and backward passes make identical threshold
+// decisions. `touches` is rule 4's rectangle test in x plus the alpha test (o G >= 1/255
+// is alpha >= 1/255, as 0.99 > 1/255); the row's y test is the caller's.
+struct Lanes {
+  vf dx, G, oG, alpha;
+  vi touches;
+};
+
+inline Lanes evalLanes(vf dx, vf ha, vf qy, vf by, vf o, vf hx, vi row_in) {
+  Lanes l;
+  l.dx = dx;
+  // ((-0.5 a) dx) dx + row_quad - row_cross dx.
+#if SARESGS_KERNEL_FMA
+  const vf power = fma(-by, dx, fma(ha * dx, dx, qy));
+#else
+  const vf power = ha * dx * dx + qy - by * dx;
+#endif
+  l.G = expNonPositive(power < vs(0.0f) ? power : vs(0.0f));
+  l.oG = o * l.G;
+  l.alpha = l.oG < vs(kMaxA) ? l.oG : vs(kMaxA);
+  const vf adx = reinterpret_cast<vf>(reinterpret_cast<vi>(dx) & 0x7fffffff);
+  l.touches = row_in & (adx <= hx) & (power <= vs(0.0f)) & (l.oG >= vs(kMinA));
+  return l;
+}
+
+// Offsets from `origin` (clipped to [0, limit - origin)) of the pixels whose centres can
+// pass the float test |i + 0.5 - mean| <= half: the difference rounds by at most 2^-24
+// relative, so the exact bound widened by 1e-6 relative and 1e-3 px is a superset. The
+// per-pixel test decides; this only bounds the loops (empty when lo > hi).
+inline void tileSpan(float mean, float half, int origin, int limit, int& lo, int& hi) {
+  const double h = static_cast<double>(half) * (1.0 + 1e-6) + 1e-3;
+  double l = std::ceil(static_cast<double>(mean) - h - 0.5) - origin;
+  double u = std::floor(static_cast<double>(mean) + h - 0.5) - origin;
+  const double top = limit - origin - 1;
+  if (!(l >= 0)) l = 0;  // NaN too
+  if (l > top + 1) l = top + 1;
+  if (!(u <= top)) u = u > top ? top : -1;  // NaN: empty
+  if (u < -1) u = -1;
+  lo = static_cast<int>(l);
+  hi = static_cast<int>(u);
+}
+
+// The columns [lo, hi] (tile offsets, within the Gaussian's span [c0, c1]) that the
+// Gaussian may touch in block row rb: its rows' alpha-ellipse chords
+// (TileGaussian::chord_*, widened against rounding) all lie within [min centre - widest
+// half, max centre + widest half], plus 0.01 px for the centres' own rounding. One square
+// root per block row; empty (lo > hi) when no row of the block meets the ellipse. Loop
+// bounds only: the per-pixel test decides.
+inline void blockRowSpan(const TileGaussian<float>& g, int x0, int y0, int rb, int c0, int c1, int& lo,
+                         int& hi) {
+  lo = c1 + 1;
+  hi = c0 - 1;
+  const float dy0 = static_cast<float>(y0 + rb * kBH) + 0.5f - g.my;
+  const float dy1 = dy0 + static_cast<float>(kBH - 1);
+  // The row nearest the centre has the widest chord.
+  const float dmin = dy0 > 0.0f ? dy0 : (dy1 < 0.0f ? dy1 : 0.0f);
+  const float t = g.chord_k0 - g.chord_k1 * (dmin * dmin);
+  if (t < 0.0f) return;
+  const float half = std::sqrt(t) + 0.01f;
+  const float xa = g.mx + g.chord_slope * dy0 - static_cast<float>(x0);
+  const float xb = g.mx + g.chord_slope * dy1 - static_cast<float>(x0);
+  float l = (xa < xb ? xa : xb) - half - 0.5f, u = (xa < xb ? xb : xa) + half - 0.5f;
+  if (!(l >= static_cast<float>(c0))) l = static_cast<float>(c0);  // NaN: no bound
+  if (!(u <= static_cast<float>(c1))) u = static_cast<float>(c1);
+  if (l > static_cast<float>(c1) || u < static_cast<float>(c0)) return;
+  lo = static_cast<int>(l);  // l >= 0: truncation, then up to the ceiling
+  if (static_cast<float>(lo) < l) ++lo;
+  hi = static_cast<int>(u);
+}
+
+inline vi absLe(vf v, vf bound) { return reinterpret_cast<vf>(reinterpret_cast<vi>(v) & 0x7fffffff) <= bound; }
+
+}  // namespace
+
+// Front-to-back compositing, Gaussian by Gaussian over the pixels of its rectangle, so
+// the inner loop runs over contiguous pixels without branches; each pixel sees exactly
+// the per-pixel sequence of rule 7. A stopped pixel keeps its transmittance with the
+// sign flipped (it is >= 1e-4 while the pixel is live), so no separate "active" array.
+void compositeTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
+                   const ForwardOut& out) {
+  constexpr int P = kTile * kTile;
+  alignas(64) float Tr[P], C0[P], C1[P], C2[P], D[P], walked[P], contrib[P];
+  const int w = x1 - x0, h = y1 - y0;
+  for (int k = 0; k < P; ++k) {
+    const bool inside = blockCol(k) < w && blockRow(k) < h;
+    Tr[k] = inside ? 1.0f : -1.0f;  // pixels beyond the image never composite
+    C0[k] = C1[k] = C2[k] = D[k] = walked[k] = contrib[k] = 0.0f;
+  }
+  int n_active = w * h;
+  const vf lane_x = laneColCentres(), lane_y = laneRowCentres();
+  for (int j = 0; j < nq && n_active > 0; ++j) {
+    const TileGaussian<float>& g = q[j];
+    int c0, c1, r0, r1;
+    tileSpan(g.mx, g.hx, x0, x1, c0, c1);
+    tileSpan(g.my, g.hy, y0, y1, r0, r1);
+    if (c0 > c1) continue;
+    const vf mx = vs(g.mx), my = vs(g.my), hx = vs(g.hx), hy = vs(g.hy), o = vs(g.o);
+    const vf jf = vs(static_cast<float>(j + 1));
+    const vf ha = vs(-0.5f) * vs(g.a);
+    const vf col0 = vs(g.col[0]), col1 = vs(g.col[1]), col2 = vs(g.col[2]), dep = vs(g.depth);
+    vi stopped = vi{} + 0;
+    for (int rb = r0 / kBH; rb <= r1 / kBH; ++rb) {
+      int lo, hi;
+      blockRowSpan(g, x0, y0, rb, c0, c1, lo, hi);
+      if (lo > hi) continue;
+      const vf dy = (vs(static_cast<float>(y0 + rb * kBH)) + lane_y) - my;
+      const vi row_in = absLe(dy, hy);
+      const vf qy = rowQuad(g, dy), by = rowCross(g, dy);
+      for (int cb = lo & ~(kBW - 1); cb <= hi; cb += kBW) {
+        const int k = (rb * kBX + cb / kBW) * L;
+        const Lanes Ln = evalLanes((vs(static_cast<float>(x0 + cb)) + lane_x) - mx, ha, qy, by, o, hx, row_in);
+        const vf alpha = Ln.alpha;
+        vf t = load(Tr + k);
+        const vi ok = (t > vs(0.0f)) & Ln.touches;
+        const vf next = t * (vs(1.0f) - alpha);
+        const vi stop = ok & (next < vs(kMinT));
+        const vi take = ok & ~stop;
+        const vf wgt = take ? alpha * t : vs(0.0f);
+        store(C0 + k, fma(wgt, col0, load(C0 + k)));
+        store(C1 + k, fma(wgt, col1, load(C1 + k)));
+        store(C2 + k, fma(wgt, col2, load(C2 + k)));
+        store(D + k, fma(wgt, dep, load(D + k)));
+        store(Tr + k, take ? next : (stop ? -t : t));
+        store(walked + k, take ? jf : load(walked + k));
+        store(contrib + k, load(contrib + k) + (take ? vs(1.0f) : vs(0.0f)));
+        stopped -= stop;  // masks are -1 where true
+      }
+    }
+    n_active -= hsumInt(stopped);
+  }
+  for (int k = 0; k < P; ++k) {
+    const int r = blockRow(k), c = blockCol(k);
+    if (r >= h || c >= w) continue;
+    const float T = std::abs(Tr[k]);
+    const std::size_t pix = static_cast<std::size_t>(y0 + r) * out.W + (x0 + c);
+    out.rgb[pix * 3] = C0[k] + T * bg[0];
+    out.rgb[pix * 3 + 1] = C1[k] + T * bg[1];
+    out.rgb[pix * 3 + 2] = C2[k] + T * bg[2];
+    out.alpha[pix] = 1.0f - T;
+    out.depth[pix] = (1.0f - T) >= 1e-6f ? D[k] / (1.0f - T) : 0.0f;
+    out.contributors[pix] = static_cast<int>(contrib[k]);
+    out.final_T[pix] = T;
+    out.n_walked[pix] = static_cast<std::uint32_t>(walked[k]);
+  }
+}
+
+namespace {
+
+// The back-to-front walk (the scalar walkBack of rasterizer.cpp, per lane), Gaussian by
+// Gaussian. kBg: the background term of dL/dalpha; without a background it is exactly 0
+// and its division is skipped.
+template <bool kBg>
+void backwardTileImpl(const TileGaussian<float>* q, int x0, int y0, int x1, int y1, const float bg[3],
+                      const BackwardIn& in, const std::uint32_t* entry_slot, float* slots) {
+  constexpr int P = kTile * kTile;
+  const int w = x1 - x0, h = y1 - y0;
+  alignas(64) float Tr[P], finalT[P], walked[P], acc0[P], acc1[P], acc2[P], w0[P], w1[P], w2[P], bgdot[P];
+  std::uint32_t jmax = 0;
+  for (int k = 0; k < P; ++k) {
+    const int r = blockRow(k), c = blockCol(k);
+    const bool inside = c < w && r < h;
+    const std::size_t pix = inside ? static_cast<std::size_t>(y0 + r) * in.W + (x0 + c) : 0;
+    Tr[k] = finalT[k] = inside ? in.final_T[pix] : 1.0f;
+    const std::uint32_t nw = inside ? in.n_walked[pix] : 0;
+    walked[k] = static_cast<float>(nw);
+    jmax = nw > jmax ? nw : jmax;
+    acc0[k] = acc1[k] = acc2[k] = 0.0f;
+    w0[k] = inside ? in.dL_drgb[pix * 3] : 0.0f;
+    w1[k] = inside ? in.dL_drgb[pix * 3 + 1] : 0.0f;
+    w2[k] = inside ? in.dL_drgb[pix * 3 + 2] : 0.0f;
+    bgdot[k] = bg[0] * w0[k] + bg[1] * w1[k] + bg[2] * w2[k];
+  }
+  const vf lane_x = laneColCentres(), lane_y = laneRowCentres();
+  for (std::uint32_t jj = jmax; jj-- > 0;) {
+    const TileGaussian<float>& g = q[jj];
+    int c0, c1, r0, r1;
+    tileSpan(g.mx, g.hx, x0, x1, c0, c1);
+    tileSpan(g.my, g.hy, y0, y1, r0, r1);
+    const vf mx = vs(g.mx), my = vs(g.my), hx = vs(g.hx), hy = vs(g.hy), o = vs(g.o);
+    const vf jv = vs(static_cast<float>(jj));
+    const vf ha = vs(-0.5f) * vs(g.a);
+    const vf col0 = vs(g.col[0]), col1 = vs(g.col[1]), col2 = vs(g.col[2]);
+    const vf zero = vs(0.0f), one = vs(1.0f);
+    // Sums over the Gaussian's pixels of e = G dL/dalpha (where alpha = o G is not
+    // clamped) times 1, dx, dy, dx^2, dx dy, dy^2, and of alpha T w_c; the 2D
+    // gradients are linear in them (see below).
+    vf s_e = zero, s_x = zero, s_y = zero, s_xx = zero, s_xy = zero, s_yy = zero, s_c0 = zero, s_c1 = zero,
+       s_c2 = zero;
+    if (c0 <= c1)
+      for (int rb = r0 / kBH; rb <= r1 / kBH; ++rb) {
+        int lo, hi;
+        blockRowSpan(g, x0, y0, rb, c0, c1, lo, hi);
+        if (lo > hi) continue;
+        const vf dy = (vs(static_cast<float>(y0 + rb * kBH)) + lane_y) - my;
+        const vi row_in = absLe(dy, hy);
+        const vf qy = rowQuad(g, dy), by = rowCross(g, dy);
+        for (int cb = lo & ~(kBW - 1); cb <= hi; cb += kBW) {
+          const int k = (rb * kBX + cb / kBW) * L;
+          const Lanes Ln = evalLanes((vs(static_cast<float>(x0 + cb)) + lane_x) - mx, ha, qy, by, o, hx, row_in);
+          const vf dx = Ln.dx, alpha = Ln.alpha;
+          const vi valid = (jv < load(walked + k)) & Ln.touches;
+          const vf a_eff = valid ? alpha : zero;
+          const vf t = load(Tr + k) / (one - a_eff);  // transmittance in front of jj
+          store(Tr + k, t);
+          // acc: the colour composited behind jj (normalised), updated once jj is used.
+          const vf a0 = load(acc0 + k), a1 = load(acc1 + k), a2 = load(acc2 + k);
+          const vf d0 = col0 - a0, d1 = col1 - a1, d2 = col2 - a2;
+          const vf ww0 = load(w0 + k), ww1 = load(w1 + k), ww2 = load(w2 + k);
+          const vf dLdc = fma(d2, ww2, fma(d1, ww1, d0 * ww0));
+          vf dLda = dLdc * t;
+          if constexpr (kBg) dLda = dLda - load(finalT + k) / (one - alpha) * load(bgdot + k);
+          store(acc0 + k, fma(a_eff, d0, a0));
+          store(acc1 + k, fma(a_eff, d1, a1));
+          store(acc2 + k, fma(a_eff, d2, a2));
+          const vi gm = valid & (Ln.oG < vs(kMaxA));
+          const vf e = gm ? Ln.G * dLda : zero;
+          s_e += e;
+          const vf ex = e * dx, ey = e * dy;
+          s_x += ex;
+          s_y += ey;
+          s_xx = fma(ex, dx, s_xx);
+          s_xy = fma(ex, dy, s_xy);
+          s_yy = fma(ey, dy, s_yy);
+          const vf wcol = a_eff * t;  // 0 where not valid
+          s_c0 = fma(wcol, ww0, s_c0);
+          s_c1 = fma(wcol, ww1, s_c1);
+          s_c2 = fma(wcol, ww2, s_c2);
+        }
+      }
+    // dL/dpower = o e; power = -(a dx^2 + 2 b dx dy + c dy^2) / 2 with dx = px - mean.
+    const float e = hsum(s_e), ex = hsum(s_x), ey = hsum(s_y), exx = hsum(s_xx), exy = hsum(s_xy),
+                eyy = hsum(s_yy);
+    float* sl = &slots[static_cast<std::size_t>(entry_slot[jj]) * kSlot];
+    sl[0] = e;
+    sl[1] = g.o * (g.a * ex + g.b * ey);
+    sl[2] = g.o * (g.b * ex + g.c * ey);
+    sl[3] = -0.5f * g.o * exx;
+    sl[4] = -g.o * exy;
+    sl[5] = -0.5f * g.o * eyy;
+    sl[6] = hsum(s_c0);
+    sl[7] = hsum(s_c1);
+    sl[8] = hsum(s_c2);
+  }
+}
+
+}  // namespace
+
+void backwardTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
+                  const BackwardIn& in, const std::uint32_t* entry_slot, float* slots) {
+  if (nq == 0) return;
+  if (bg[0] != 0.0f || bg[1] != 0.0f || bg[2] != 0.0f)
+    backwardTileImpl<true>(q, x0, y0, x1, y1, bg, in, entry_slot, slots);
+  else
+    backwardTileImpl<false>(q, x0, y0, x1, y1, bg, in, entry_slot, slots);
+}
+
+}  // namespace saresgs::raster_kernels::SARESGS_KERNEL_NS

@@ -1,0 +1,43 @@
+#pragma once
+// The rasterizer templated on the scalar: float is the product, double serves the
+// gradient tests (same code, so a double finite-difference check tests the float path's
+// logic, and float-vs-double tests its rounding).
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "splat/rasterize.h"
+
+namespace saresgs {
+
+template <typename T>
+struct RasterStateT;
+
+template <typename T>
+struct RenderOutputT {
+  int width = 0, height = 0;
+  std::vector<T> rgb, alpha, depth;  // 3, 1, 1 per pixel
+  std::vector<int> contributors;
+  std::vector<T> radii;
+  std::vector<std::uint8_t> visible;
+  std::shared_ptr<const RasterStateT<T>> state;
+};
+
+template <typename T>
+RenderOutputT<T> rasterizeT(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& s,
+                            std::span<const std::uint8_t> mask = {});
+
+// Adds dL/dparams to `grad` for dL/drgb (3 per pixel); grad_mean2d (2 per Gaussian,
+// pixels) is added to when given.
+template <typename T>
+void rasterizeBackwardT(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& s,
+                        const RenderOutputT<T>& fwd, const T* dL_drgb, GaussiansT<T>& grad,
+                        std::vector<T>* grad_mean2d = nullptr);
+
+// Adds, per parameter, sum over pixels of (d(C_r + C_g + C_b)/dparam)^2 to `sq`
+// (FisherRF's diagonal information; rotations are left untouched).
+template <typename T>
+void rasterizeSquaredGradientsT(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& s,
+                                const RenderOutputT<T>& fwd, GaussiansT<T>& sq);
+
+}  // namespace saresgs

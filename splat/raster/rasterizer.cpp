@@ -1,0 +1,737 @@
+// The fast tiled rasterizer: TBB-parallel over Gaussians for projection and over 16x16
+// tiles for compositing and backward. Every gradient contribution lands in a slot owned
+// by one (tile, Gaussian) pair and slots are reduced per Gaussian in a fixed order, so
+// results are bit-identical for the same inputs, whatever the thread count.
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+#include <type_traits>
+
+#include "splat/raster/execution.h"
+#include "splat/raster/projection.h"
+#include "splat/raster/raster_kernels.h"
+#include "splat/raster/rasterize_detail.h"
+
+// The baseline (four-lane) float kernels; the AVX2 ones are in raster_kernels_avx2.cpp.
+#define SARESGS_KERNEL_NS base4
+#define SARESGS_KERNEL_LANES 4
+#include "splat/raster/raster_kernels_impl.h"
+#undef SARESGS_KERNEL_NS
+#undef SARESGS_KERNEL_LANES
+
+namespace saresgs {
+
+using projection::CameraT;
+using projection::Projected;
+using projection::ProjectedGrad;
+
+template <typename T>
+struct RasterStateT {
+  RasterSettings settings;
+  std::vector<Projected<T>> proj;  // per Gaussian
+  std::vector<TileGaussian<T>> tile_data;  // per Gaussian: what the tile kernels read
+  int tiles_x = 0, tiles_y = 0;
+  std::vector<std::uint32_t> gauss_start;  // N + 1: each Gaussian's pair slots
+  std::vector<std::uint32_t> tile_start;   // tiles + 1
+  std::vector<std::uint32_t> entry_gauss;  // per tile entry: the Gaussian
+  std::vector<std::uint32_t> entry_slot;   // per tile entry: its pair slot
+  std::vector<T> final_T;                  // per pixel
+  std::vector<std::uint32_t> n_walked;     // per pixel: tile entries walked (last contributor + 1)
+  int isa = 0;                             // the float kernels the forward pass used
+};
+
+namespace {
+
+// The arena a pass runs in: the forward pass's execution settings (its thread count
+// does not change results, so the backward pass simply reuses it).
+template <typename T>
+tbb::task_arena& arena(const RasterStateT<T>& st) {
+  return raster_execution::arena(st.settings.execution.threads);
+}
+
+// The float kernels, indexed by raster_execution::kernelIndex; index 0 is the baseline.
+struct KernelSet {
+  const char* name;
+  raster_kernels::CompositeFn composite;
+  raster_kernels::BackwardFn backward;
+};
+constexpr KernelSet kKernelSets[] = {
+    {"baseline", raster_kernels::base4::compositeTile, raster_kernels::base4::backwardTile},
+    {"avx2", raster_kernels::avx2::compositeTile, raster_kernels::avx2::backwardTile},
+};
+static_assert(raster_kernels::base4::kTile == kTileSize && raster_kernels::base4::kMinA == kMinAlpha &&
+              raster_kernels::base4::kMaxA == kMaxAlpha && raster_kernels::base4::kMinT == kMinTransmittance);
+
+// Pixel range [lo, hi] whose centres (i + 0.5) lie within mean +- half, clipped to [0, n).
+template <typename T>
+void pixelRange(T mean, T half, int n, int& lo, int& hi) {
+  lo = std::max(0, static_cast<int>(std::ceil(mean - half - T(0.5))));
+  hi = std::min(n - 1, static_cast<int>(std::floor(mean + half - T(0.5))));
+}
+
+// A projected Gaussian as the tile kernels read it. The chord terms (splat/raster/raster_kernels.h):
+// a pixel at offset (dx, dy) can pass o G >= 1/255 only where a dx^2 + 2 b dx dy + c dy^2
+// <= k2 = 2 ln(255 o), i.e. |dx + (b/a) dy| <= sqrt(k2/a - (det/a^2) dy^2), det = ac - b^2.
+// The float test rounds each term of its exponent, so its boundary can move by a few ulp
+// of the terms' sizes, which are at most ~4 kappa k2 with kappa = (a + c)^2 / (4 det)
+// (1 for a circle); k2 is widened by 1% + 1e-4, far more than that for kappa <= 250.
+// Beyond (needle-like Gaussians) or for anything not finite, no chord: the loops then
+// cover the whole rectangle, as they would without these terms.
+template <typename T>
+TileGaussian<T> tileData(const Projected<T>& P) {
+  TileGaussian<T> q{P.mean2d[0], P.mean2d[1], P.conic[0], P.conic[1], P.conic[2], P.opacity, P.half[0],
+                    P.half[1], P.depth, {P.color[0], P.color[1], P.color[2]}, T(0),
+                    std::numeric_limits<T>::max(), T(0)};
+  const double a = P.conic[0], b = P.conic[1], c = P.conic[2], o = P.opacity;
+  const double det = a * c - b * b;
+  const double k2 = 2.0 * std::log(255.0 * o) * 1.01 + 1e-4;
+  if (a > 0 && det > 0 && std::isfinite(a + b + c + det + k2) && (a + c) * (a + c) <= 1000.0 * det) {
+    q.chord_slope = static_cast<T>(-b / a);
+    q.chord_k0 = static_cast<T>(k2 / a);
+    q.chord_k1 = static_cast<T>(det / (a * a));
+  }
+  return q;
+}
+
+template <typename T>
+void gatherTile(const RasterStateT<T>& st, int tile, std::vector<TileGaussian<T>>& out) {
+  const std::uint32_t b = st.tile_start[tile], e = st.tile_start[tile + 1];
+  out.resize(e - b);
+  for (std::uint32_t k = b; k < e; ++k) out[k - b] = st.tile_data[st.entry_gauss[k]];
+}
+
+// exp for x <= 0 in float without a libm call, so the pixel loops vectorise: Cody-Waite
+// range reduction x = n ln2 + r, |r| <= ln2 / 2 + rounding, and a degree-6 polynomial
+// (relative error < 3e-7 over the range). Below -87 it returns 0 (e^-87 ~ 1.6e-38 is
+// far under every threshold of the contract). The double instantiation uses std::exp.
+inline float expNonPositive(float x) {
+  const float xc = std::max(x, -87.0f);
+  const float t = xc * 1.4426950408889634f;
+  const float n = static_cast<float>(static_cast<int>(t - 0.5f));  // t <= 0: rounds to nearest
+  const float r = (xc - n * 0.693145751953125f) - n * 1.428606765330187e-06f;
+  float p = 1.0f / 720.0f;
+  p = p * r + 1.0f / 120.0f;
+  p = p * r + 1.0f / 24.0f;
+  p = p * r + 1.0f / 6.0f;
+  p = p * r + 0.5f;
+  p = p * r + 1.0f;
+  p = p * r + 1.0f;
+  const float scale = std::bit_cast<float>((static_cast<std::int32_t>(n) + 127) << 23);
+  return x < -87.0f ? 0.0f : p * scale;
+}
+inline double expNonPositive(double x) { return std::exp(x); }
+
+// The exponent of a Gaussian at offset (dx, dy), written once so that the forward and
+// backward passes round identically (their threshold decisions must agree). The row
+// terms are separate so the forward pass can hoist them out of its pixel loop.
+template <typename T>
+T rowQuad(const TileGaussian<T>& q, T dy) { return T(-0.5) * q.c * dy * dy; }
+template <typename T>
+T rowCross(const TileGaussian<T>& q, T dy) { return q.b * dy; }
+template <typename T>
+T powerAt(const TileGaussian<T>& q, T dx, T row_quad, T row_cross) {
+  return T(-0.5) * q.a * dx * dx + row_quad - row_cross * dx;
+}
+
+// G and alpha of a Gaussian at a pixel centre; false when it does not touch the pixel
+// (outside its rectangle, or alpha below 1/255). `unclamped`: o G < 0.99.
+template <typename T>
+bool evalAlpha(const TileGaussian<T>& q, T px, T py, T& dx, T& dy, T& G, T& alpha, bool& unclamped) {
+  dx = px - q.mx;
+  dy = py - q.my;
+  if (std::abs(dx) > q.hx || std::abs(dy) > q.hy) return false;
+  const T power = powerAt(q, dx, rowQuad(q, dy), rowCross(q, dy));
+  if (power > 0) return false;  // cannot happen for a valid conic; guards rounding
+  G = expNonPositive(power);
+  const T oG = q.o * G;
+  unclamped = oG < T(kMaxAlpha);
+  alpha = unclamped ? oG : T(kMaxAlpha);
+  return alpha >= T(kMinAlpha);
+}
+
+// Rule 6 for every tile at once: the Gaussians with pairs, by camera z, ties by index.
+// Binning them in this order (a stable counting sort by tile) leaves every tile sorted,
+// which costs far less than sorting each tile. Float depths go through a stable LSD radix
+// sort on their bits (mapped so that unsigned order is float order); double uses
+// std::sort.
+template <typename T>
+std::vector<std::uint32_t> depthOrder(const std::vector<Projected<T>>& proj, const std::vector<std::uint32_t>& count) {
+  std::vector<std::uint32_t> order;
+  order.reserve(proj.size());
+  for (std::size_t i = 0; i < proj.size(); ++i)
+    if (count[i]) order.push_back(static_cast<std::uint32_t>(i));
+  if constexpr (std::is_same_v<T, float>) {
+    const std::size_t m = order.size();
+    std::vector<std::uint32_t> key(m), key2(m), order2(m);
+    for (std::size_t j = 0; j < m; ++j) {
+      // + 0 turns -0 into +0, which the comparison of rule 6 treats as equal.
+      const std::uint32_t b = std::bit_cast<std::uint32_t>(proj[order[j]].depth + 0.0f);
+      key[j] = (b & 0x80000000u) ? ~b : (b | 0x80000000u);
+    }
+    constexpr int kBits = 11, kBuckets = 1 << kBits;
+    for (int shift = 0; shift < 32; shift += kBits) {
+      std::array<std::uint32_t, kBuckets + 1> start{};
+      for (std::size_t j = 0; j < m; ++j) ++start[((key[j] >> shift) & (kBuckets - 1)) + 1];
+      for (int k = 0; k < kBuckets; ++k) start[k + 1] += start[k];
+      for (std::size_t j = 0; j < m; ++j) {
+        const std::uint32_t d = start[(key[j] >> shift) & (kBuckets - 1)]++;
+        key2[d] = key[j];
+        order2[d] = order[j];
+      }
+      key.swap(key2);
+      order.swap(order2);
+    }
+  } else {
+    std::sort(order.begin(), order.end(), [&](std::uint32_t x, std::uint32_t y) {
+      return proj[x].depth < proj[y].depth || (proj[x].depth == proj[y].depth && x < y);
+    });
+  }
+  return order;
+}
+
+template <typename T>
+void tilePixels(const RasterStateT<T>& st, int tile, int width, int height, int& x0, int& y0, int& x1,
+                int& y1) {
+  const int tx = tile % st.tiles_x, ty = tile / st.tiles_x;
+  x0 = tx * kTileSize;
+  y0 = ty * kTileSize;
+  x1 = std::min(width, x0 + kTileSize);
+  y1 = std::min(height, y0 + kTileSize);
+}
+
+
+// Columns or rows of a tile (offsets 0..15) whose pixel centres may lie within
+// mean +- half: the exact test is applied per pixel, this only bounds the loops, so it
+// is widened by a pixel against rounding.
+template <typename T>
+void tileSpan(T mean, T half, int origin, int limit, int& lo, int& hi) {
+  lo = std::max(0, static_cast<int>(std::floor(mean - half - T(0.5))) - 1 - origin);
+  hi = std::min(limit - origin - 1, static_cast<int>(std::ceil(mean + half - T(0.5))) + 1 - origin);
+}
+
+// Front-to-back compositing of one tile, Gaussian by Gaussian over the pixels of its
+// rectangle, so the inner loop runs over contiguous pixels without branches. Each
+// pixel sees exactly the per-pixel sequence of rule 7.
+template <typename T>
+void compositeTile(const std::vector<TileGaussian<T>>& q, int x0, int y0, int x1, int y1, const T bg[3],
+                   int W, RenderOutputT<T>& out, RasterStateT<T>& st) {
+  constexpr int P = kTileSize * kTileSize;
+  alignas(64) T Tr[P], C0[P], C1[P], C2[P], D[P];
+  alignas(64) std::int32_t walked[P], contrib[P], active[P];
+  const int w = x1 - x0, h = y1 - y0;
+  for (int k = 0; k < P; ++k) {
+    Tr[k] = 1;
+    C0[k] = C1[k] = C2[k] = D[k] = 0;
+    walked[k] = contrib[k] = 0;
+    active[k] = (k % kTileSize) < w && (k / kTileSize) < h;
+  }
+  int n_active = w * h;
+  const std::int32_t nq = static_cast<std::int32_t>(q.size());
+  for (std::int32_t j = 0; j < nq && n_active > 0; ++j) {
+    const TileGaussian<T>& g = q[j];
+    int c0, c1, r0, r1;
+    tileSpan(g.mx, g.hx, x0, x1, c0, c1);
+    tileSpan(g.my, g.hy, y0, y1, r0, r1);
+    int stopped = 0;
+    for (int r = r0; r <= r1; ++r) {
+      const T dy = T(y0 + r) + T(0.5) - g.my;
+      const bool row_in = std::abs(dy) <= g.hy;
+      if (!row_in) continue;
+      const T qy = rowQuad(g, dy);
+      const T by = rowCross(g, dy);
+      T* tr = Tr + r * kTileSize;
+      T* c0p = C0 + r * kTileSize;
+      T* c1p = C1 + r * kTileSize;
+      T* c2p = C2 + r * kTileSize;
+      T* dp = D + r * kTileSize;
+      std::int32_t* wk = walked + r * kTileSize;
+      std::int32_t* ct = contrib + r * kTileSize;
+      std::int32_t* ac = active + r * kTileSize;
+#pragma GCC ivdep
+      for (int c = c0; c <= c1; ++c) {
+        const T dx = T(x0 + c) + T(0.5) - g.mx;
+        const T power = powerAt(g, dx, qy, by);
+        const T G = expNonPositive(power < T(0) ? power : T(0));
+        const T oG = g.o * G;
+        const T alpha = oG < T(kMaxAlpha) ? oG : T(kMaxAlpha);
+        // Non-short-circuit '&' keeps the body branch-free so it vectorises.
+        const bool ok = (ac[c] != 0) & (std::abs(dx) <= g.hx) & (power <= T(0)) & (alpha >= T(kMinAlpha));
+        const T next = tr[c] * (T(1) - alpha);
+        const bool stop = ok & (next < T(kMinTransmittance));
+        const bool take = ok & !stop;
+        const T wgt = take ? alpha * tr[c] : T(0);
+        c0p[c] += wgt * g.col[0];
+        c1p[c] += wgt * g.col[1];
+        c2p[c] += wgt * g.col[2];
+        dp[c] += wgt * g.depth;
+        tr[c] = take ? next : tr[c];
+        wk[c] = take ? j + 1 : wk[c];
+        ct[c] += take ? 1 : 0;
+        ac[c] = stop ? 0 : ac[c];
+        stopped += stop ? 1 : 0;
+      }
+    }
+    n_active -= stopped;
+  }
+  for (int r = 0; r < h; ++r)
+    for (int c = 0; c < w; ++c) {
+      const int k = r * kTileSize + c;
+      const std::size_t pix = static_cast<std::size_t>(y0 + r) * W + (x0 + c);
+      out.rgb[pix * 3] = C0[k] + Tr[k] * bg[0];
+      out.rgb[pix * 3 + 1] = C1[k] + Tr[k] * bg[1];
+      out.rgb[pix * 3 + 2] = C2[k] + Tr[k] * bg[2];
+      out.alpha[pix] = T(1) - Tr[k];
+      out.depth[pix] = (T(1) - Tr[k]) >= T(1e-6) ? D[k] / (T(1) - Tr[k]) : T(0);
+      out.contributors[pix] = contrib[k];
+      st.final_T[pix] = Tr[k];
+      st.n_walked[pix] = static_cast<std::uint32_t>(walked[k]);
+    }
+}
+
+}  // namespace
+
+const char* rasterKernelName(const RasterExecution& e) {
+  return kKernelSets[raster_execution::kernelIndex(e.kernels)].name;
+}
+
+namespace {
+
+// The forward pass runs three stages: projectAll (rules 1-5, per Gaussian), binAndSort
+// (rule 6, per tile) and compositeTiles (rule 7, per pixel).
+
+// What projection leaves for binning: the tiles each projected Gaussian touches.
+struct TileCover {
+  std::vector<std::uint32_t> count;      // per Gaussian: tiles touched, 0 when culled
+  std::vector<std::array<int, 4>> rect;  // per Gaussian: tiles x0, x1, y0, y1 (inclusive)
+};
+
+// Projects every unmasked Gaussian, culls, fills its tile data, radius and visibility,
+// and counts the tiles its pixel rectangle touches.
+template <typename T>
+TileCover projectAll(const GaussiansT<T>& g, const CameraT<T>& camT, std::span<const std::uint8_t> mask,
+                     int W, int H, RasterStateT<T>& st, RenderOutputT<T>& out) {
+  const std::size_t n = g.size();
+  const RasterSettings& rs = st.settings;
+  out.radii.assign(n, T(0));
+  out.visible.assign(n, 0);
+  st.proj.resize(n);
+  st.tile_data.resize(n);
+  TileCover cover;
+  cover.count.assign(n, 0);
+  cover.rect.resize(n);
+  arena(st).execute([&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& r) {
+      for (std::size_t i = r.begin(); i < r.end(); ++i) {
+        if (!mask.empty() && !mask[i]) {
+          st.proj[i] = Projected<T>{};
+          continue;
+        }
+        Projected<T>& P = st.proj[i] = projection::project(g, i, camT, rs);
+        if (!P.visible) continue;
+        st.tile_data[i] = tileData(P);
+        out.visible[i] = 1;
+        out.radii[i] = P.radius;
+        int px0, px1, py0, py1;
+        pixelRange(P.mean2d[0], P.half[0], W, px0, px1);
+        pixelRange(P.mean2d[1], P.half[1], H, py0, py1);
+        if (px0 > px1 || py0 > py1) continue;
+        std::array<int, 4>& rect = cover.rect[i];
+        rect = {px0 / kTileSize, px1 / kTileSize, py0 / kTileSize, py1 / kTileSize};
+        cover.count[i] = static_cast<std::uint32_t>((rect[1] - rect[0] + 1) * (rect[3] - rect[2] + 1));
+      }
+    });
+  });
+  return cover;
+}
+
+// Builds the per-tile lists: pair slots, Gaussian-major, then a stable counting sort by
+// tile of the Gaussians in depth order (depthOrder), so each tile comes out sorted by
+// rule 6.
+template <typename T>
+void binAndSort(const TileCover& cover, RasterStateT<T>& st) {
+  const std::size_t n = cover.count.size();
+  const int tiles = st.tiles_x * st.tiles_y;
+  st.gauss_start.assign(n + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) st.gauss_start[i + 1] = st.gauss_start[i] + cover.count[i];
+  const std::uint32_t pairs = st.gauss_start[n];
+  std::vector<std::uint32_t> slot_tile(pairs);
+  arena(st).execute([&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& r) {
+      for (std::size_t i = r.begin(); i < r.end(); ++i) {
+        if (!cover.count[i]) continue;
+        const auto& [tx0, tx1, ty0, ty1] = cover.rect[i];
+        std::uint32_t k = st.gauss_start[i];
+        for (int ty = ty0; ty <= ty1; ++ty)
+          for (int tx = tx0; tx <= tx1; ++tx)
+            slot_tile[k++] = static_cast<std::uint32_t>(ty * st.tiles_x + tx);
+      }
+    });
+  });
+  st.tile_start.assign(tiles + 1, 0);
+  for (std::uint32_t k = 0; k < pairs; ++k) ++st.tile_start[slot_tile[k] + 1];
+  for (int t = 0; t < tiles; ++t) st.tile_start[t + 1] += st.tile_start[t];
+  st.entry_gauss.resize(pairs);
+  st.entry_slot.resize(pairs);
+  std::vector<std::uint32_t> fill(st.tile_start.begin(), st.tile_start.end() - 1);
+  for (const std::uint32_t i : depthOrder(st.proj, cover.count))
+    for (std::uint32_t k = st.gauss_start[i]; k < st.gauss_start[i + 1]; ++k) {
+      const std::uint32_t e = fill[slot_tile[k]]++;
+      st.entry_gauss[e] = i;
+      st.entry_slot[e] = k;
+    }
+}
+
+// Composites every tile front to back (float: the SIMD kernels of st.isa) into `out`,
+// keeping each pixel's final transmittance and walk length for the backward pass.
+template <typename T>
+void compositeTiles(int W, int H, RasterStateT<T>& st, RenderOutputT<T>& out) {
+  out.rgb.assign(static_cast<std::size_t>(W) * H * 3, T(0));
+  out.alpha.assign(static_cast<std::size_t>(W) * H, T(0));
+  out.depth.assign(static_cast<std::size_t>(W) * H, T(0));
+  out.contributors.assign(static_cast<std::size_t>(W) * H, 0);
+  st.final_T.assign(static_cast<std::size_t>(W) * H, T(1));
+  st.n_walked.assign(static_cast<std::size_t>(W) * H, 0);
+  const RasterSettings& rs = st.settings;
+  const T bg[3] = {T(rs.background[0]), T(rs.background[1]), T(rs.background[2])};
+  arena(st).execute([&] {
+    tbb::parallel_for(0, st.tiles_x * st.tiles_y, [&](int tile) {
+      thread_local std::vector<TileGaussian<T>> q;
+      gatherTile(st, tile, q);
+      int x0, y0, x1, y1;
+      tilePixels(st, tile, W, H, x0, y0, x1, y1);
+      if constexpr (std::is_same_v<T, float>) {
+        const raster_kernels::ForwardOut fo{W,
+                                            out.rgb.data(),
+                                            out.alpha.data(),
+                                            out.depth.data(),
+                                            out.contributors.data(),
+                                            st.final_T.data(),
+                                            st.n_walked.data()};
+        kKernelSets[st.isa].composite(q.data(), static_cast<int>(q.size()), x0, y0, x1, y1, bg, fo);
+      } else {
+        compositeTile(q, x0, y0, x1, y1, bg, W, out, st);
+      }
+    });
+  });
+}
+
+}  // namespace
+
+template <typename T>
+RenderOutputT<T> rasterizeT(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& s,
+                            std::span<const std::uint8_t> mask) {
+  const int W = cam.K.width, H = cam.K.height;
+  auto st = std::make_shared<RasterStateT<T>>();
+  st->settings = s;
+  st->isa = raster_execution::kernelIndex(s.execution.kernels);
+  st->settings.sh_degree = std::clamp(s.sh_degree, 0, g.max_sh_degree);
+  st->tiles_x = (W + kTileSize - 1) / kTileSize;
+  st->tiles_y = (H + kTileSize - 1) / kTileSize;
+  const CameraT<T> camT(cam, T(s.guard_band));
+
+  RenderOutputT<T> out;
+  out.width = W;
+  out.height = H;
+  const TileCover cover = projectAll(g, camT, mask, W, H, *st, out);
+  binAndSort(cover, *st);
+  compositeTiles(W, H, *st, out);
+  out.state = st;
+  return out;
+}
+
+namespace {
+
+// Walks one pixel's contributors back to front and calls
+// visit(entry, dx, dy, G, alpha, unclamped, dL_dalpha, dL_dcolor_weight) where dL_dalpha
+// is for the per-pixel objective sum_c w_c C_c and dL_dcolor_weight = alpha T.
+template <typename T, typename Visit>
+void walkBack(const std::vector<TileGaussian<T>>& q, std::uint32_t walked, T final_T, T px, T py,
+              const T w[3], const T bg[3], Visit&& visit) {
+  T Tr = final_T;
+  T accum[3] = {0, 0, 0}, last_alpha = 0, last_col[3] = {0, 0, 0};
+  const T bg_dot = bg[0] * w[0] + bg[1] * w[1] + bg[2] * w[2];
+  for (std::uint32_t jj = walked; jj-- > 0;) {
+    T dx, dy, G, alpha;
+    bool unclamped;
+    if (!evalAlpha(q[jj], px, py, dx, dy, G, alpha, unclamped)) continue;
+    Tr = Tr / (T(1) - alpha);  // transmittance in front of this Gaussian
+    T dL_dalpha = 0;
+    for (int c = 0; c < 3; ++c) {
+      accum[c] = last_alpha * last_col[c] + (T(1) - last_alpha) * accum[c];
+      dL_dalpha += (q[jj].col[c] - accum[c]) * w[c];
+    }
+    dL_dalpha = dL_dalpha * Tr - final_T / (T(1) - alpha) * bg_dot;
+    last_alpha = alpha;
+    for (int c = 0; c < 3; ++c) last_col[c] = q[jj].col[c];
+    visit(jj, dx, dy, G, alpha, unclamped, dL_dalpha, alpha * Tr);
+  }
+}
+
+// The 2D gradients of one contribution: through alpha = o G (when unclamped) to the
+// opacity, the 2D mean and the conic.
+template <typename T>
+void alphaToProjected(const TileGaussian<T>& q, T dx, T dy, T G, bool unclamped, T dL_dalpha, T* g2d) {
+  if (!unclamped) return;
+  g2d[0] += G * dL_dalpha;  // opacity
+  const T dG = q.o * dL_dalpha * G;  // dL/dpower
+  g2d[1] += dG * (q.a * dx + q.b * dy);  // mean2d x (d power / d mean = -d power / d dx)
+  g2d[2] += dG * (q.b * dx + q.c * dy);
+  g2d[3] += dG * T(-0.5) * dx * dx;  // conic a
+  g2d[4] += dG * (-dx * dy);         // conic b
+  g2d[5] += dG * T(-0.5) * dy * dy;  // conic c
+}
+
+// Walks every pixel's contributors back to front, tiles in parallel, for the per-pixel
+// objective sum_c w_c C_c with w = weights(pixel), and calls
+// visit(tile entry, its Gaussian's tile data, dx, dy, G, unclamped, dL/dalpha, alpha T, w).
+template <typename T, typename Weights, typename Visit>
+void walkAllPixels(const RasterStateT<T>& st, int W, int H, Weights&& weights, Visit&& visit) {
+  const RasterSettings& rs = st.settings;
+  const T bg[3] = {T(rs.background[0]), T(rs.background[1]), T(rs.background[2])};
+  arena(st).execute([&] {
+    tbb::parallel_for(0, st.tiles_x * st.tiles_y, [&](int tile) {
+      std::vector<TileGaussian<T>> q;
+      gatherTile(st, tile, q);
+      const std::uint32_t base = st.tile_start[tile];
+      int x0, y0, x1, y1;
+      tilePixels(st, tile, W, H, x0, y0, x1, y1);
+      for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+          const std::size_t pix = static_cast<std::size_t>(y) * W + x;
+          const T* w = weights(pix);
+          walkBack(q, st.n_walked[pix], st.final_T[pix], T(x) + T(0.5), T(y) + T(0.5), w, bg,
+                   [&](std::uint32_t jj, T dx, T dy, T G, T, bool unclamped, T dL_dalpha, T wcol) {
+                     visit(base + jj, q[jj], dx, dy, G, unclamped, dL_dalpha, wcol, w);
+                   });
+        }
+    });
+  });
+}
+
+}  // namespace
+
+// Fills the backward pass's per-pair slots (9 per pair: opacity, mean2d 2, conic 3,
+// colour 3). The generic version walks pixel by pixel (the double tests run it); the
+// float version below is the SIMD kernel with the same arithmetic per contribution.
+template <typename T>
+void backwardSlots(const RasterStateT<T>& st, int W, int H, const T* dL_drgb, T* slots) {
+  constexpr int kSlot = 9;
+  walkAllPixels(
+      st, W, H, [&](std::size_t pix) { return &dL_drgb[pix * 3]; },
+      [&](std::uint32_t e, const TileGaussian<T>& q, T dx, T dy, T G, bool unclamped, T dL_dalpha, T wcol,
+          const T* w) {
+        T* sl = &slots[static_cast<std::size_t>(st.entry_slot[e]) * kSlot];
+        alphaToProjected(q, dx, dy, G, unclamped, dL_dalpha, sl);
+        for (int c = 0; c < 3; ++c) sl[6 + c] += wcol * w[c];
+      });
+}
+
+// The float version runs the SIMD kernels of the instruction set the forward pass used.
+template <>
+void backwardSlots<float>(const RasterStateT<float>& st, int W, int H, const float* dL_drgb, float* slots) {
+  const RasterSettings& rs = st.settings;
+  const float bg[3] = {rs.background[0], rs.background[1], rs.background[2]};
+  const raster_kernels::BackwardIn in{W, st.final_T.data(), st.n_walked.data(), dL_drgb};
+  const raster_kernels::BackwardFn kernel = kKernelSets[st.isa].backward;
+  arena(st).execute([&] {
+    tbb::parallel_for(0, st.tiles_x * st.tiles_y, [&](int tile) {
+      thread_local std::vector<TileGaussian<float>> q;
+      gatherTile(st, tile, q);
+      if (q.empty()) return;
+      int x0, y0, x1, y1;
+      tilePixels(st, tile, W, H, x0, y0, x1, y1);
+      kernel(q.data(), static_cast<int>(q.size()), x0, y0, x1, y1, bg, in, &st.entry_slot[st.tile_start[tile]],
+             slots);
+    });
+  });
+}
+
+template <typename T>
+void rasterizeBackwardT(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& s,
+                        const RenderOutputT<T>& fwd, const T* dL_drgb, GaussiansT<T>& grad,
+                        std::vector<T>* grad_mean2d) {
+  const RasterStateT<T>& st = *fwd.state;
+  const RasterSettings& rs = st.settings;
+  const int W = fwd.width, H = fwd.height;
+  const std::size_t n = g.size();
+  const std::uint32_t pairs = st.gauss_start[n];
+  // Per pair slot: opacity, mean2d (2), conic (3), colour (3).
+  constexpr int kSlot = 9;
+  std::vector<T> slots(static_cast<std::size_t>(pairs) * kSlot, T(0));
+  backwardSlots(st, W, H, dL_drgb, slots.data());
+
+  arena(st).execute([&] {
+    // Reduce each Gaussian's slots in slot order, then chain to its parameters.
+    const CameraT<T> camT(cam, T(rs.guard_band));
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& r) {
+      for (std::size_t i = r.begin(); i < r.end(); ++i) {
+        if (st.gauss_start[i] == st.gauss_start[i + 1]) continue;
+        ProjectedGrad<T> dP;
+        for (std::uint32_t k = st.gauss_start[i]; k < st.gauss_start[i + 1]; ++k) {
+          const T* sl = &slots[static_cast<std::size_t>(k) * kSlot];
+          dP.opacity += sl[0];
+          dP.mean2d[0] += sl[1];
+          dP.mean2d[1] += sl[2];
+          for (int c = 0; c < 3; ++c) dP.conic[c] += sl[3 + c];
+          for (int c = 0; c < 3; ++c) dP.color[c] += sl[6 + c];
+        }
+        if (grad_mean2d) {
+          (*grad_mean2d)[2 * i] += dP.mean2d[0];
+          (*grad_mean2d)[2 * i + 1] += dP.mean2d[1];
+        }
+        projection::projectBackward(g, i, camT, rs, st.proj[i], dP,
+                                    projection::ParamGradRef<T>::of(grad, i));
+      }
+    });
+  });
+}
+
+template <typename T>
+void rasterizeSquaredGradientsT(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& s,
+                                const RenderOutputT<T>& fwd, GaussiansT<T>& sq) {
+  const RasterStateT<T>& st = *fwd.state;
+  const RasterSettings& rs = st.settings;
+  const int W = fwd.width, H = fwd.height;
+  const std::size_t n = g.size();
+  const std::uint32_t pairs = st.gauss_start[n];
+  const CameraT<T> camT(cam, T(rs.guard_band));
+
+  // Per Gaussian, the linear maps from its projected quantities (opacity, mean2d, conic,
+  // colour: 9 inputs) to its means and log-scales, read off projectBackward with unit
+  // inputs; the per-pixel gradient is then a small product, squared before summing.
+  constexpr int kIn = 9;
+  std::vector<T> jac(n * kIn * 6, T(0));  // [i][input][mean 3 | log_scale 3]
+  std::vector<T> dlogit(n, T(0));         // d logit per d opacity
+  arena(st).execute([&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& r) {
+      for (std::size_t i = r.begin(); i < r.end(); ++i) {
+        if (st.gauss_start[i] == st.gauss_start[i + 1]) continue;
+        const Projected<T>& P = st.proj[i];
+        dlogit[i] = P.opacity * (T(1) - P.opacity);
+        for (int in = 1; in < kIn; ++in) {  // input 0 (opacity) touches only the logit
+          ProjectedGrad<T> dP;
+          if (in <= 2) dP.mean2d[in - 1] = 1;
+          else if (in <= 5) dP.conic[in - 3] = 1;
+          else dP.color[in - 6] = 1;
+          T* J = &jac[(i * kIn + in) * 6];
+          projection::ParamGradRef<T> ref;
+          ref.mean = J;
+          ref.log_scale = J + 3;
+          projection::projectBackward(g, i, camT, rs, P, dP, ref);
+        }
+      }
+    });
+  });
+
+  // Per pair slot: squared sums for mean (3), log_scale (3), opacity logit (1), and
+  // sum (alpha T)^2, which times Y_k^2 is the SH coefficients' information.
+  constexpr int kSlot = 8;
+  std::vector<T> slots(static_cast<std::size_t>(pairs) * kSlot, T(0));
+  const T ones[3] = {1, 1, 1};
+  walkAllPixels(
+      st, W, H, [&](std::size_t) { return ones; },
+      [&](std::uint32_t e, const TileGaussian<T>& q, T dx, T dy, T G, bool unclamped, T dL_dalpha, T wcol,
+          const T*) {
+        const std::uint32_t i = st.entry_gauss[e];
+        T in[kIn] = {0, 0, 0, 0, 0, 0, wcol, wcol, wcol};
+        alphaToProjected(q, dx, dy, G, unclamped, dL_dalpha, in);
+        T* sl = &slots[static_cast<std::size_t>(st.entry_slot[e]) * kSlot];
+        const T* J = &jac[static_cast<std::size_t>(i) * kIn * 6];
+        for (int p = 0; p < 6; ++p) {
+          T v = 0;
+          for (int k = 1; k < kIn; ++k) v += in[k] * J[k * 6 + p];
+          sl[p] += v * v;
+        }
+        const T gl = in[0] * dlogit[i];
+        sl[6] += gl * gl;
+        sl[7] += wcol * wcol;
+      });
+  arena(st).execute([&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& r) {
+      const int K = g.shCoeffs(), active = shCoeffCount(rs.sh_degree);
+      for (std::size_t i = r.begin(); i < r.end(); ++i) {
+        if (st.gauss_start[i] == st.gauss_start[i + 1]) continue;
+        T acc[kSlot] = {0, 0, 0, 0, 0, 0, 0, 0};
+        for (std::uint32_t k = st.gauss_start[i]; k < st.gauss_start[i + 1]; ++k)
+          for (int p = 0; p < kSlot; ++p) acc[p] += slots[static_cast<std::size_t>(k) * kSlot + p];
+        for (int p = 0; p < 3; ++p) sq.means[3 * i + p] += acc[p];
+        for (int p = 0; p < 3; ++p) sq.log_scales[3 * i + p] += acc[3 + p];
+        sq.opacities[i] += acc[6];
+        // SH: d C / d sh_kc = alpha T Y_k for unclamped channels.
+        const Projected<T>& P = st.proj[i];
+        T d[3], basis[16];
+        projection::viewBasis(g, i, camT, rs.sh_degree, d, basis);
+        for (int k = 0; k < active; ++k)
+          for (int c = 0; c < 3; ++c)
+            if (!P.clamped[c]) sq.sh[(i * K + k) * 3 + c] += acc[7] * basis[k] * basis[k];
+      }
+    });
+  });
+}
+
+RenderResult rasterize(const Gaussians& g, const Camera& cam, const RasterSettings& s,
+                       std::span<const std::uint8_t> mask) {
+  RenderOutputT<float> o = rasterizeT(g, cam, s, mask);
+  RenderResult r;
+  r.rgb.width = r.alpha.width = r.depth.width = o.width;
+  r.rgb.height = r.alpha.height = r.depth.height = o.height;
+  r.rgb.channels = 3;
+  r.alpha.channels = r.depth.channels = 1;
+  r.rgb.data = std::move(o.rgb);
+  r.alpha.data = std::move(o.alpha);
+  r.depth.data = std::move(o.depth);
+  r.contributors = std::move(o.contributors);
+  r.radii = std::move(o.radii);
+  r.visible = std::move(o.visible);
+  r.state = std::move(o.state);
+  return r;
+}
+
+namespace {
+// The templated functions read only width, height and state from the forward output.
+RenderOutputT<float> view(const RenderResult& fwd) {
+  RenderOutputT<float> o;
+  o.width = fwd.rgb.width;
+  o.height = fwd.rgb.height;
+  o.state = fwd.state;
+  return o;
+}
+}  // namespace
+
+void rasterizeBackward(const Gaussians& g, const Camera& cam, const RasterSettings& s,
+                       const RenderResult& fwd, const ImageF& dL_drgb, Gaussians& grad,
+                       std::vector<float>* grad_mean2d) {
+  if (dL_drgb.width != fwd.rgb.width || dL_drgb.height != fwd.rgb.height || dL_drgb.channels != 3)
+    throw std::invalid_argument("rasterizeBackward: dL/drgb must match the render (3 channels)");
+  if (grad_mean2d && grad_mean2d->size() != 2 * g.size()) grad_mean2d->resize(2 * g.size(), 0.0f);
+  rasterizeBackwardT(g, cam, s, view(fwd), dL_drgb.data.data(), grad, grad_mean2d);
+}
+
+void rasterizeSquaredGradients(const Gaussians& g, const Camera& cam, const RasterSettings& s,
+                               const RenderResult& fwd, Gaussians& sq) {
+  rasterizeSquaredGradientsT(g, cam, s, view(fwd), sq);
+}
+
+template RenderOutputT<float> rasterizeT(const GaussiansT<float>&, const Camera&, const RasterSettings&,
+                                         std::span<const std::uint8_t>);
+template RenderOutputT<double> rasterizeT(const GaussiansT<double>&, const Camera&, const RasterSettings&,
+                                          std::span<const std::uint8_t>);
+template void rasterizeBackwardT(const GaussiansT<float>&, const Camera&, const RasterSettings&,
+                                 const RenderOutputT<float>&, const float*, GaussiansT<float>&,
+                                 std::vector<float>*);
+template void rasterizeBackwardT(const GaussiansT<double>&, const Camera&, const RasterSettings&,
+                                 const RenderOutputT<double>&, const double*, GaussiansT<double>&,
+                                 std::vector<double>*);
+template void rasterizeSquaredGradientsT(const GaussiansT<float>&, const Camera&, const RasterSettings&,
+                                         const RenderOutputT<float>&, GaussiansT<float>&);
+template void rasterizeSquaredGradientsT(const GaussiansT<double>&, const Camera&, const RasterSettings&,
+                                         const RenderOutputT<double>&, GaussiansT<double>&);
+
+}  // namespace saresgs

@@ -1,0 +1,31 @@
+#pragma once
+// How the rasterizer runs: the threads of its TBB arena and its float SIMD kernels. A
+// field of RasterSettings (splat/rasterize.h), so each render says how it runs and no
+// process-wide state does. Results do not depend on the thread count (every reduction
+// runs in a fixed order); the two kernel sets differ only in rounding. A render's
+// backward and squared-gradient passes run with its forward pass's execution.
+#include <optional>
+#include <string_view>
+
+namespace saresgs {
+
+// kDefault: avx2 when the CPU has AVX2 and FMA, unless SARESGS_RASTER_ISA=baseline is set
+// in the environment; kBaseline: four lanes, any target; kAvx2: eight lanes.
+enum class RasterKernels { kDefault, kBaseline, kAvx2 };
+
+struct RasterExecution {
+  int threads = 0;  // the rasterizer's arena; 0: all cores
+  RasterKernels kernels = RasterKernels::kDefault;
+};
+
+// "default", "baseline" or "avx2"; nullopt for any other name.
+std::optional<RasterKernels> parseRasterKernels(std::string_view name);
+// Whether this build and CPU can run the avx2 kernels.
+bool rasterCpuHasAvx2();
+// The threads a render with `e` runs on (the arena's concurrency: `threads`, or all cores).
+int rasterThreadCount(const RasterExecution& e);
+// The kernels a render with `e` uses, "baseline" or "avx2" (kDefault resolved). Throws
+// std::invalid_argument for kAvx2 on a CPU without it, as rendering with `e` does.
+const char* rasterKernelName(const RasterExecution& e);
+
+}  // namespace saresgs

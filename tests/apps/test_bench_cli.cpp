@@ -1,0 +1,71 @@
+// Runs `saresgs bench occupancy` on a tiny scene: what it prints is one JSON line a
+// script can read, with the measured timings, the grid it measured them on and the
+// machine. The timings' values are not checked (speed is not a test property).
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "common/run_command.h"
+
+namespace {
+
+using Result = saresgs::test::CommandResult;
+
+Result run(const std::string& args) { return saresgs::test::runCommand(std::string(SARESGS_CLI) + " " + args); }
+
+}  // namespace
+
+TEST(BenchCli, OccupancyPrintsOneJsonLineWithTheMeasuredParts) {
+  const Result r = run("bench occupancy --width 32 --height 24 --points 400 --resolution 16 --threads 1");
+  ASSERT_EQ(r.code, 0) << r.output;
+  // One line, nothing else (stdout and stderr together).
+  ASSERT_FALSE(r.output.empty());
+  EXPECT_EQ(r.output.find('\n'), r.output.size() - 1) << r.output;
+  nlohmann::json j;
+  ASSERT_NO_THROW(j = nlohmann::json::parse(r.output)) << r.output;
+  ASSERT_TRUE(j.is_object()) << r.output;
+
+  EXPECT_EQ(j.at("benchmark"), "occupancy");
+  EXPECT_EQ(j.at("width"), 32);
+  EXPECT_EQ(j.at("height"), 24);
+  EXPECT_EQ(j.at("resolution"), 16);
+  EXPECT_EQ(j.at("threads"), 1);
+  const auto sfm = j.at("sfm_points").get<std::size_t>();
+  EXPECT_GT(sfm, 0u);
+  EXPECT_LE(sfm, 400u);
+  EXPECT_GT(j.at("cameras").get<int>(), 0);
+  // The grid it timed is not empty: timings of an empty grid would mean nothing.
+  EXPECT_GT(j.at("coarse_voxels").get<std::size_t>(), 0u);
+  EXPECT_GE(j.at("scene_voxels").get<std::size_t>(), j.at("coarse_voxels").get<std::size_t>());
+  EXPECT_GT(j.at("observed_points").get<std::size_t>(), 0u);
+  EXPECT_LE(j.at("observed_scene_voxels").get<std::size_t>(), j.at("scene_voxels").get<std::size_t>());
+  const double f = j.at("observed_fraction").get<double>();
+  EXPECT_GE(f, 0.0);
+  EXPECT_LE(f, 1.0);
+  for (const char* k : {"scene_grid", "add_observed", "embree_bvh"}) {
+    ASSERT_TRUE(j.at("stage_ms").contains(k)) << k;
+    EXPECT_GE(j["stage_ms"][k].get<double>(), 0.0) << k;
+  }
+  for (const char* k : {"frustum_set", "visible_set_stride4", "visible_set_stride1", "score_exact",
+                        "score_hashed_2pow19", "score_hashed_2pow11", "score_dense_2pow19_1thread"}) {
+    ASSERT_TRUE(j.at("per_candidate_ms").contains(k)) << k;
+    EXPECT_GE(j["per_candidate_ms"][k].get<double>(), 0.0) << k;
+  }
+  for (const char* k : {"scene_vdb", "observed_vdb", "scene_index"}) {
+    ASSERT_TRUE(j.at("memory_kb").contains(k)) << k;
+    EXPECT_GT(j["memory_kb"][k].get<double>(), 0.0) << k;
+  }
+  EXPECT_GT(j.at("peak_rss_mb").get<double>(), 0.0);
+  EXPECT_FALSE(j.at("cpu").get<std::string>().empty());
+}
+
+TEST(BenchCli, OccupancyRejectsABadOptionValueByName) {
+  Result r = run("bench occupancy --resolution 0");
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.output.find("--resolution"), std::string::npos) << r.output;
+
+  r = run("bench occupancy --points many");
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.output.find("--points"), std::string::npos) << r.output;
+}

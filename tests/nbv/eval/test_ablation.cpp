@@ -1,0 +1,215 @@
+// The ablation grid: config errors, job expansion and shards, the ranking-error measures
+// against independent formulas, tables, and the prefilter sweep on a tiny synthetic scene.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <set>
+
+#include "common/test_support.h"
+#include "common/tiny_dataset.h"
+#include "geometry/occupancy/coverage_score.h"
+#include "geometry/occupancy/occupancy_grid.h"
+#include "geometry/synth/from_manifest.h"
+#include "nbv/eval/ablation.h"
+#include "nbv/active_run.h"
+#include "nbv/eval/prefilter_sweep.h"
+
+using namespace saresgs;
+using saresgs::test::TempDir;
+using saresgs::test::throwsInputError;
+using saresgs::test::writeBytes;
+
+namespace {
+
+const char* kGrid = R"({
+  "preset": "quick",
+  "scenes": [{"name": "a", "dataset": "data/a"}, {"name": "b", "dataset": "data/b", "layout": "object"}],
+  "methods": ["random", "sa-resgs"],
+  "seeds": [0, 1],
+  "method_args": {"sa-resgs": ["--time-exhaustive-fisher"]},
+  "variants": [{"name": "default"}, {"name": "beta0.2", "methods": ["sa-resgs"], "args": ["--residual-beta", "0.2"]}],
+  "sweep": {"scenes": ["b"], "views": [4]}
+})";
+
+}  // namespace
+
+TEST(Ablation, GridExpandsIntoEveryCombinationOnce) {
+  TempDir d;
+  writeBytes(d.file("g.json"), kGrid);
+  const AblationGrid g = readAblationGrid(d.file("g.json"));
+  const std::vector<AblationJob> jobs = expandGrid(g);
+  // 1 sweep + 2 scenes x (random: 1 variant + sa-resgs: 2 variants) x 2 seeds.
+  ASSERT_EQ(jobs.size(), 1u + 2 * 3 * 2);
+  EXPECT_EQ(jobs[0].kind, AblationJob::Kind::kSweep);
+  std::set<std::string> ids;
+  for (const auto& j : jobs) ids.insert(j.id);
+  EXPECT_EQ(ids.size(), jobs.size());
+  for (const auto& j : jobs) {
+    if (j.kind != AblationJob::Kind::kActive) continue;
+    const auto has = [&](const std::string& s) { return std::find(j.args.begin(), j.args.end(), s) != j.args.end(); };
+    EXPECT_EQ(has("--time-exhaustive-fisher"), j.method == "sa-resgs") << j.id;
+    EXPECT_EQ(has("--residual-beta"), j.variant == "beta0.2") << j.id;
+    EXPECT_NE(j.method == "random", j.variant == "beta0.2" || j.method == "sa-resgs") << j.id;
+  }
+  // Shards partition the jobs.
+  std::multiset<std::string> shard_ids;
+  for (int i = 0; i < 3; ++i)
+    for (const auto& j : shardJobs(jobs, i, 3)) shard_ids.insert(j.id);
+  EXPECT_EQ(std::set<std::string>(shard_ids.begin(), shard_ids.end()), ids);
+  EXPECT_EQ(shard_ids.size(), ids.size());
+  EXPECT_EQ(parseShard("1/2"), std::make_pair(1, 2));
+  EXPECT_THROW(parseShard("2/2"), std::invalid_argument);
+  EXPECT_THROW(parseShard("1"), std::invalid_argument);
+  EXPECT_THROW(parseShard("1/2x"), std::invalid_argument);
+}
+
+TEST(Ablation, GridTakesEveryMethodOfTheList) {
+  TempDir d;
+  nlohmann::json j = {{"scenes", {{{"name", "a"}, {"dataset", "x"}}}}, {"methods", methodNames()}};
+  writeBytes(d.file("g.json"), j.dump());
+  const AblationGrid g = readAblationGrid(d.file("g.json"));
+  EXPECT_EQ(g.methods, methodNames());
+  EXPECT_EQ(expandGrid(g).size(), allMethods().size());
+}
+
+TEST(Ablation, MalformedGridsNameTheFileAndField) {
+  TempDir d;
+  const std::string f = d.file("g.json");
+  auto bad = [&](const std::string& text, const std::string& field) {
+    writeBytes(f, text);
+    return throwsInputError([&] { readAblationGrid(f); }, f, field);
+  };
+  EXPECT_TRUE(bad("{", "json"));
+  EXPECT_TRUE(bad(R"({"scenes": []})", "scenes"));
+  EXPECT_TRUE(bad(R"({"scenes": [{"name": "a", "dataset": "x"}], "methods": ["nope"]})", "methods"));
+  // Sweep options are checked when the grid is read, not when its job runs.
+  EXPECT_TRUE(bad(R"({"scenes": [{"name": "a", "dataset": "x"}], "sweep": {"sets": ["frustrum"]}})", "sweep.sets"));
+  EXPECT_TRUE(bad(R"({"scenes": [{"name": "a", "dataset": "x"}], "sweep": {"encodings": ["hash:31"]}})", "sweep.encodings"));
+  EXPECT_TRUE(bad(R"({"scenes": [{"name": "a", "dataset": "x"}], "sweep": {"scores": ["and"]}})", "sweep.scores"));
+  EXPECT_TRUE(bad(R"({"scenes": [{"name": "a", "dataset": "x"}], "sweep": {"lifting": "sift"}})", "sweep.lifting"));
+  EXPECT_TRUE(bad(R"({"scenes": [{"name": "a", "dataset": "x"}], "methods": ["random"], "colour": 1})", "colour"));
+  EXPECT_TRUE(bad(R"({"scenes": [{"name": "a/b", "dataset": "x"}], "methods": ["random"]})", "scenes[0].name"));
+  EXPECT_TRUE(bad(R"({"scenes": [{"name": "a", "dataset": "x"}, {"name": "a", "dataset": "y"}], "methods": ["random"]})",
+                  "scenes[1].name"));
+  EXPECT_TRUE(bad(R"({"scenes": [{"name": "a", "dataset": "x"}], "methods": ["random"], "seeds": "0"})", "seeds"));
+  EXPECT_TRUE(bad(R"({"scenes": [{"name": "a", "dataset": "x"}], "sweep": {"scenes": ["z"]}})", "sweep.scenes"));
+  EXPECT_TRUE(bad(R"({"scenes": [{"name": "a", "dataset": "x"}]})", "methods"));
+}
+
+// tau-b from its textbook definition: sum of sign products over pairs, normalised by the
+// untied pair counts of each ranking.
+static double tauOracle(const std::vector<double>& a, const std::vector<double>& b) {
+  double s = 0, n1 = 0, n2 = 0;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    for (std::size_t j = i + 1; j < a.size(); ++j) {
+      const double sa = (a[i] > a[j]) - (a[i] < a[j]), sb = (b[i] > b[j]) - (b[i] < b[j]);
+      s += sa * sb;
+      n1 += sa != 0;
+      n2 += sb != 0;
+    }
+  return s / std::sqrt(n1 * n2);
+}
+
+TEST(Ablation, KendallTauMatchesItsDefinitionWithTies) {
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> small(0, 4);  // many ties
+  for (int trial = 0; trial < 50; ++trial) {
+    std::vector<double> a(30), b(30);
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      a[i] = small(rng);
+      b[i] = a[i] + small(rng) - 2;
+    }
+    EXPECT_NEAR(kendallTauB(a, b), tauOracle(a, b), 1e-12);
+  }
+  const std::vector<double> up{1, 2, 3, 4}, down{4, 3, 2, 1}, flat{1, 1, 1, 1};
+  EXPECT_DOUBLE_EQ(kendallTauB(up, up), 1.0);
+  EXPECT_DOUBLE_EQ(kendallTauB(up, down), -1.0);
+  EXPECT_DOUBLE_EQ(kendallTauB(flat, up), 0.0);  // a constant ranking carries no order
+  EXPECT_THROW(kendallTauB(up, {1.0}), std::invalid_argument);
+  // Top 50 % of 4 = 2 items: {3, 2} vs {3, 1}: one in common.
+  EXPECT_DOUBLE_EQ(topOverlap({0, 5, 4, 9}, {0, 5, 4, 9}, 0.5), 1.0);
+  EXPECT_DOUBLE_EQ(topOverlap({0, 1, 8, 9}, {0, 8, 1, 9}, 0.5), 0.5);
+}
+
+TEST(Ablation, TablesAggregateSeedsAndSplitMeanStdInCsv) {
+  TempDir d;
+  writeBytes(d.file("g.json"), kGrid);
+  const AblationGrid g = readAblationGrid(d.file("g.json"));
+  std::vector<JobResult> results;
+  for (const AblationJob& j : expandGrid(g)) {
+    if (j.kind != AblationJob::Kind::kActive || j.scene != "a" || j.method != "random") continue;
+    RunReport r;
+    r.psnr = j.seed == 0 ? 20.0 : 22.0;
+    r.ssim = 0.5;
+    r.iterations = 100;
+    r.seconds.training = 2.0;
+    r.end_to_end_seconds = 3.0;
+    r.steps = {{4, 15.0, {}, {}, {}, {}, {}}, {5, 17.0, {}, {}, {}, {}, {}}};
+    results.push_back({j, r, {}});
+  }
+  ASSERT_EQ(results.size(), 2u);
+  const std::vector<Table> tables = ablationTables(g, results);
+  const auto find = [&](const std::string& n) {
+    for (const auto& t : tables)
+      if (t.name == n) return t;
+    ADD_FAILURE() << "no table " << n;
+    return Table{};
+  };
+  const Table main = find("results");
+  ASSERT_EQ(main.rows.size(), 1u);
+  EXPECT_EQ(main.rows[0][3], "21.00 \u00b1 1.41");  // mean 21, sample std sqrt(2)
+  EXPECT_EQ(main.rows[0][5], "n/a");                 // no AUSE
+  const std::string csv = main.csv();
+  EXPECT_NE(csv.find("PSNR_mean,PSNR_std"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("21.00,1.41"), std::string::npos) << csv;
+  const Table time = find("time");
+  ASSERT_EQ(time.rows.size(), 1u);
+  EXPECT_EQ(time.rows[0][9], "20.0");  // 2 s / 100 iterations
+  const Table views = find("psnr_vs_views");
+  ASSERT_EQ(views.rows.size(), 1u);
+  EXPECT_EQ(views.rows[0][2], "15.00");
+  EXPECT_EQ(views.rows[0][3], "17.00");
+  EXPECT_FALSE(ablationPlots(g, results).empty());
+}
+
+TEST(Ablation, PrefilterSweepReferenceIsExactAndACollisionFreeHashMatchesIt) {
+  const Scene& scene = test::tinyDataset();
+  const auto truth = rebuildSyntheticScene(scene.source, scene);
+  ASSERT_TRUE(truth);
+  SweepSpec spec;
+  spec.view_counts = {4, 6};
+  spec.encodings.clear();
+  for (const char* e : {"hash:2", "hash:20", "exact"}) {
+    CoverageScoring c;
+    parseCoverageEncoding(e, c, kSweepMinHashBits, kSweepMaxHashBits);
+    spec.encodings.push_back(c);
+  }
+  spec.lifting = LiftingSource::kDepth;
+  spec.timing_repeats = 1;
+  const auto rows = prefilterSweep(
+      scene, spec, [&](const Camera& c) { return truth->render(c); }, [&](const Camera& c) { return truth->renderDepth(c); });
+  ASSERT_EQ(rows.size(), 2u * 2 * 2 * 3);  // views x scores x sets x encodings
+  // Are the scene voxels collision-free in a 2^20 table? Then hashed scores order the
+  // candidates exactly as the exact ones do.
+  auto pf = makeCoveragePrefilter(scene, PrefilterConfig{});
+  std::set<std::uint32_t> bits;
+  for (const Voxel& v : pf->grids().sceneVoxels().voxels()) bits.insert(spatialHash(v, 1u << 20));
+  const bool collision_free = bits.size() == pf->grids().sceneCount();
+  for (const SweepRow& r : rows) {
+    EXPECT_TRUE(std::isfinite(r.kendall_tau) && std::isfinite(r.overlap)) << r.set << r.encoding;
+    EXPECT_GT(r.candidates, 0);
+    if (r.set == "visible" && r.encoding == "exact") {
+      EXPECT_DOUBLE_EQ(r.kendall_tau, 1.0);
+      EXPECT_DOUBLE_EQ(r.overlap, 1.0);
+    }
+    if (r.set == "visible" && r.encoding == "hash:20" && collision_free) {
+      EXPECT_DOUBLE_EQ(r.kendall_tau, 1.0) << r.score;
+    }
+    if (r.encoding == "hash:2") {
+      EXPECT_LT(r.kendall_tau, 0.999) << r.set << " " << r.score;  // 4 bits: nearly all collide
+    }
+  }
+  EXPECT_TRUE(collision_free) << "pick a larger table for the test";
+}

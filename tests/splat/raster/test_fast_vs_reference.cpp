@@ -1,0 +1,103 @@
+// The fast tiled path against the slow per-pixel reference (written independently from
+// the contract in splat/rasterize.h): images, per-pixel and per-Gaussian outputs, and
+// the fast path's analytic gradients against finite differences of the reference.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "raster_test_scenes.h"
+#include "splat/raster/rasterize_detail.h"
+#include "splat/raster/reference_renderer.h"
+
+using namespace saresgs;
+
+namespace {
+
+struct Case {
+  int gaussians, sh_degree, width, height;
+  ExtentRule rule;
+  std::uint64_t seed;
+};
+
+class FastVsReference : public ::testing::TestWithParam<Case> {};
+
+}  // namespace
+
+TEST_P(FastVsReference, ImagesAndPerGaussianOutputsAgree) {
+  const Case c = GetParam();
+  const Camera cam = test::smallCamera(c.width, c.height);
+  const GaussiansD gd = test::randomScene<double>(c.gaussians, c.sh_degree, c.seed, 1.2);
+  RasterSettings s;
+  s.sh_degree = c.sh_degree;
+  s.extent = c.rule;
+  s.background = {0.25f, 0.5f, 0.75f};
+  std::vector<std::uint8_t> mask(gd.size(), 1);
+  for (std::size_t i = 1; i < gd.size(); i += 5) mask[i] = 0;
+  for (bool masked : {false, true}) {
+    SCOPED_TRACE(masked ? "masked" : "full");
+    const std::span<const std::uint8_t> m = masked ? std::span<const std::uint8_t>(mask) : std::span<const std::uint8_t>();
+    const ReferenceImage ref = referenceRender(gd, cam, s, m);
+    const auto fast = rasterizeT(gd, cam, s, m);
+    for (const auto& [name, kernels] : test::runnableKernels()) {
+      SCOPED_TRACE(name);
+      RasterSettings sk = s;
+      sk.execution.kernels = kernels;
+      const auto fastf = rasterizeT(gd.cast<float>(), cam, sk, m);
+      // Float fast path: to float tolerance (a pixel may differ by one borderline
+      // contribution, see the reference's notes on the 1e-4 stop rule).
+      int off = 0;
+      for (std::size_t k = 0; k < ref.rgb.size(); ++k) off += std::abs(fastf.rgb[k] - ref.rgb[k]) > 1e-4;
+      EXPECT_LE(off, static_cast<int>(ref.rgb.size() / 1000)) << off << " channels off by > 1e-4";
+    }
+    // Double fast path: the same arithmetic up to summation order.
+    for (std::size_t k = 0; k < ref.rgb.size(); ++k) ASSERT_NEAR(fast.rgb[k], ref.rgb[k], 1e-9);
+    for (std::size_t k = 0; k < ref.alpha.size(); ++k) {
+      ASSERT_NEAR(fast.alpha[k], ref.alpha[k], 1e-9);
+      ASSERT_NEAR(fast.depth[k], ref.depth[k], 1e-7 * (1 + ref.depth[k]));
+      ASSERT_EQ(fast.contributors[k], ref.contributors[k]) << "pixel " << k;
+    }
+    for (std::size_t i = 0; i < gd.size(); ++i) {
+      ASSERT_EQ(fast.visible[i], ref.visible[i]) << "Gaussian " << i;
+      ASSERT_NEAR(fast.radii[i], ref.radii[i], 1e-9 * (1 + ref.radii[i]));
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Scenes, FastVsReference,
+    ::testing::Values(Case{40, 0, 40, 30, ExtentRule::kOpacityAware, 1}, Case{80, 3, 48, 40, ExtentRule::kOpacityAware, 2},
+                      Case{80, 1, 33, 17, ExtentRule::kThreeSigma, 3}, Case{150, 2, 64, 48, ExtentRule::kOpacityAware, 4},
+                      Case{5, 0, 1, 1, ExtentRule::kOpacityAware, 5}));
+
+TEST(FastVsReference, AnalyticGradientsMatchFiniteDifferencesOfTheReference) {
+  const Camera cam = test::smallCamera(20, 16);
+  for (int sh_degree : {0, 3}) {
+    SCOPED_TRACE(sh_degree);
+    GaussiansD g = test::randomScene<double>(6, sh_degree, 40 + sh_degree);
+    RasterSettings s;
+    s.sh_degree = sh_degree;
+    s.background = {0.6f, 0.1f, 0.3f};
+    std::mt19937_64 rng(7);
+    std::normal_distribution<double> nd(0, 1);
+    std::vector<double> w(20 * 16 * 3);
+    for (auto& v : w) v = nd(rng);
+    const auto fwd = rasterizeT(g, cam, s);
+    GaussiansD grad = g.zerosLike();
+    rasterizeBackwardT(g, cam, s, fwd, w.data(), grad);
+    auto loss = [&] {
+      const ReferenceImage r = referenceRender(g, cam, s);
+      double l = 0;
+      for (std::size_t k = 0; k < w.size(); ++k) l += w[k] * r.rgb[k];
+      return l;
+    };
+    test::GradCheck gc;
+    test::checkGradientArray(g.means, grad.means, loss, "means", gc);
+    test::checkGradientArray(g.log_scales, grad.log_scales, loss, "log_scales", gc);
+    test::checkGradientArray(g.rotations, grad.rotations, loss, "rotations", gc);
+    test::checkGradientArray(g.opacities, grad.opacities, loss, "opacities", gc);
+    test::checkGradientArray(g.sh, grad.sh, loss, "sh", gc);
+    EXPECT_EQ(gc.bad, 0);
+    EXPECT_GT(gc.checked, 80);
+    EXPECT_LE(gc.kinks, gc.checked / 20);
+  }
+}

@@ -1,0 +1,148 @@
+// Stiff and extreme cases: no NaN or Inf may escape into images or gradients.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "raster_test_scenes.h"
+#include "splat/raster/rasterize_detail.h"
+
+using namespace saresgs;
+
+namespace {
+
+template <typename V>
+bool allFinite(const V& v) {
+  for (auto x : v)
+    if (!std::isfinite(static_cast<double>(x))) return false;
+  return true;
+}
+
+// Renders (float, the product path), back-propagates a dense loss and the squared
+// gradients, and checks every output is finite. Returns the forward output.
+RenderOutputT<float> renderChecked(const Gaussians& g, const Camera& cam, int sh_degree = 0) {
+  RasterSettings s;
+  s.sh_degree = sh_degree;
+  s.background = {0.1f, 0.2f, 0.3f};
+  const auto r = rasterizeT(g, cam, s);
+  EXPECT_TRUE(allFinite(r.rgb));
+  EXPECT_TRUE(allFinite(r.alpha));
+  EXPECT_TRUE(allFinite(r.depth));
+  EXPECT_TRUE(allFinite(r.radii));
+  std::vector<float> w(r.rgb.size(), 1.0f);
+  Gaussians grad = g.zerosLike();
+  std::vector<float> g2d(2 * g.size(), 0.0f);
+  rasterizeBackwardT(g, cam, s, r, w.data(), grad, &g2d);
+  grad.forEachArray([](const std::vector<float>& a, std::size_t) { EXPECT_TRUE(allFinite(a)); });
+  EXPECT_TRUE(allFinite(g2d));
+  Gaussians sq = g.zerosLike();
+  rasterizeSquaredGradientsT(g, cam, s, r, sq);
+  sq.forEachArray([](const std::vector<float>& a, std::size_t) { EXPECT_TRUE(allFinite(a)); });
+  return r;
+}
+
+Gaussians oneGaussian(const Eigen::Vector3d& mean, double scale, float logit = 2.0f) {
+  Gaussians g;
+  g.resize(1);
+  for (int k = 0; k < 3; ++k) {
+    g.means[k] = static_cast<float>(mean[k]);
+    g.log_scales[k] = static_cast<float>(std::log(scale));
+  }
+  g.rotations = {1, 0, 0, 0};
+  g.opacities = {logit};
+  g.sh = {0.5f, -0.2f, 0.1f};
+  return g;
+}
+
+}  // namespace
+
+TEST(RasterStability, ScalesFromTinyToHuge) {
+  const Camera cam = test::smallCamera(32, 24);
+  const double extent = 3.0;  // the test camera's distance to the scene
+  for (double rel : {1e-6, 1e-4, 1e-2, 1.0, 1e2, 1e4}) {
+    SCOPED_TRACE(rel);
+    const auto r = renderChecked(oneGaussian(Eigen::Vector3d(0.1, 0.0, 0.05), rel * extent), cam);
+    if (rel >= 1.0) {
+      EXPECT_GT(r.alpha[12 * 32 + 16], 0.0f);  // a big Gaussian covers the centre
+    }
+  }
+  // Anisotropic: one axis tiny, one huge.
+  Gaussians g = oneGaussian(Eigen::Vector3d::Zero(), 1.0);
+  g.log_scales = {std::log(1e-6f * 3), std::log(1e4f * 3), 0.0f};
+  renderChecked(g, cam);
+}
+
+TEST(RasterStability, OpacityLogitsOfPlusMinusThirty) {
+  const Camera cam = test::smallCamera(32, 24);
+  Gaussians g = test::randomScene<double>(20, 1, 30).cast<float>();
+  for (std::size_t i = 0; i < g.size(); ++i) g.opacities[i] = (i % 2) ? 30.0f : -30.0f;
+  const auto r = renderChecked(g, cam, 1);
+  for (std::size_t i = 0; i < g.size(); i += 2) EXPECT_EQ(r.visible[i], 0);  // o ~ 1e-13 is culled
+}
+
+TEST(RasterStability, ZeroQuaternionIsTheIdentity) {
+  const Camera cam = test::smallCamera(32, 24);
+  Gaussians a = oneGaussian(Eigen::Vector3d(0.1, 0, 0), 0.3);
+  a.log_scales = {std::log(0.5f), std::log(0.1f), std::log(0.2f)};
+  Gaussians z = a;
+  z.rotations = {0, 0, 0, 0};
+  const auto ra = renderChecked(a, cam), rz = renderChecked(z, cam);
+  EXPECT_TRUE(ra.rgb == rz.rgb);
+}
+
+TEST(RasterStability, NearPlaneBehindTheCameraAndOnTheBorders) {
+  const Camera cam = test::smallCamera(32, 24);
+  const Eigen::Vector3d C = cam.center(), f = cam.viewDirection();
+  RasterSettings s;
+  Gaussians g;
+  g.resize(6);
+  const Eigen::Vector3d means[6] = {
+      C + double(s.near_plane) * f,          // exactly at the near plane
+      C + 0.5 * double(s.near_plane) * f,    // in front of the camera, before the near plane
+      C - 1.0 * f,                           // behind the camera
+      cam.unproject(Eigen::Vector2d(0, 12), 2.0),    // on the left border
+      cam.unproject(Eigen::Vector2d(32, 24), 2.0),   // on the bottom-right corner
+      C,                                      // at the camera centre
+  };
+  for (int i = 0; i < 6; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      g.means[3 * i + k] = static_cast<float>(means[i][k]);
+      g.log_scales[3 * i + k] = std::log(0.05f);
+    }
+    g.rotations[4 * i] = 1;
+    g.opacities[i] = 3.0f;
+    g.sh[3 * i] = 0.7f;
+  }
+  const auto r = renderChecked(g, cam);
+  EXPECT_EQ(r.visible[1], 0);
+  EXPECT_EQ(r.visible[2], 0);
+  EXPECT_EQ(r.visible[5], 0);
+  EXPECT_EQ(r.visible[3], 1);
+  EXPECT_EQ(r.visible[4], 1);
+}
+
+TEST(RasterStability, OneByOneAndVeryWideImages) {
+  for (auto [w, h] : {std::pair{1, 1}, std::pair{4096, 8}, std::pair{7, 4096}}) {
+    SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h));
+    Intrinsics K;
+    K.width = w;
+    K.height = h;
+    K.fx = K.fy = 1.2 * std::max(w, h);
+    K.cx = 0.5 * w;
+    K.cy = 0.5 * h;
+    const Camera cam = Camera::lookAt(K, Eigen::Vector3d(0, -3, 0), Eigen::Vector3d::Zero());
+    const Gaussians g = test::randomScene<double>(50, 2, 31).cast<float>();
+    const auto r = renderChecked(g, cam, 2);
+    EXPECT_EQ(r.rgb.size(), static_cast<std::size_t>(w) * h * 3);
+  }
+}
+
+TEST(RasterStability, EmptyModelAndDegenerateCamera) {
+  const Camera cam = test::smallCamera(16, 16);
+  Gaussians none;
+  const auto r = renderChecked(none, cam);
+  EXPECT_FLOAT_EQ(r.rgb[0], 0.1f);  // background
+  // A camera with a huge focal length (near-zero field of view) still gives finite output.
+  Camera narrow = cam;
+  narrow.K.fx = narrow.K.fy = 1e9;
+  renderChecked(test::randomScene<double>(10, 0, 32).cast<float>(), narrow);
+}
