@@ -80,9 +80,9 @@ int runActive(const ActiveArgs& a) {
             << scene.test.size() << " test views), preset " << a.preset << ", seed " << opt.seed << "\n";
   Progress progress;
   const ActiveResult r = run.run([&](const ActiveProgress& p) {
-    char detail[160];
-    std::snprintf(detail, sizeof detail, "views %d/%d  loss %.4f  PSNR %.2f  Gaussians %zu", p.views, p.max_views,
-                  p.loss, p.psnr, p.gaussians);
+    char detail[200];
+    std::snprintf(detail, sizeof detail, "%s %d/%d  views %d/%d  loss %.4f  PSNR %.2f  Gaussians %zu", toString(p.phase),
+                  p.phase_done, p.phase_total, p.views, p.max_views, p.loss, p.psnr, p.gaussians);
     progress.update("active", p.iteration, p.total_iterations, detail);
   });
   const Trainer& t = run.trainer();

@@ -18,7 +18,7 @@ void Progress::update(const std::string& stage, int done, int total, const std::
   const double eta = (rate > 0 && total > done) ? (total - done) / rate : 0.0;
   const bool tty = ::isatty(STDERR_FILENO);
   const int decile = total > 0 ? 10 * done / total : 10;
-  if (!tty && decile == last_decile_ && done != total) return;
+  if (!tty && decile == last_decile_ && done != total && now - last_draw_ < kLogInterval) return;
   // A terminal is redrawn at most ~10 times a second: fast loops stay fast.
   if (tty && done != total && now - last_draw_ < std::chrono::milliseconds(100)) return;
   last_draw_ = now;

@@ -41,6 +41,26 @@ ActiveRun::ActiveRun(const Scene& scene, const ActiveOptions& opt, std::string c
   if (needs.coverage) prefilter_ = makeCoveragePrefilter(scene_, opt_.prefilter);
 }
 
+const char* toString(ActivePhase p) {
+  switch (p) {
+    case ActivePhase::kTraining: return "training";
+    case ActivePhase::kLifting: return "lifting";
+    case ActivePhase::kPrefilter: return "prefilter";
+    case ActivePhase::kFisher: return "Fisher";
+    case ActivePhase::kExhaustiveFisher: return "exhaustive Fisher";
+    case ActivePhase::kFinalEvaluation: return "final evaluation";
+  }
+  return "?";
+}
+
+void ActiveRun::report(ActivePhase phase, int done, int total) {
+  last_.phase = phase;
+  last_.phase_done = done;
+  last_.phase_total = total;
+  last_.gaussians = trainer_->gaussians().size();
+  if (progress_) progress_(last_);
+}
+
 int ActiveRun::selectNext(SelectionLog& log) {
   std::vector<int> candidates;
   for (int v : scene_.train)
@@ -49,11 +69,16 @@ int ActiveRun::selectNext(SelectionLog& log) {
   const MethodNeeds needs = needsOf(opt_.method);
   std::vector<int> pool = candidates;
   if (needs.coverage) {
-    std::vector<int> fresh(selected_.begin() + observed_upto_, selected_.end());
-    prefilter_->observe(
-        fresh, [this](const Camera& c) { return trainer_->render(c).rgb; },
-        [this](const Camera& c) { return trainer_->render(c).depth; }, log.seconds);
+    const std::vector<int> fresh(selected_.begin() + observed_upto_, selected_.end());
+    for (std::size_t i = 0; i < fresh.size(); ++i) {
+      // One view at a time, so that progress is reported per lifted view.
+      report(ActivePhase::kLifting, static_cast<int>(i), static_cast<int>(fresh.size()));
+      prefilter_->observe(
+          {fresh[i]}, [this](const Camera& c) { return trainer_->render(c).rgb; },
+          [this](const Camera& c) { return trainer_->render(c).depth; }, log.seconds);
+    }
     observed_upto_ = static_cast<int>(selected_.size());
+    report(ActivePhase::kPrefilter, 0, static_cast<int>(candidates.size()));
     const std::vector<double> cov = prefilter_->score(candidates, log.seconds);
     if (!needs.fisher) {
       log.candidates = candidates;
@@ -84,11 +109,13 @@ int ActiveRun::selectNext(SelectionLog& log) {
   const RasterSettings s = trainer_->rasterSettings();
   auto t0 = Clock::now();
   log.candidates = pool;
-  log.scores = fisherScores(trainer_->gaussians(), s, scene_, selected_, pool, opt_.fisher_lambda);
+  log.scores = fisherScores(trainer_->gaussians(), s, scene_, selected_, pool, opt_.fisher_lambda,
+                            [this](int done, int total) { report(ActivePhase::kFisher, done, total); });
   log.seconds.fisher += since(t0);
   if (needs.coverage && opt_.time_exhaustive_fisher) {
     t0 = Clock::now();
-    (void)fisherScores(trainer_->gaussians(), s, scene_, selected_, candidates, opt_.fisher_lambda);
+    (void)fisherScores(trainer_->gaussians(), s, scene_, selected_, candidates, opt_.fisher_lambda,
+                       [this](int done, int total) { report(ActivePhase::kExhaustiveFisher, done, total); });
     log.seconds.exhaustive_fisher += since(t0);
   }
   return pool[argmaxScore(log.scores, pool)];
@@ -96,6 +123,9 @@ int ActiveRun::selectNext(SelectionLog& log) {
 
 ActiveResult ActiveRun::run(const std::function<void(const ActiveProgress&)>& progress) {
   const auto start = Clock::now();
+  progress_ = progress;
+  last_ = {};
+  last_.max_views = opt_.max_views;
   if (!loadCheckpoint()) {
     std::vector<Eigen::Vector3d> centers;
     for (int v : scene_.train) centers.push_back(scene_.views[static_cast<std::size_t>(v)].camera.center());
@@ -112,10 +142,13 @@ ActiveResult ActiveRun::run(const std::function<void(const ActiveProgress&)>& pr
     const int phase = last ? std::max(opt_.total_iterations - iterations_done_, k * opt_.interval) : k * opt_.interval;
     if (opt_.reset_after_add) trainer_->reset();
     const auto t0 = Clock::now();
+    last_.views = k;
+    last_.total_iterations = std::max(opt_.total_iterations, iterations_done_ + phase);
+    last_.psnr = last_psnr;
     trainer_->train(selected_, phase, [&](const TrainProgress& p) {
-      if (progress)
-        progress({k, opt_.max_views, iterations_done_ + p.done, std::max(opt_.total_iterations, iterations_done_ + phase),
-                  p.loss_ema, last_psnr, p.gaussians});
+      last_.iteration = iterations_done_ + p.done;
+      last_.loss = p.loss_ema;
+      report(ActivePhase::kTraining, p.done, phase);
     });
     const double train_s = since(t0);
     iterations_done_ += phase;
@@ -143,9 +176,12 @@ ActiveResult ActiveRun::run(const std::function<void(const ActiveProgress&)>& pr
   r.steps = steps_;
   for (const auto& s : steps_) r.total_seconds += s.seconds;
   r.iterations = iterations_done_;
+  report(ActivePhase::kFinalEvaluation, 0, 1);
   r.test = trainer_->evaluate(scene_.test.empty() ? scene_.train : scene_.test);
   r.ause = depthAuse(*trainer_, selected_, scene_.test.empty() ? scene_.train : scene_.test, opt_.fisher_lambda);
   r.seconds = since(start);
+  report(ActivePhase::kFinalEvaluation, 1, 1);
+  progress_ = {};
   return r;
 }
 

@@ -48,7 +48,13 @@ struct SelectionLog {
   double progress_psnr = 0;         // on the progress test views, before selection
 };
 
+// What an active run is doing; selection stages report per view or candidate handled.
+enum class ActivePhase { kTraining, kLifting, kPrefilter, kFisher, kExhaustiveFisher, kFinalEvaluation };
+const char* toString(ActivePhase p);  // "training", "lifting", ...
+
 struct ActiveProgress {
+  ActivePhase phase = ActivePhase::kTraining;
+  int phase_done = 0, phase_total = 0;      // within the phase: iterations, views or candidates
   int views = 0, max_views = 0;
   int iteration = 0, total_iterations = 0;  // over the whole run
   double loss = 0, psnr = 0;                // latest loss; PSNR after the last phase
@@ -74,6 +80,8 @@ class ActiveRun {
 
  private:
   int selectNext(SelectionLog& log);
+  // Passes the latest state, in `phase` at done/total, to the caller's progress callback.
+  void report(ActivePhase phase, int done, int total);
   void saveCheckpoint() const;
   bool loadCheckpoint();
 
@@ -87,6 +95,8 @@ class ActiveRun {
   std::vector<SelectionLog> steps_;
   int iterations_done_ = 0;
   int observed_upto_ = 0;  // selected_[0..observed_upto_) are in the prefilter's grids
+  std::function<void(const ActiveProgress&)> progress_;  // during run()
+  ActiveProgress last_;                                   // what was last reported
 };
 
 }  // namespace saresgs

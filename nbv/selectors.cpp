@@ -40,17 +40,20 @@ std::vector<double> farthestViewScores(const Scene& scene, const std::vector<int
 
 std::vector<double> fisherScores(const Gaussians& g, const RasterSettings& s, const Scene& scene,
                                  const std::vector<int>& chosen, const std::vector<int>& candidates,
-                                 double lambda) {
+                                 double lambda, const std::function<void(int, int)>& tick) {
   Gaussians H = g.zerosLike();
   for (int v : chosen) addViewInformation(g, scene.views.at(v).camera, s, H);
   Gaussians Hv = g.zerosLike();
   std::vector<double> out;
   out.reserve(candidates.size());
+  const int total = static_cast<int>(candidates.size());
   for (int c : candidates) {
+    if (tick) tick(static_cast<int>(out.size()), total);
     clearInformation(Hv);
     addViewInformation(g, scene.views.at(c).camera, s, Hv);
     out.push_back(fisherScore(Hv, H, lambda));
   }
+  if (tick) tick(total, total);
   return out;
 }
 

@@ -3,6 +3,7 @@
 // and FisherRF's information gain. Each takes the views chosen so far and the remaining
 // candidates (indices into scene.views) and returns candidate scores or a choice; ties
 // go to the lowest view index, so choices are deterministic.
+#include <functional>
 #include <random>
 #include <string>
 #include <vector>
@@ -26,10 +27,10 @@ std::vector<double> farthestViewScores(const Scene& scene, const std::vector<int
 
 // FisherRF: H_train from `chosen`, then each candidate's sum H_v / (H_train + lambda).
 // Candidates are streamed through one information buffer: memory does not grow with
-// their number.
+// their number. `tick(done, total)` is called before each candidate (and at the end).
 std::vector<double> fisherScores(const Gaussians& g, const RasterSettings& s, const Scene& scene,
                                  const std::vector<int>& chosen, const std::vector<int>& candidates,
-                                 double lambda = 1e-6);
+                                 double lambda = 1e-6, const std::function<void(int, int)>& tick = {});
 
 // Index (into candidates) of the highest score; ties to the lowest view index.
 std::size_t argmaxScore(const std::vector<double>& scores, const std::vector<int>& candidates);

@@ -5,6 +5,7 @@
 
 #include <cstring>
 #include <filesystem>
+#include <map>
 
 #include "common/test_support.h"
 #include "common/tiny_dataset.h"
@@ -48,7 +49,7 @@ TEST(ActiveRun, ProtocolCountsAndIterationBudget) {
     const ActiveResult r = run.run([&](const ActiveProgress& p) {
       EXPECT_GE(p.iteration, last_iteration);
       last_iteration = p.iteration;
-      ++calls;
+      calls += p.phase == ActivePhase::kTraining;
     });
     ASSERT_EQ(r.initial_views.size(), 2u);
     EXPECT_EQ(r.initial_views[0], s.train[0]);
@@ -58,7 +59,7 @@ TEST(ActiveRun, ProtocolCountsAndIterationBudget) {
     for (int v : r.selected_views) EXPECT_NE(std::find(s.train.begin(), s.train.end(), v), s.train.end());
     // 2*6 + 3*6 + 4*6 = 54 iterations over three selections, then the rest of 90.
     EXPECT_EQ(last_iteration, 90);
-    EXPECT_EQ(calls, 90);
+    EXPECT_EQ(calls, 90);  // one per training iteration
     EXPECT_EQ(r.steps.size(), 4u);  // three selections and the final phase
     EXPECT_TRUE(std::isfinite(r.test.psnr));
     ASSERT_TRUE(r.ause.has_value());  // the synthetic dataset has depth
@@ -177,6 +178,47 @@ TEST(CoveragePrefilter, PrefersTheViewOfTheUnobservedSide) {
   }
   PrefilterConfig bad;
   EXPECT_THROW(parseCoverageEncoding("hash:40", bad.scoring), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace saresgs
+
+namespace saresgs {
+namespace {
+
+// The progress callback names every stage as it runs, with per-item counts, so that a
+// front end can show a live line during selection as well as training.
+TEST(ActiveRun, ProgressNamesEveryPhaseWithItsCounts) {
+  const Scene& s = tinyDataset();
+  ActiveOptions o = tinyOptions(Method::kSaResgs);
+  o.time_exhaustive_fisher = true;
+  ActiveRun run(s, o);
+  std::map<ActivePhase, int> calls;
+  std::map<ActivePhase, int> max_total;
+  int last_iteration = 0;
+  ActivePhase last_phase = ActivePhase::kTraining;
+  run.run([&](const ActiveProgress& p) {
+    ++calls[p.phase];
+    max_total[p.phase] = std::max(max_total[p.phase], p.phase_total);
+    EXPECT_GE(p.phase_done, 0);
+    EXPECT_LE(p.phase_done, p.phase_total) << toString(p.phase);
+    EXPECT_GE(p.iteration, last_iteration);
+    last_iteration = p.iteration;
+    last_phase = p.phase;
+  });
+  // 3 selections: training callbacks every iteration, lifting per new view (2 initial,
+  // then 1 each), Fisher per prefiltered candidate plus a closing call.
+  EXPECT_EQ(calls[ActivePhase::kTraining], 90);
+  EXPECT_EQ(calls[ActivePhase::kLifting], 2 + 1 + 1);
+  EXPECT_EQ(calls[ActivePhase::kPrefilter], 3);
+  EXPECT_GE(calls[ActivePhase::kFisher], 3 * 2);
+  EXPECT_GT(calls[ActivePhase::kExhaustiveFisher], calls[ActivePhase::kFisher]);
+  EXPECT_EQ(calls[ActivePhase::kFinalEvaluation], 2);
+  EXPECT_EQ(last_phase, ActivePhase::kFinalEvaluation);
+  EXPECT_EQ(last_iteration, 90);
+  for (ActivePhase p : {ActivePhase::kTraining, ActivePhase::kLifting, ActivePhase::kPrefilter, ActivePhase::kFisher,
+                        ActivePhase::kExhaustiveFisher, ActivePhase::kFinalEvaluation})
+    EXPECT_STRNE(toString(p), "?");
 }
 
 }  // namespace
