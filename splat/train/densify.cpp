@@ -38,6 +38,49 @@ void gatherAdam(AdamState& adam, const std::vector<int>& idx, std::size_t fresh_
 
 }  // namespace
 
+void keepLargestGradients(std::vector<int>& clone, std::vector<int>& split, const std::vector<float>& mean_grad,
+                          std::size_t n, const DensifyOptions& opt) {
+  // A clone adds one Gaussian, a split adds split_count - 1 (its parent is removed).
+  const std::size_t split_cost = static_cast<std::size_t>(std::max(1, opt.split_count - 1));
+  const std::size_t room = opt.max_gaussians > n ? opt.max_gaussians - n : 0;
+  if (clone.size() + split.size() * split_cost <= room) return;
+  // Candidates ranked by mean gradient, ties to the lower index: a strict total order, so
+  // the kept set does not depend on how the selection partitions.
+  struct Candidate {
+    int index;
+    bool is_split;
+  };
+  std::vector<Candidate> all;
+  all.reserve(clone.size() + split.size());
+  for (int i : clone) all.push_back({i, false});
+  for (int i : split) all.push_back({i, true});
+  auto before = [&](const Candidate& a, const Candidate& b) {
+    const float ga = mean_grad[static_cast<std::size_t>(a.index)], gb = mean_grad[static_cast<std::size_t>(b.index)];
+    return ga != gb ? ga > gb : a.index < b.index;
+  };
+  std::size_t keep = 0;
+  if (split_cost == 1) {
+    // Every candidate costs one Gaussian: the `room` best, found by selection.
+    keep = std::min(room, all.size());
+    std::nth_element(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(keep), all.end(), before);
+  } else {
+    // Mixed costs: best first while they fit.
+    std::sort(all.begin(), all.end(), before);
+    for (std::size_t used = 0; keep < all.size(); ++keep) {
+      const std::size_t cost = all[keep].is_split ? split_cost : 1;
+      if (used + cost > room) break;
+      used += cost;
+    }
+  }
+  all.resize(keep);
+  clone.clear();
+  split.clear();
+  for (const Candidate& c : all) (c.is_split ? split : clone).push_back(c.index);
+  // Index order, as without the cap: the new model's layout follows the old one's.
+  std::sort(clone.begin(), clone.end());
+  std::sort(split.begin(), split.end());
+}
+
 void accumulateDensifyStats(DensifyStats& st, const std::vector<float>& grad_mean2d, const std::vector<float>& radii,
                             const std::vector<std::uint8_t>& visible, int width, int height) {
   const float sx = 0.5f * static_cast<float>(width), sy = 0.5f * static_cast<float>(height);
@@ -56,21 +99,14 @@ DensifyReport densifyAndPrune(Gaussians& g, AdamState& adam, DensifyStats& st, c
   const std::size_t n = g.size();
   const float dense_limit = opt.percent_dense * static_cast<float>(extent);
   std::vector<int> clone, split;
+  std::vector<float> mean_grad(n, 0.0f);
   for (std::size_t i = 0; i < n; ++i) {
     if (st.count[i] == 0) continue;
-    const float mean_grad = st.grad_accum[i] / static_cast<float>(st.count[i]);
-    if (!(mean_grad >= opt.grad_threshold)) continue;
+    mean_grad[i] = st.grad_accum[i] / static_cast<float>(st.count[i]);
+    if (!(mean_grad[i] >= opt.grad_threshold)) continue;
     (maxScale(g, i) <= dense_limit ? clone : split).push_back(static_cast<int>(i));
   }
-  // A cap on the model size trims growth (largest gradients first would need a sort; the
-  // index order is deterministic and the cap is a CPU-budget guard, not a method).
-  if (opt.max_gaussians > 0) {
-    std::size_t room = opt.max_gaussians > n ? opt.max_gaussians - n : 0;
-    if (clone.size() > room) clone.resize(room);
-    room -= clone.size();
-    const std::size_t split_room = room / static_cast<std::size_t>(std::max(1, opt.split_count - 1));
-    if (split.size() > split_room) split.resize(split_room);
-  }
+  if (opt.max_gaussians > 0) keepLargestGradients(clone, split, mean_grad, n, opt);
   rep.cloned = clone.size();
   rep.split = split.size();
 

@@ -25,7 +25,9 @@ struct DensifyOptions {
   float max_screen_radius = 20;   // px; prunes only after the first opacity reset
   float max_world_scale = 0.1f;   // fraction of extent; likewise
   int split_count = 2;
-  std::size_t max_gaussians = 0;  // 0: unlimited; otherwise no growth beyond it
+  // 0: unlimited; otherwise no growth beyond it: when the candidates would exceed it, the
+  // ones with the largest mean gradient are kept (keepLargestGradients).
+  std::size_t max_gaussians = 0;
   // An opacity reset needs iterations after it to recover: it is skipped when fewer than
   // this many remain in the trainer's plan (Trainer::planUntil, or the train() call) (3DGS resets at 3000 of 30000; a
   // 3000-iteration run would otherwise end on a transparent model).
@@ -49,6 +51,14 @@ struct DensifyStats {
 void accumulateDensifyStats(DensifyStats& st, const std::vector<float>& grad_mean2d,
                             const std::vector<float>& radii, const std::vector<std::uint8_t>& visible, int width,
                             int height);
+
+// Under the cap (opt.max_gaussians, the model holding n): keeps, of the clone and split
+// candidates, those with the largest mean 2D gradient (ties to the lower index) whose
+// added Gaussians fit; both lists stay in index order. 3DGS's budgeted variants (e.g.
+// Taming 3DGS) likewise spend a fixed budget on the highest-scoring candidates; the
+// gradient is the score 3DGS's own densification already thresholds.
+void keepLargestGradients(std::vector<int>& clone, std::vector<int>& split, const std::vector<float>& mean_grad,
+                          std::size_t n, const DensifyOptions& opt);
 
 struct DensifyReport {
   std::size_t cloned = 0, split = 0, pruned = 0;

@@ -214,6 +214,88 @@ TEST(TrainDensify, CapLimitsGrowthAndOpacityResetZeroesItsMoments) {
   for (float m : c.adam.m.opacities) EXPECT_EQ(m, 0.0f);
 }
 
+// The brute-force reading of the cap: candidates by mean gradient (ties to the lower
+// index), best first, kept while their added Gaussians fit.
+std::pair<std::vector<int>, std::vector<int>> keptByBruteForce(const std::vector<int>& clone, const std::vector<int>& split,
+                                                               const std::vector<float>& grad, std::size_t room, int split_count) {
+  std::vector<std::pair<int, bool>> all;
+  for (int i : clone) all.push_back({i, false});
+  for (int i : split) all.push_back({i, true});
+  std::sort(all.begin(), all.end(), [&](const auto& a, const auto& b) {
+    return grad[a.first] != grad[b.first] ? grad[a.first] > grad[b.first] : a.first < b.first;
+  });
+  std::vector<int> kc, ks;
+  std::size_t used = 0;
+  for (const auto& [i, is_split] : all) {
+    const std::size_t cost = is_split ? static_cast<std::size_t>(split_count - 1) : 1;
+    if (used + cost > room) break;
+    used += cost;
+    (is_split ? ks : kc).push_back(i);
+  }
+  std::sort(kc.begin(), kc.end());
+  std::sort(ks.begin(), ks.end());
+  return {kc, ks};
+}
+
+TEST(TrainDensify, CapKeepsTheCandidatesWithTheLargestGradients) {
+  std::mt19937_64 rng(12);
+  std::uniform_int_distribution<int> coarse(0, 20);  // many ties
+  for (int split_count : {2, 3}) {
+    for (int trial = 0; trial < 20; ++trial) {
+      const std::size_t n = 300;
+      std::vector<float> grad(n);
+      for (float& x : grad) x = 1e-4f * static_cast<float>(coarse(rng));
+      std::vector<int> clone, split;
+      for (std::size_t i = 0; i < n; ++i)
+        if (grad[i] >= 5e-4f) (i % 3 ? clone : split).push_back(static_cast<int>(i));
+      for (std::size_t room : {std::size_t{0}, std::size_t{1}, std::size_t{37}, std::size_t{150}, std::size_t{1000}}) {
+        DensifyOptions opt;
+        opt.split_count = split_count;
+        opt.max_gaussians = n + room;
+        std::vector<int> c = clone, s = split;
+        keepLargestGradients(c, s, grad, n, opt);
+        const auto [bc, bs] = keptByBruteForce(clone, split, grad, room, split_count);
+        EXPECT_EQ(c, bc) << "room " << room << " split_count " << split_count;
+        EXPECT_EQ(s, bs) << "room " << room << " split_count " << split_count;
+        const std::size_t added = c.size() + s.size() * static_cast<std::size_t>(split_count - 1);
+        EXPECT_LE(added, room);
+        if (room >= clone.size() + split.size() * static_cast<std::size_t>(split_count - 1)) {
+          EXPECT_EQ(c, clone);  // no cap binds: everything kept
+          EXPECT_EQ(s, split);
+        }
+      }
+    }
+  }
+}
+
+TEST(TrainDensify, CapInTheModelKeepsTheHighestGradientGaussiansGrowing) {
+  // Ten small Gaussians, all over the threshold, gradients rising with the index; room for
+  // three clones: the three last are cloned (index order did not decide).
+  Gaussians g;
+  g.resize(10);
+  for (std::size_t i = 0; i < 10; ++i) {
+    g.means[3 * i] = static_cast<float>(i);
+    for (int a = 0; a < 3; ++a) g.log_scales[3 * i + a] = std::log(0.001f);
+    g.opacities[i] = 2.0f;
+    g.rotations[4 * i] = 1.0f;
+  }
+  AdamState adam;
+  adam.resetFor(g);
+  DensifyStats st;
+  st.resize(10);
+  for (std::size_t i = 0; i < 10; ++i) {
+    st.grad_accum[i] = 1e-3f * static_cast<float>(i + 1);
+    st.count[i] = 1;
+  }
+  DensifyOptions opt;
+  opt.max_gaussians = 13;
+  std::mt19937_64 rng(3);
+  const DensifyReport r = densifyAndPrune(g, adam, st, opt, 10.0, false, rng);
+  EXPECT_EQ(r.cloned, 3u);
+  ASSERT_EQ(g.size(), 13u);
+  for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(g.means[3 * (10 + k)], static_cast<float>(7 + k)) << k;
+}
+
 Gaussians rankedModel(int n) {
   Gaussians g;
   g.resize(n);
