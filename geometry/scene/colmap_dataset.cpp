@@ -39,10 +39,11 @@ std::string modelFile(const std::string& dir, const char* stem) {
 bool readManifestSplit(const fs::path& manifest, Scene& scene) {
   if (!fs::exists(manifest)) return false;
   const nlohmann::json j = readJsonFile(manifest.string());
-  if (j.contains("background")) {
+  // null: the data has no background (an enclosed scene).
+  if (j.contains("background") && !j["background"].is_null()) {
     const auto& b = j["background"];
     if (!b.is_array() || b.size() != 3 || !b[0].is_number() || !b[1].is_number() || !b[2].is_number())
-      throw InputError(manifest.string(), "background", "expected an array of 3 numbers");
+      throw InputError(manifest.string(), "background", "expected an array of 3 numbers, or null for none");
     scene.background = std::array<float, 3>{b[0].get<float>(), b[1].get<float>(), b[2].get<float>()};
   }
   if (!j.contains("split")) return false;

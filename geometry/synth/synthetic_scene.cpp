@@ -297,7 +297,10 @@ SyntheticScene makeSyntheticScene(const SyntheticOptions& opts) {
   m["num_test"] = scene.test.size();
   m["up_axis"] = opts.up_axis;
   m["projection"] = opts.projection;
-  m["background"] = toJson(scene.background);
+  // The data's background: an enclosed room has none (every pixel sees a wall), which
+  // tells a trainer that no white-background handling applies; an object layout's misses
+  // are white.
+  m["background"] = opts.layout == "object" ? toJson(scene.background) : nlohmann::json(nullptr);
   m["light"] = {{"direction", toJson(lighting.to_light)},
                 {"ambient", lighting.ambient},
                 {"diffuse", lighting.diffuse},

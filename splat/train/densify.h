@@ -29,9 +29,11 @@ struct DensifyOptions {
   // ones with the largest mean gradient are kept (keepLargestGradients).
   std::size_t max_gaussians = 0;
   // An opacity reset needs iterations after it to recover: it is skipped when fewer than
-  // this many remain in the trainer's plan (Trainer::planUntil, or the train() call) (3DGS resets at 3000 of 30000; a
-  // 3000-iteration run would otherwise end on a transparent model).
-  int min_iterations_after_reset = 500;
+  // this many remain in the trainer's plan (Trainer::planUntil, or the train() call).
+  // The default is one reset interval, the recovery time 3DGS gives its model before the
+  // next reset; so a phase shorter than that (every phase of an active run's quick
+  // preset, and a 3000-iteration fit) is never left with a transparent model.
+  int min_iterations_after_reset = 3000;
 };
 
 // Per-Gaussian statistics gathered between densification steps.

@@ -237,7 +237,10 @@ double Trainer::step(int view) {
   if (d.enabled && iteration_ < d.until_iter) {
     if (iteration_ > d.from_iter && d.interval > 0 && iteration_ % d.interval == 0)
       last_densify_ = densifyAndPrune(g_, adam_, stats_, d, ext, iteration_ > d.opacity_reset_interval, rng_);
-    const bool white = s.background[0] == 1.0f && s.background[1] == 1.0f && s.background[2] == 1.0f;
+    // 3DGS's extra reset at densify_from for white-background data: only where the data
+    // has an empty background (an enclosed scene has none; Scene::background is unset).
+    const bool white = scene_.background && (*scene_.background)[0] == 1.0f && (*scene_.background)[1] == 1.0f &&
+                       (*scene_.background)[2] == 1.0f;
     const bool due = (d.opacity_reset_interval > 0 && iteration_ % d.opacity_reset_interval == 0) ||
                      (white && iteration_ == d.from_iter);
     // Outside train() (a bare step()) there is no plan: the schedule applies as is.

@@ -129,6 +129,14 @@ TEST_P(SyntheticDataset, ReadsBackIdenticallyAndColmapAgrees) {
     expectSameModel(expected, text);
   }
   const Scene s = loadDataset(d.file("ds"));
+  // The background is a property of the data: white where rays miss (object), none in an
+  // enclosed room, where every pixel sees a wall.
+  if (GetParam() == "object") {
+    ASSERT_TRUE(s.background.has_value());
+    EXPECT_EQ(*s.background, (std::array<float, 3>{1, 1, 1}));
+  } else {
+    EXPECT_FALSE(s.background.has_value()) << GetParam();
+  }
   ASSERT_EQ(s.views.size(), scene.cameras.size());
   for (size_t i = 0; i < s.views.size(); ++i) {
     EXPECT_EQ(s.views[i].name, scene.names[i]);

@@ -49,8 +49,8 @@ void expectUnscaledFieldsEqual(const TrainerOptions& a, const TrainerOptions& b)
   EXPECT_EQ(a.seed, b.seed);
 }
 
-// A quarter of 3DGS's schedule is what the active loop's quick preset sets by hand
-// (nbv/active_run.cpp): 125, 25, 750, 3750, 125 and 250.
+// A quarter of 3DGS's schedule is the active loop's quick preset (nbv/preset.cpp): 125,
+// 25, 750, 3750 and 250, and a reset guard of one (scaled) reset interval, 750.
 TEST(ScaledSchedule, QuarterOfTheDefaultsIsTheQuickSchedule) {
   const TrainerOptions defaults;
   const TrainerOptions q = scaledSchedule(defaults, 0.25);
@@ -58,7 +58,7 @@ TEST(ScaledSchedule, QuarterOfTheDefaultsIsTheQuickSchedule) {
   EXPECT_EQ(q.densify.interval, 25);
   EXPECT_EQ(q.densify.opacity_reset_interval, 750);
   EXPECT_EQ(q.densify.until_iter, 3750);
-  EXPECT_EQ(q.densify.min_iterations_after_reset, 125);
+  EXPECT_EQ(q.densify.min_iterations_after_reset, 750);
   EXPECT_EQ(q.sh_interval, 250);
   expectUnscaledFieldsEqual(q, defaults);
 }
@@ -84,7 +84,7 @@ TEST(ScaledSchedule, RoundsAndKeepsIntervalsPositive) {
   const TrainerOptions s = scaledSchedule(base, 0.1);
   EXPECT_EQ(s.densify.from_iter, 0);
   EXPECT_EQ(s.densify.interval, 10);
-  EXPECT_EQ(s.densify.min_iterations_after_reset, 50);
+  EXPECT_EQ(s.densify.min_iterations_after_reset, 300);
   const TrainerOptions tiny = scaledSchedule(TrainerOptions{}, 1e-4);
   EXPECT_EQ(tiny.densify.interval, 1);
   EXPECT_EQ(tiny.densify.opacity_reset_interval, 1);

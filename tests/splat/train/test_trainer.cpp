@@ -237,3 +237,44 @@ TEST(Trainer, NoOpacityResetRightBeforeTheEndOfThePlan) {
 
 }  // namespace
 }  // namespace saresgs
+
+namespace saresgs {
+namespace {
+
+float maxOpacityOf(const Gaussians& g) {
+  float m = -1e30f;
+  for (float x : g.opacities) m = std::max(m, x);
+  return 1 / (1 + std::exp(-m));
+}
+
+// 3DGS's extra reset at densify_from applies to data with a white (empty) background
+// only, and like every reset it needs min_iterations_after_reset iterations left in the
+// plan: a phase shorter than that keeps its opacities.
+TEST(Trainer, WhiteBackgroundResetOnlyWhereTheDataHasABackgroundAndRoomToRecover) {
+  const Scene& object = tinyDataset();
+  ASSERT_TRUE(object.background.has_value());  // the object layout misses to white
+  Scene enclosed = object;
+  enclosed.background.reset();  // as a room's manifest says: no background
+  TrainerOptions o;
+  o.max_sh_degree = 0;
+  o.densify.from_iter = 10;
+  o.densify.interval = 1000;
+  o.densify.opacity_reset_interval = 1000;
+  o.densify.min_iterations_after_reset = 20;
+  o.seed = 4;
+  auto afterTen = [&](const Scene& s, int plan) {
+    Trainer t(s, o);
+    t.planUntil(plan);
+    t.train(s.train, 10);
+    return maxOpacityOf(t.gaussians());
+  };
+  EXPECT_LE(afterTen(object, 40), 0.0101f);   // white data, 30 iterations left: reset
+  EXPECT_GT(afterTen(enclosed, 40), 0.0101f);  // no background: no reset
+  EXPECT_GT(afterTen(object, 25), 0.0101f);    // 15 left < 20: too short to recover
+  EXPECT_LE(afterTen(object, 30), 0.0101f);    // exactly the guard: reset
+  // The default guard is one reset interval, and schedules scale it with the rest.
+  EXPECT_EQ(DensifyOptions{}.min_iterations_after_reset, DensifyOptions{}.opacity_reset_interval);
+}
+
+}  // namespace
+}  // namespace saresgs
