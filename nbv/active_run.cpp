@@ -140,7 +140,10 @@ ActiveResult ActiveRun::run(const std::function<void(const ActiveProgress&)>& pr
     const int k = static_cast<int>(selected_.size());
     const bool last = k >= opt_.max_views || k >= static_cast<int>(scene_.train.size());
     const int phase = last ? std::max(opt_.total_iterations - iterations_done_, k * opt_.interval) : k * opt_.interval;
-    if (opt_.reset_after_add) trainer_->reset();
+    if (opt_.reset_after_add) {
+      trainer_->reset();
+      if (opt_.global_sh_clock) trainer_->setShClockStart(iterations_done_);
+    }
     const auto t0 = Clock::now();
     last_.views = k;
     last_.total_iterations = std::max(opt_.total_iterations, iterations_done_ + phase);

@@ -29,6 +29,9 @@ struct ActiveOptions {
   int interval = 100;             // iterations per view held
   int total_iterations = 20000;
   bool reset_after_add = true;
+  // After each reset the SH degree restarts at 0 and rises on the run's global iteration
+  // clock (FisherRF's reference), not on the phase's own count.
+  bool global_sh_clock = true;
   double fisher_lambda = 1e-6;
   ViewDistance fvs_metric = ViewDistance::kEuclidean;
   PrefilterConfig prefilter;

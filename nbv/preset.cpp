@@ -34,6 +34,10 @@ ActiveOptions presetOptions(Preset p) {
   // and Fisher scoring the whole cost. The cap keeps the model at a size the images
   // can constrain.
   o.trainer.densify.max_gaussians = 40000;
+  // View-dependent colour from a few views at 25 iterations per view is noise: the quick
+  // preset fits SH degree 0 for every method (the paper preset keeps degree 3 on the
+  // global clock, which under per-phase resets rarely passes degree 1 either).
+  o.trainer.max_sh_degree = 0;
   return o;
 }
 

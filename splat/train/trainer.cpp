@@ -158,10 +158,14 @@ void Trainer::reset() {
   loss_ema_ = 0;
   planned_until_ = 0;
   view_stack_.clear();
+  sh_clock_start_ = 0;
 }
 
 int Trainer::activeShDegree() const {
-  const int steps = opt_.sh_interval > 0 ? iteration_ / opt_.sh_interval : opt_.max_sh_degree;
+  // Multiples of sh_interval in (start, start + iteration]: the plain schedule for start 0.
+  const int steps = opt_.sh_interval > 0
+                        ? (sh_clock_start_ + iteration_) / opt_.sh_interval - sh_clock_start_ / opt_.sh_interval
+                        : opt_.max_sh_degree;
   return std::min(opt_.max_sh_degree, steps);
 }
 

@@ -105,6 +105,12 @@ class Trainer {
   // The model, optimiser and schedules as after construction; the random generator
   // continues (so that repeated resets do not replay the same views).
   void reset();
+  // Puts the SH schedule on an outer clock that stood at `start` when this model (re)started
+  // at degree 0: the degree rises each time start + iteration() crosses a multiple of
+  // sh_interval, as in FisherRF's reference, which keeps one global iteration counter
+  // across the model resets of its active loop. reset() returns to the plain schedule
+  // (start 0).
+  void setShClockStart(int start) { sh_clock_start_ = start; }
 
   // Everything a resumed run needs, written atomically; load throws InputError naming
   // the file and field on a mismatch (another scene size, truncated file).
@@ -128,6 +134,7 @@ class Trainer {
 
   Scene scene_;
   TrainerOptions opt_;
+  int sh_clock_start_ = 0;
   Gaussians initial_, g_, grad_;
   std::vector<float> grad2d_;
   AdamState adam_;

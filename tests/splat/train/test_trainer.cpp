@@ -278,3 +278,34 @@ TEST(Trainer, WhiteBackgroundResetOnlyWhereTheDataHasABackgroundAndRoomToRecover
 
 }  // namespace
 }  // namespace saresgs
+
+namespace saresgs {
+namespace {
+
+// The SH degree on an outer clock: after a reset at global iteration 950 with
+// sh_interval 100, the degree rises at global 1000, 1100, 1200 (iterations 50, 150, 250
+// of the phase), not at 100, 200, 300; reset() returns to the plain schedule.
+TEST(Trainer, ShScheduleOnTheGlobalClock) {
+  const Scene& s = tinyDataset();
+  TrainerOptions o;
+  o.max_sh_degree = 3;
+  o.sh_interval = 100;
+  o.densify.enabled = false;
+  Trainer t(s, o);
+  t.setShClockStart(950);
+  EXPECT_EQ(t.activeShDegree(), 0);
+  t.train(s.train, 49);
+  EXPECT_EQ(t.activeShDegree(), 0);
+  t.train(s.train, 1);
+  EXPECT_EQ(t.activeShDegree(), 1);
+  t.train(s.train, 200);
+  EXPECT_EQ(t.activeShDegree(), 3);
+  t.reset();
+  t.train(s.train, 99);
+  EXPECT_EQ(t.activeShDegree(), 0);
+  t.train(s.train, 1);
+  EXPECT_EQ(t.activeShDegree(), 1);
+}
+
+}  // namespace
+}  // namespace saresgs
