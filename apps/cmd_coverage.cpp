@@ -10,6 +10,7 @@
 
 #include "apps/commands.h"
 #include "apps/prefilter_flags.h"
+#include "apps/view_list.h"
 #include "geometry/error.h"
 #include "geometry/io/atomic_file.h"
 #include "geometry/synth/from_manifest.h"
@@ -28,39 +29,12 @@ struct CoverageArgs {
   int downscale = 1;
 };
 
-std::vector<int> parseViews(const std::string& text, const Scene& scene) {
-  std::vector<int> out;
-  std::stringstream ss(text);
-  for (std::string item; std::getline(ss, item, ',');) {
-    // A train index or an image name.
-    int v = -1;
-    try {
-      std::size_t used = 0;
-      const int i = std::stoi(item, &used);
-      if (used == item.size()) {
-        if (i < 0 || i >= static_cast<int>(scene.train.size()))
-          throw InputError("--views", item, "train index out of range 0.." + std::to_string(scene.train.size() - 1));
-        v = scene.train[static_cast<std::size_t>(i)];
-      }
-    } catch (const std::invalid_argument&) {
-    }
-    if (v < 0) {
-      for (int t : scene.train)
-        if (scene.views[static_cast<std::size_t>(t)].name == item) v = t;
-      if (v < 0) throw InputError("--views", item, "neither a train index nor the name of a train image");
-    }
-    out.push_back(v);
-  }
-  if (out.empty()) throw InputError("--views", text, "expected a comma-separated list of train views");
-  return out;
-}
-
 int runCoverage(const CoverageArgs& a) {
   const PrefilterConfig config = parsePrefilterFlags(a.flags, a.config, "--");
   DatasetOptions dopt;
   dopt.load.downscale = a.downscale;
   const Scene scene = loadDataset(a.dataset, dopt);
-  const std::vector<int> views = parseViews(a.views, scene);
+  const std::vector<int> views = parseTrainViews(a.views, scene, "--views");
   ViewRenderer render;
   DepthRenderer depth;
   std::string source;

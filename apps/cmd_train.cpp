@@ -9,10 +9,12 @@
 
 #include "apps/commands.h"
 #include "apps/progress.h"
+#include "apps/view_list.h"
 #include "geometry/io/atomic_file.h"
 #include "geometry/scene/scene.h"
 #include "splat/ply.h"
 #include "splat/raster_execution.h"
+#include "splat/train/schedule.h"
 #include "splat/train/test_renders.h"
 #include "splat/train/trainer.h"
 
@@ -29,7 +31,8 @@ struct TrainArgs {
   int threads = 0;
   int checkpoint_every = 1000;
   bool resume = false;
-  std::string ranking = "both";
+  std::string ranking = "both", views;
+  double schedule_scale = 1.0;
   TrainerOptions opt;
 };
 
@@ -46,6 +49,8 @@ int runTrain(TrainArgs& a) {
   DatasetOptions dopt;
   dopt.load.downscale = a.downscale;
   const Scene scene = loadDataset(a.dataset, dopt);
+  if (a.schedule_scale != 1.0) a.opt = scaledSchedule(a.opt, a.schedule_scale);
+  const std::vector<int> views = a.views.empty() ? scene.train : parseTrainViews(a.views, scene, "--views");
   fs::create_directories(a.out);
   const std::string ckpt = a.out + "/checkpoint.bin";
   Trainer trainer(scene, a.opt);
@@ -53,7 +58,7 @@ int runTrain(TrainArgs& a) {
     trainer.loadCheckpoint(ckpt);
     std::cerr << "resumed " << ckpt << " at iteration " << trainer.iteration() << "\n";
   }
-  std::cerr << "training on " << scene.train.size() << " views (" << scene.test.size() << " test), "
+  std::cerr << "training on " << views.size() << " views (" << scene.test.size() << " test), "
             << trainer.gaussians().size() << " initial Gaussians, " << a.iterations << " iterations\n";
   trainer.planUntil(a.iterations);
   Progress progress;
@@ -63,7 +68,7 @@ int runTrain(TrainArgs& a) {
     const int chunk = std::min(a.iterations - trainer.iteration(),
                                a.checkpoint_every > 0 ? a.checkpoint_every - trainer.iteration() % a.checkpoint_every
                                                       : a.iterations);
-    trainer.train(scene.train, chunk, [&](const TrainProgress& p) {
+    trainer.train(views, chunk, [&](const TrainProgress& p) {
       char detail[128];
       std::snprintf(detail, sizeof detail, "it %d  loss %.4f  Gaussians %s", p.iteration, p.loss_ema,
                     shortCount(p.gaussians).c_str());
@@ -118,6 +123,12 @@ void addTrainCommand(CLI::App& app, Action& action) {
   sub->add_option("--max-gaussians", a->opt.densify.max_gaussians, "Cap on the model size (0: none)")->capture_default_str();
   sub->add_option("--random-init", a->opt.random_init_points, "Random points when the dataset has none")->capture_default_str();
   sub->add_flag("--residual", a->opt.residual.enabled, "Add SA-ResGS residual supervision");
+  sub->add_option("--views", a->views,
+                  "Train on these train views only, in this order (indices or image names, comma-separated; e.g. an "
+                  "active run's selected_views to refit them)");
+  sub->add_option("--schedule-scale", a->schedule_scale,
+                  "Scale the densification, opacity-reset and SH schedules (the quick preset's is 0.25)")
+      ->check(CLI::Range(1e-4, 1e4))->capture_default_str();
   sub->add_option("--residual-alpha", a->opt.residual.alpha, "Random fraction of G_sub")->check(CLI::Range(0.0, 1.0))->capture_default_str();
   sub->add_option("--residual-beta", a->opt.residual.beta, "Uncertain fraction of G_sub")->check(CLI::Range(0.0, 1.0))->capture_default_str();
   sub->add_option("--residual-ranking", a->ranking, "both | opacity | scale | random")

@@ -41,6 +41,13 @@ ActiveRun::ActiveRun(const Scene& scene, const ActiveOptions& opt, std::string c
   if (needs.coverage) prefilter_ = makeCoveragePrefilter(scene_, opt_.prefilter);
 }
 
+TrainerOptions finalFitOptions(const ActiveOptions& o) {
+  TrainerOptions t = o.trainer;
+  t.seed = o.seed;
+  t.residual.enabled = false;
+  return t;
+}
+
 const char* toString(ActivePhase p) {
   switch (p) {
     case ActivePhase::kTraining: return "training";
@@ -49,6 +56,7 @@ const char* toString(ActivePhase p) {
     case ActivePhase::kFisher: return "Fisher";
     case ActivePhase::kExhaustiveFisher: return "exhaustive Fisher";
     case ActivePhase::kFinalEvaluation: return "final evaluation";
+    case ActivePhase::kFinalFit: return "final fit";
   }
   return "?";
 }
@@ -182,8 +190,17 @@ ActiveResult ActiveRun::run(const std::function<void(const ActiveProgress&)>& pr
   report(ActivePhase::kFinalEvaluation, 0, 1);
   r.test = trainer_->evaluate(scene_.test.empty() ? scene_.train : scene_.test);
   r.ause = depthAuse(*trainer_, selected_, scene_.test.empty() ? scene_.train : scene_.test, opt_.fisher_lambda);
-  r.seconds = since(start);
   report(ActivePhase::kFinalEvaluation, 1, 1);
+  if (opt_.final_iterations > 0) {
+    final_fit_ = std::make_unique<Trainer>(scene_, finalFitOptions(opt_));
+    last_.views = static_cast<int>(selected_.size());
+    final_fit_->train(selected_, opt_.final_iterations, [&](const TrainProgress& p) {
+      last_.loss = p.loss_ema;
+      report(ActivePhase::kFinalFit, p.done, opt_.final_iterations);
+    });
+    r.final_fit = FinalFit{opt_.final_iterations, final_fit_->evaluate(scene_.test.empty() ? scene_.train : scene_.test)};
+  }
+  r.seconds = since(start);
   progress_ = {};
   return r;
 }

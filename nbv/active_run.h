@@ -37,6 +37,10 @@ struct ActiveOptions {
   PrefilterConfig prefilter;
   bool time_exhaustive_fisher = false;  // prefiltered methods: also time Fisher on all
   int progress_test_views = 3;
+  // After the last view: a fresh model from the initial state trained on exactly the
+  // chosen views for this many iterations (0: none), so that the views can be judged
+  // apart from the loop's schedule. Plain 3DGS for every method (finalFitOptions).
+  int final_iterations = 0;
   TrainerOptions trainer;
   std::uint64_t seed = 0;
 };
@@ -52,7 +56,7 @@ struct SelectionLog {
 };
 
 // What an active run is doing; selection stages report per view or candidate handled.
-enum class ActivePhase { kTraining, kLifting, kPrefilter, kFisher, kExhaustiveFisher, kFinalEvaluation };
+enum class ActivePhase { kTraining, kLifting, kPrefilter, kFisher, kExhaustiveFisher, kFinalEvaluation, kFinalFit };
 const char* toString(ActivePhase p);  // "training", "lifting", ...
 
 struct ActiveProgress {
@@ -64,15 +68,27 @@ struct ActiveProgress {
   std::size_t gaussians = 0;
 };
 
+// The final fit's outcome (ActiveOptions::final_iterations).
+struct FinalFit {
+  int iterations = 0;
+  Evaluation test;
+};
+
 struct ActiveResult {
   std::vector<int> initial_views, selected_views;
   std::vector<SelectionLog> steps;
   Evaluation test;
   std::optional<double> ause;
+  std::optional<FinalFit> final_fit;
   SelectionSeconds total_seconds;
   int iterations = 0;  // training iterations over the whole run
   double seconds = 0;  // end to end, this process
 };
+
+// The trainer options of the final fit: the run's (preset schedule, cap, SH degree, seed)
+// without residual supervision, the same for every method; `saresgs train` with these
+// options on the chosen views trains the same model.
+TrainerOptions finalFitOptions(const ActiveOptions& o);
 
 class ActiveRun {
  public:
@@ -80,6 +96,8 @@ class ActiveRun {
   ActiveRun(const Scene& scene, const ActiveOptions& opt, std::string checkpoint = {});
   ActiveResult run(const std::function<void(const ActiveProgress&)>& progress = {});
   const Trainer& trainer() const { return *trainer_; }
+  // The final fit's model (null before run() or without a final fit).
+  const Trainer* finalFitTrainer() const { return final_fit_.get(); }
 
  private:
   int selectNext(SelectionLog& log);
@@ -93,6 +111,7 @@ class ActiveRun {
   std::string checkpoint_;
   std::unique_ptr<Trainer> trainer_;
   std::unique_ptr<CoveragePrefilter> prefilter_;
+  std::unique_ptr<Trainer> final_fit_;
   std::mt19937_64 rng_;
   std::vector<int> initial_, selected_;
   std::vector<SelectionLog> steps_;

@@ -23,6 +23,17 @@ T field(const json& j, const char* key, const std::string& source, const std::st
   }
 }
 
+// The optional per-view array `j["views"]` (named `path` in messages).
+void readViews(const json& j, const std::string& src, const std::string& path, std::vector<ViewReport>& out) {
+  if (!j.contains("views")) return;
+  if (!j["views"].is_array()) throw InputError(src, path, "expected an array");
+  for (std::size_t i = 0; i < j["views"].size(); ++i) {
+    const std::string p = path + "[" + std::to_string(i) + "]";
+    const json& v = j["views"][i];
+    out.push_back({field<std::string>(v, "name", src, p), field<double>(v, "psnr", src, p), field<double>(v, "ssim", src, p)});
+  }
+}
+
 std::vector<std::string> names(const Scene& scene, const std::vector<int>& views) {
   std::vector<std::string> n;
   n.reserve(views.size());
@@ -68,6 +79,12 @@ RunReport makeRunReport(const Scene& scene, const ActiveOptions& opt, const Acti
   for (const ViewMetrics& m : r.test.views)
     rep.views.push_back({scene.views.at(static_cast<std::size_t>(m.view)).name, m.psnr, m.ssim});
   for (const SelectionLog& s : r.steps) rep.steps.push_back(stepReport(scene, s));
+  if (r.final_fit) {
+    FinalFitReport f{r.final_fit->iterations, r.final_fit->test.psnr, r.final_fit->test.ssim, {}};
+    for (const ViewMetrics& m : r.final_fit->test.views)
+      f.views.push_back({scene.views.at(static_cast<std::size_t>(m.view)).name, m.psnr, m.ssim});
+    rep.final_fit = f;
+  }
   return rep;
 }
 
@@ -134,6 +151,11 @@ json toJson(const RunReport& r) {
   j["threads"] = r.threads;
   for (const ViewReport& v : r.views) j["views"].push_back({{"name", v.name}, {"psnr", v.psnr}, {"ssim", v.ssim}});
   for (const StepReport& s : r.steps) j["steps"].push_back(toJson(s));
+  if (r.final_fit) {
+    json f = {{"iterations", r.final_fit->iterations}, {"psnr", r.final_fit->psnr}, {"ssim", r.final_fit->ssim}};
+    for (const ViewReport& v : r.final_fit->views) f["views"].push_back({{"name", v.name}, {"psnr", v.psnr}, {"ssim", v.ssim}});
+    j["final_fit"] = f;
+  }
   return j;
 }
 
@@ -176,17 +198,19 @@ RunReport runReportFromJson(const json& j, const std::string& src) {
   r.gaussians = field<std::size_t>(j, "gaussians", src, "");
   r.iterations = field<int>(j, "iterations", src, "");
   r.threads = field<int>(j, "threads", src, "");
-  if (j.contains("views")) {
-    if (!j["views"].is_array()) throw InputError(src, "views", "expected an array");
-    for (std::size_t i = 0; i < j["views"].size(); ++i) {
-      const std::string p = "views[" + std::to_string(i) + "]";
-      const json& v = j["views"][i];
-      r.views.push_back({field<std::string>(v, "name", src, p), field<double>(v, "psnr", src, p), field<double>(v, "ssim", src, p)});
-    }
-  }
+  readViews(j, src, "views", r.views);
   if (!j.contains("steps") || !j["steps"].is_array()) throw InputError(src, "steps", "expected an array");
   for (std::size_t i = 0; i < j["steps"].size(); ++i)
     r.steps.push_back(stepReportFromJson(j["steps"][i], src, "steps[" + std::to_string(i) + "]"));
+  if (j.contains("final_fit")) {
+    const json& f = j["final_fit"];
+    FinalFitReport ff;
+    ff.iterations = field<int>(f, "iterations", src, "final_fit");
+    ff.psnr = field<double>(f, "psnr", src, "final_fit");
+    ff.ssim = field<double>(f, "ssim", src, "final_fit");
+    r.final_fit = ff;
+    readViews(f, src, "final_fit.views", r.final_fit->views);
+  }
   return r;
 }
 

@@ -44,11 +44,18 @@ struct ViewReport {
   double psnr = 0, ssim = 0;
 };
 
+// The final fit: a fresh plain-3DGS model trained on exactly the chosen views.
+struct FinalFitReport {
+  int iterations = 0;
+  double psnr = 0, ssim = 0;
+  std::vector<ViewReport> views;
+};
+
 struct RunReport {
   std::string dataset, method, preset;
   std::uint64_t seed = 0;
   RunOptionsReport options;
-  double psnr = 0, ssim = 0;       // mean over the test views
+  double psnr = 0, ssim = 0;       // mean over the test views (the paper's in-loop model)
   std::optional<double> ause;      // none without ground-truth depth
   std::vector<std::string> initial_views;
   std::vector<std::string> selected_views;  // the views added after the initial ones
@@ -60,6 +67,7 @@ struct RunReport {
   int threads = 0;
   std::vector<ViewReport> views;  // per test view
   std::vector<StepReport> steps;
+  std::optional<FinalFitReport> final_fit;  // none when the run made no final fit
 };
 
 // Where and how the run was made, which the loop itself does not know.

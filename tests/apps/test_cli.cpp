@@ -1,6 +1,8 @@
 // Runs the real `saresgs` binary as a user would: exit codes, messages, outputs.
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
 #include <filesystem>
 
 #include "common/run_command.h"
@@ -79,14 +81,16 @@ TEST(Cli, TrainCoverageAndActiveOnASmallScene) {
           d.file("c2"));
   ASSERT_EQ(r.code, 0) << r.output;
 
-  r = run("active --dataset " + d.file("s") + " --method fvs --max-views 5 --interval 4 --iterations 40 --out " + d.file("a"));
+  r = run("active --dataset " + d.file("s") + " --method fvs --max-views 5 --interval 4 --iterations 40 --final-iterations 0 --out " +
+          d.file("a"));
   ASSERT_EQ(r.code, 0) << r.output;
   const std::string ar = saresgs::test::readBytes(d.file("a/results.json"));
   for (const char* key : {"\"psnr\"", "\"ssim\"", "\"ause\"", "\"selected_views\"", "\"seconds\""})
     EXPECT_NE(ar.find(key), std::string::npos) << key;
   EXPECT_TRUE(fs::exists(d.path() / "a" / "cameras.png"));
   // Running again into the same folder without --resume is refused (nothing overwritten).
-  r = run("active --dataset " + d.file("s") + " --method fvs --max-views 5 --interval 4 --iterations 40 --out " + d.file("a"));
+  r = run("active --dataset " + d.file("s") + " --method fvs --max-views 5 --interval 4 --iterations 40 --final-iterations 0 --out " +
+          d.file("a"));
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.output.find("--resume"), std::string::npos) << r.output;
 
@@ -112,4 +116,36 @@ TEST(Cli, ActiveAcceptsEveryMethodOfTheList) {
   EXPECT_NE(bad.output.find("--method"), std::string::npos) << bad.output;
   const Result help = run("active --help");
   EXPECT_NE(help.output.find(saresgs::methodChoices()), std::string::npos) << help.output;
+}
+
+// The final fit judges the chosen views apart from the loop's schedule: it is plain 3DGS
+// from the initial model on exactly those views, so `saresgs train` on the same views with
+// the run's options (quick preset: a quarter of the schedule, the cap, SH degree 0, the
+// seed) gives the same model, byte for byte, and the same test PSNR.
+TEST(Cli, FinalFitEqualsTrainOnTheChosenViews) {
+  TempDir d;
+  ASSERT_EQ(run("scene --layout object --views 12 --width 64 --height 48 --out " + d.file("s")).code, 0);
+  Result r = run("active --dataset " + d.file("s") + " --method sa-resgs --max-views 5 --interval 4 --iterations 40 " +
+                 "--final-iterations 150 --seed 3 --threads 2 --out " + d.file("a"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("final fit on these views (150 it)"), std::string::npos) << r.output;
+  const nlohmann::json a = nlohmann::json::parse(saresgs::test::readBytes(d.file("a/results.json")));
+  ASSERT_TRUE(a.contains("final_fit")) << a.dump();
+  EXPECT_EQ(a["final_fit"]["iterations"], 150);
+  std::string views;
+  for (const auto& v : a["initial_views"]) views += (views.empty() ? "" : ",") + v.get<std::string>();
+  for (const auto& v : a["selected_views"]) views += "," + v.get<std::string>();
+  r = run("train --dataset " + d.file("s") + " --views " + views +
+          " --iterations 150 --schedule-scale 0.25 --max-gaussians 40000 --sh-degree 0 --seed 3 --threads 2 --out " +
+          d.file("t"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  const nlohmann::json t = nlohmann::json::parse(saresgs::test::readBytes(d.file("t/results.json")));
+  EXPECT_EQ(t["psnr"].get<double>(), a["final_fit"]["psnr"].get<double>());
+  EXPECT_EQ(t["ssim"].get<double>(), a["final_fit"]["ssim"].get<double>());
+  EXPECT_EQ(saresgs::test::readBytes(d.file("t/point_cloud.ply")), saresgs::test::readBytes(d.file("a/final_fit.ply")));
+  // A view listed twice, or not a train view, is refused by name.
+  r = run("train --dataset " + d.file("s") + " --views 0,0 --iterations 5 --out " + d.file("t2"));
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.output.find("--views"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("twice"), std::string::npos) << r.output;
 }
