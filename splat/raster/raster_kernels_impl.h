@@ -376,4 +376,107 @@ void backwardTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, 
     backwardTileImpl<false>(q, x0, y0, x1, y1, bg, in, entry_slot, slots);
 }
 
+// FisherRF's squared-gradient pass (FisherMoment in raster_kernels.h): the backward walk
+// for the fixed objective C_r + C_g + C_b, accumulating moments instead of gradients.
+// Kept apart from the backward kernel: its weights are all 1, so the three colour
+// accumulators collapse into one (sum_c (col_c - acc_c) = sum col - sum acc, and each
+// acc_c is updated linearly), and the background term is the same for every pixel.
+namespace {
+
+template <bool kBg>
+void fisherTileImpl(const TileGaussian<float>* q, int x0, int y0, int x1, int y1, float bg_sum,
+                    const FisherIn& in, const std::uint32_t* entry_slot, float* slots) {
+  constexpr int P = kTile * kTile;
+  constexpr int M = kFisherSlot;
+  const int w = x1 - x0, h = y1 - y0;
+  alignas(64) float Tr[P], finalT[P], walked[P], acc[P];
+  std::uint32_t jmax = 0;
+  for (int k = 0; k < P; ++k) {
+    const int r = blockRow(k), c = blockCol(k);
+    const bool inside = c < w && r < h;
+    const std::size_t pix = inside ? static_cast<std::size_t>(y0 + r) * in.W + (x0 + c) : 0;
+    Tr[k] = finalT[k] = inside ? in.final_T[pix] : 1.0f;
+    const std::uint32_t nw = inside ? in.n_walked[pix] : 0;
+    walked[k] = static_cast<float>(nw);
+    jmax = nw > jmax ? nw : jmax;
+    acc[k] = 0.0f;
+  }
+  const vf lane_x = laneColCentres(), lane_y = laneRowCentres();
+  const vf zero = vs(0.0f), one = vs(1.0f), bgs = vs(bg_sum);
+  for (std::uint32_t jj = jmax; jj-- > 0;) {
+    const TileGaussian<float>& g = q[jj];
+    int c0, c1, r0, r1;
+    tileSpan(g.mx, g.hx, x0, x1, c0, c1);
+    tileSpan(g.my, g.hy, y0, y1, r0, r1);
+    const vf mx = vs(g.mx), my = vs(g.my), hx = vs(g.hx), hy = vs(g.hy), o = vs(g.o);
+    const vf jv = vs(static_cast<float>(jj));
+    const vf ha = vs(-0.5f) * vs(g.a);
+    const vf colsum = vs(g.col[0] + g.col[1] + g.col[2]);
+    vf m[M];
+    for (int k = 0; k < M; ++k) m[k] = zero;
+    if (c0 <= c1)
+      for (int rb = r0 / kBH; rb <= r1 / kBH; ++rb) {
+        int lo, hi;
+        blockRowSpan(g, x0, y0, rb, c0, c1, lo, hi);
+        if (lo > hi) continue;
+        const vf dy = (vs(static_cast<float>(y0 + rb * kBH)) + lane_y) - my;
+        const vi row_in = absLe(dy, hy);
+        const vf qy = rowQuad(g, dy), by = rowCross(g, dy);
+        const vf yy = dy * dy;
+        for (int cb = lo & ~(kBW - 1); cb <= hi; cb += kBW) {
+          const int k = (rb * kBX + cb / kBW) * L;
+          const Lanes Ln = evalLanes((vs(static_cast<float>(x0 + cb)) + lane_x) - mx, ha, qy, by, o, hx, row_in);
+          const vf dx = Ln.dx, alpha = Ln.alpha;
+          const vi valid = (jv < load(walked + k)) & Ln.touches;
+          const vf a_eff = valid ? alpha : zero;
+          const vf t = load(Tr + k) / (one - a_eff);  // transmittance in front of jj
+          store(Tr + k, t);
+          const vf a = load(acc + k), d = colsum - a;
+          vf dLda = d * t;
+          if constexpr (kBg) dLda = dLda - load(finalT + k) / (one - alpha) * bgs;
+          store(acc + k, fma(a_eff, d, a));
+          const vi gm = valid & (Ln.oG < vs(kMaxA));
+          const vf e = gm ? Ln.G * dLda : zero;
+          const vf wc = a_eff * t;  // 0 where not valid
+          const vf xx = dx * dx, xy = dx * dy;
+          const vf e2 = e * e, ew = e * wc;
+          const vf e2xx = e2 * xx, e2yy = e2 * yy;
+          m[kE00] += e2;
+          m[kE20] += e2xx;
+          m[kE11] = fma(e2 * dx, dy, m[kE11]);
+          m[kE02] += e2yy;
+          m[kE30] = fma(e2xx, dx, m[kE30]);
+          m[kE21] = fma(e2xx, dy, m[kE21]);
+          m[kE12] = fma(e2yy, dx, m[kE12]);
+          m[kE03] = fma(e2yy, dy, m[kE03]);
+          m[kE40] = fma(e2xx, xx, m[kE40]);
+          m[kE31] = fma(e2xx, xy, m[kE31]);
+          m[kE22] = fma(e2xx, yy, m[kE22]);
+          m[kE13] = fma(e2yy, xy, m[kE13]);
+          m[kE04] = fma(e2yy, yy, m[kE04]);
+          m[kF10] = fma(ew, dx, m[kF10]);
+          m[kF01] = fma(ew, dy, m[kF01]);
+          m[kF20] = fma(ew, xx, m[kF20]);
+          m[kF11] = fma(ew, xy, m[kF11]);
+          m[kF02] = fma(ew, yy, m[kF02]);
+          m[kW] = fma(wc, wc, m[kW]);
+        }
+      }
+    float* sl = &slots[static_cast<std::size_t>(entry_slot[jj]) * M];
+    for (int k = 0; k < M; ++k) sl[k] = hsum(m[k]);
+  }
+}
+
+}  // namespace
+
+void fisherTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
+                const FisherIn& in, const std::uint32_t* entry_slot, float* slots) {
+  if (nq == 0) return;
+  const float bg_sum = bg[0] + bg[1] + bg[2];
+  if (bg_sum != 0.0f)
+    fisherTileImpl<true>(q, x0, y0, x1, y1, bg_sum, in, entry_slot, slots);
+  else
+    fisherTileImpl<false>(q, x0, y0, x1, y1, bg_sum, in, entry_slot, slots);
+}
+
 }  // namespace saresgs::raster_kernels::SARESGS_KERNEL_NS
