@@ -620,25 +620,6 @@ void fisherMoments(const RasterStateT<float>& st, int W, int H, float* slots) {
   });
 }
 
-// Gaussian i's Jacobian from its projected inputs (rows: mean2d x, y, conic a, b, c and
-// the colour weight, which drives all three channels alike) to its means and log-scales
-// (columns), read off projectBackward, which is linear in its input gradients.
-void fisherJacobian(const Gaussians& g, std::size_t i, const CameraT<float>& camT, const RasterSettings& rs,
-                    const Projected<float>& P, double J[6][6]) {
-  for (int in = 0; in < 6; ++in) {
-    ProjectedGrad<float> dP;
-    if (in < 2) dP.mean2d[in] = 1;
-    else if (in < 5) dP.conic[in - 2] = 1;
-    else dP.color[0] = dP.color[1] = dP.color[2] = 1;
-    float out[6] = {0, 0, 0, 0, 0, 0};
-    projection::ParamGradRef<float> ref;
-    ref.mean = out;
-    ref.log_scale = out + 3;
-    projection::projectBackward(g, i, camT, rs, P, dP, ref);
-    for (int p = 0; p < 6; ++p) J[in][p] = out[p];
-  }
-}
-
 // Per parameter p, the per-pixel gradient is o e u_p(dx, dy) + wc Jc_p with
 //   u_p = (a dx + b dy) J_mx + (b dx + c dy) J_my - dx^2 J_ca / 2 - dx dy J_cb - dy^2 J_cc / 2
 // (alphaToProjected's 2D gradients through the Jacobian), so its square summed over the
@@ -662,8 +643,10 @@ void squaredGradientsFloat(const Gaussians& g, const Camera& cam, const RenderOu
         for (std::uint32_t k = st.gauss_start[i]; k < st.gauss_start[i + 1]; ++k)
           for (int p = 0; p < kFisherSlot; ++p) mo[p] += slots[static_cast<std::size_t>(k) * kFisherSlot + p];
         const Projected<float>& P = st.proj[i];
-        double J[6][6];
-        fisherJacobian(g, i, camT, rs, P, J);
+        // One frame for the Jacobian and the SH basis below.
+        const projection::BackwardFrame<float> frame = projection::backwardFrame(g, i, camT, rs);
+        float J[6][6];
+        projection::projectJacobian(g, i, camT, rs, P, frame, J);
         const double a = P.conic[0], b = P.conic[1], c = P.conic[2], o = P.opacity;
         // The moments of the monomials (dx, dy, dx^2, dx dy, dy^2) pairwise.
         const double E[5][5] = {{mo[kE20], mo[kE11], mo[kE30], mo[kE21], mo[kE12]},
@@ -692,12 +675,10 @@ void squaredGradientsFloat(const Gaussians& g, const Camera& cam, const RenderOu
         const double dlogit = o * (1.0 - o);
         sq.opacities[i] += static_cast<float>(dlogit * dlogit * mo[kE00]);
         // SH: d C / d sh_kc = alpha T Y_k for unclamped channels.
-        float d[3], basis[16];
-        projection::viewBasis(g, i, camT, rs.sh_degree, d, basis);
         for (int k = 0; k < active; ++k)
           for (int ch = 0; ch < 3; ++ch)
             if (!P.clamped[ch])
-              sq.sh[(i * K + k) * 3 + ch] += static_cast<float>(mo[kW] * basis[k] * basis[k]);
+              sq.sh[(i * K + k) * 3 + ch] += static_cast<float>(mo[kW] * frame.basis[k] * frame.basis[k]);
       }
     });
   });
