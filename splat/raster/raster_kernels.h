@@ -76,7 +76,8 @@ struct FisherIn {
 };
 
 // The back-to-front walk of a tile for the objective C_r + C_g + C_b: for each tile
-// entry jj its kFisherSlot moments go to slots[entry_slot[jj] * kFisherSlot].
+// entry jj its kFisherSlot moments go to slots[entry_slot[jj] * kFisherSlot] (every
+// entry's slot is written, zeros where no pixel reaches it).
 using FisherFn = void (*)(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1,
                           const float bg[3], const FisherIn& in, const std::uint32_t* entry_slot, float* slots);
 

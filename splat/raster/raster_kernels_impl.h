@@ -383,8 +383,32 @@ void backwardTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, 
 // acc_c is updated linearly), and the background term is the same for every pixel.
 namespace {
 
+// Pairwise lane sums of two vectors: [a0 + a1, a2 + a3, ..., b0 + b1, b2 + b3, ...].
+// (The preprocessor picks the lane count: shuffle indices must be constants even in a
+// discarded branch outside a template.)
+inline vf pairSums(vf a, vf b) {
+#if SARESGS_KERNEL_LANES == 4
+  return __builtin_shufflevector(a, b, 0, 2, 4, 6) + __builtin_shufflevector(a, b, 1, 3, 5, 7);
+#else
+  return __builtin_shufflevector(a, b, 0, 2, 4, 6, 8, 10, 12, 14) +
+         __builtin_shufflevector(a, b, 1, 3, 5, 7, 9, 11, 13, 15);
+#endif
+}
+
+// The lane sums of L vectors v[0, L) as one vector (lane k: the sum of v[k]), in a
+// fixed tree order: L - 1 shuffle-adds instead of L horizontal sums, which cost more
+// than the pixel loop for the small Gaussians that cover a tile in a few blocks.
+inline vf transposeSums(const vf* v) {
+#if SARESGS_KERNEL_LANES == 4
+  return pairSums(pairSums(v[0], v[1]), pairSums(v[2], v[3]));
+#else
+  return pairSums(pairSums(pairSums(v[0], v[1]), pairSums(v[2], v[3])),
+                  pairSums(pairSums(v[4], v[5]), pairSums(v[6], v[7])));
+#endif
+}
+
 template <bool kBg>
-void fisherTileImpl(const TileGaussian<float>* q, int x0, int y0, int x1, int y1, float bg_sum,
+void fisherTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, float bg_sum,
                     const FisherIn& in, const std::uint32_t* entry_slot, float* slots) {
   constexpr int P = kTile * kTile;
   constexpr int M = kFisherSlot;
@@ -401,6 +425,10 @@ void fisherTileImpl(const TileGaussian<float>* q, int x0, int y0, int x1, int y1
     jmax = nw > jmax ? nw : jmax;
     acc[k] = 0.0f;
   }
+  // Entries no pixel walks have no information; their slots are written here all the
+  // same, so that the caller needs no cleared buffer.
+  for (int jj = static_cast<int>(jmax); jj < nq; ++jj)
+    std::memset(&slots[static_cast<std::size_t>(entry_slot[jj]) * M], 0, sizeof(float) * M);
   const vf lane_x = laneColCentres(), lane_y = laneRowCentres();
   const vf zero = vs(0.0f), one = vs(1.0f), bgs = vs(bg_sum);
   for (std::uint32_t jj = jmax; jj-- > 0;) {
@@ -412,8 +440,9 @@ void fisherTileImpl(const TileGaussian<float>* q, int x0, int y0, int x1, int y1
     const vf jv = vs(static_cast<float>(jj));
     const vf ha = vs(-0.5f) * vs(g.a);
     const vf colsum = vs(g.col[0] + g.col[1] + g.col[2]);
-    vf m[M];
-    for (int k = 0; k < M; ++k) m[k] = zero;
+    constexpr int kPadded = (M + L - 1) / L * L;
+    vf m[kPadded];
+    for (int k = 0; k < kPadded; ++k) m[k] = zero;
     if (c0 <= c1)
       for (int rb = r0 / kBH; rb <= r1 / kBH; ++rb) {
         int lo, hi;
@@ -462,8 +491,9 @@ void fisherTileImpl(const TileGaussian<float>* q, int x0, int y0, int x1, int y1
           m[kW] = fma(wc, wc, m[kW]);
         }
       }
-    float* sl = &slots[static_cast<std::size_t>(entry_slot[jj]) * M];
-    for (int k = 0; k < M; ++k) sl[k] = hsum(m[k]);
+    alignas(64) float sums[kPadded];
+    for (int k = 0; k < kPadded; k += L) store(sums + k, transposeSums(m + k));
+    std::memcpy(&slots[static_cast<std::size_t>(entry_slot[jj]) * M], sums, sizeof(float) * M);
   }
 }
 
@@ -474,9 +504,9 @@ void fisherTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, in
   if (nq == 0) return;
   const float bg_sum = bg[0] + bg[1] + bg[2];
   if (bg_sum != 0.0f)
-    fisherTileImpl<true>(q, x0, y0, x1, y1, bg_sum, in, entry_slot, slots);
+    fisherTileImpl<true>(q, nq, x0, y0, x1, y1, bg_sum, in, entry_slot, slots);
   else
-    fisherTileImpl<false>(q, x0, y0, x1, y1, bg_sum, in, entry_slot, slots);
+    fisherTileImpl<false>(q, nq, x0, y0, x1, y1, bg_sum, in, entry_slot, slots);
 }
 
 }  // namespace saresgs::raster_kernels::SARESGS_KERNEL_NS

@@ -631,8 +631,13 @@ void squaredGradientsFloat(const Gaussians& g, const Camera& cam, const RenderOu
   const RasterStateT<float>& st = *fwd.state;
   const RasterSettings& rs = st.settings;
   const std::size_t n = g.size();
-  std::vector<float> slots(static_cast<std::size_t>(st.gauss_start[n]) * kFisherSlot, 0.0f);
-  fisherMoments(st, fwd.width, fwd.height, slots.data());
+  // One buffer per calling thread, kept between calls and never cleared: the kernels
+  // write every pair's slot, and a fresh buffer per view (the selector runs one per
+  // candidate) cost its page faults and clearing, as much as the kernels' own work.
+  thread_local std::vector<float> slot_buffer;
+  slot_buffer.resize(std::max(slot_buffer.size(), static_cast<std::size_t>(st.gauss_start[n]) * kFisherSlot));
+  float* const slots = slot_buffer.data();
+  fisherMoments(st, fwd.width, fwd.height, slots);
   const CameraT<float> camT(cam, float(rs.guard_band));
   arena(st).execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& r) {
