@@ -11,6 +11,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <stdexcept>
 #include <type_traits>
 
@@ -602,6 +603,44 @@ namespace {
 constexpr raster_kernels::FisherFn kFisherKernels[] = {raster_kernels::base4::fisherTile,
                                                        raster_kernels::avx2::fisherTile};
 
+// A slot buffer of at least `size` floats, not cleared, taken from a process-wide pool
+// and given back when the lease ends. A fresh buffer per view (the selector runs one per
+// candidate) cost its page faults and clearing, as much as the kernels' own work; the
+// kernels write every pair's slot, so old contents never leak. A pool rather than one
+// buffer per thread: a thread waiting inside a pass may run another pass's tasks.
+class SlotLease {
+ public:
+  explicit SlotLease(std::size_t size) {
+    {
+      const std::lock_guard<std::mutex> lock(mutex());
+      auto& pool = free();
+      if (!pool.empty()) {
+        buf_ = std::move(pool.back());
+        pool.pop_back();
+      }
+    }
+    if (buf_.size() < size) buf_.resize(size);
+  }
+  ~SlotLease() {
+    const std::lock_guard<std::mutex> lock(mutex());
+    free().push_back(std::move(buf_));
+  }
+  SlotLease(const SlotLease&) = delete;
+  SlotLease& operator=(const SlotLease&) = delete;
+  float* data() const { return const_cast<float*>(buf_.data()); }
+
+ private:
+  static std::mutex& mutex() {
+    static std::mutex m;
+    return m;
+  }
+  static std::vector<std::vector<float>>& free() {
+    static std::vector<std::vector<float>> pool;
+    return pool;
+  }
+  std::vector<float> buf_;
+};
+
 void fisherMoments(const RasterStateT<float>& st, int W, int H, float* slots) {
   const RasterSettings& rs = st.settings;
   const float bg[3] = {rs.background[0], rs.background[1], rs.background[2]};
@@ -631,12 +670,8 @@ void squaredGradientsFloat(const Gaussians& g, const Camera& cam, const RenderOu
   const RasterStateT<float>& st = *fwd.state;
   const RasterSettings& rs = st.settings;
   const std::size_t n = g.size();
-  // One buffer per calling thread, kept between calls and never cleared: the kernels
-  // write every pair's slot, and a fresh buffer per view (the selector runs one per
-  // candidate) cost its page faults and clearing, as much as the kernels' own work.
-  thread_local std::vector<float> slot_buffer;
-  slot_buffer.resize(std::max(slot_buffer.size(), static_cast<std::size_t>(st.gauss_start[n]) * kFisherSlot));
-  float* const slots = slot_buffer.data();
+  const SlotLease lease(static_cast<std::size_t>(st.gauss_start[n]) * kFisherSlot);
+  float* const slots = lease.data();
   fisherMoments(st, fwd.width, fwd.height, slots);
   const CameraT<float> camT(cam, float(rs.guard_band));
   arena(st).execute([&] {
