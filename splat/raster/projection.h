@@ -438,8 +438,8 @@ void projectBackward(const GaussiansT<T>& g, std::size_t i, const CameraT<T>& ca
 // Gaussian i's Jacobian for the Fisher pass: row r is what projectBackward adds to the
 // means (columns 0-2) and log-scales (3-5) for a unit gradient of input r: the 2D mean
 // x, y (rows 0, 1), the conic a, b, c (2-4) and all three colour channels at once (5).
-// Each row runs only the stages its input reaches (equal to the full call up to the
-// sign of zeros).
+// Each row runs only the stages its input reaches; the conic rows use the chain's
+// low-rank form (equal to projectBackward's up to rounding).
 template <typename T>
 void projectJacobian(const GaussiansT<T>& g, std::size_t i, const CameraT<T>& cam, const RasterSettings& s,
                      const Projected<T>& P, const BackwardFrame<T>& f, T J[6][6]) {
@@ -452,14 +452,40 @@ void projectJacobian(const GaussiansT<T>& g, std::size_t i, const CameraT<T>& ca
     mean2dBackward(cam, f, dmean2d, zero3, gp);
     cameraToMean(cam, gp, zero3, J[r]);
   }
-  const T zero2[2] = {0, 0};
+  // The conic rows: conicBackward for a unit gradient of conic a, b or c, in closed form.
+  // dL/dSigma2D = -Q gQ Q is -(u v^T + v u^T) / 2 with u, v among Q's columns q1 = (a, b),
+  // q2 = (b, c): (q1, q1) for a, (q1, q2) for b (it appears twice in Q), (q2, q2) for c.
+  // Each stage of the chain then stays of that form: with r = A^T u (and A^T v),
+  // dL/dSigma = -(r_u r_v^T + r_v r_u^T) / 2, dL/dA = -(u (Sig r_v)^T + v (Sig r_u)^T), and,
+  // as M = Rq diag(sc), dL/dlog_scale_k = -2 sc_k^2 (Rq^T r_u)_k (Rq^T r_v)_k.
+  const T q[2][2] = {{P.conic[0], P.conic[1]}, {P.conic[1], P.conic[2]}};
+  T rA[2][3], wR[2][3], tR[2][3];
+  for (int j = 0; j < 2; ++j) {
+    for (int k = 0; k < 3; ++k) rA[j][k] = q[j][0] * f.A[0][k] + q[j][1] * f.A[1][k];
+    T sS[3];
+    for (int k = 0; k < 3; ++k) sS[k] = f.Sig[k][0] * rA[j][0] + f.Sig[k][1] * rA[j][1] + f.Sig[k][2] * rA[j][2];
+    for (int k = 0; k < 3; ++k) wR[j][k] = cam.R[k][0] * sS[0] + cam.R[k][1] * sS[1] + cam.R[k][2] * sS[2];
+    for (int k = 0; k < 3; ++k) tR[j][k] = f.Rq.m[0][k] * rA[j][0] + f.Rq.m[1][k] * rA[j][1] + f.Rq.m[2][k] * rA[j][2];
+  }
+  const T* p = f.p;
+  const T iz = f.iz, iz2 = f.iz2;
+  const int uv[3][2] = {{0, 0}, {0, 1}, {1, 1}};
   for (int r = 0; r < 3; ++r) {
-    const T dconic[3] = {T(r == 0), T(r == 1), T(r == 2)};
-    T gpc[3], gp[3], gM[3][3];
-    conicBackward(cam, P, f, dconic, gpc, gM);
-    mean2dBackward(cam, f, zero2, gpc, gp);
+    const int u = uv[r][0], v = uv[r][1];
+    // dL/dJ = dL/dA W^T = -(u (W Sig r_v)^T + v (W Sig r_u)^T).
+    T gJ[2][3];
+    for (int row = 0; row < 2; ++row)
+      for (int k = 0; k < 3; ++k) gJ[row][k] = -(q[u][row] * wR[v][k] + q[v][row] * wR[u][k]);
+    T gp[3];
+    gp[0] = gJ[0][2] * (-cam.fx * iz2);
+    gp[1] = gJ[1][2] * (-cam.fy * iz2);
+    gp[2] = gJ[0][0] * (-cam.fx * iz2) + gJ[0][2] * (T(2) * cam.fx * p[0] * iz2 * iz) +
+            gJ[1][1] * (-cam.fy * iz2) + gJ[1][2] * (T(2) * cam.fy * p[1] * iz2 * iz);
     cameraToMean(cam, gp, zero3, J[2 + r]);
-    scaleBackward(g, i, f, gM, J[2 + r] + 3);
+    for (int k = 0; k < 3; ++k) {
+      const T raw = g.log_scales[3 * i + k];
+      if (raw > T(-60) && raw < T(60)) J[2 + r][3 + k] = T(-2) * f.sc[k] * f.sc[k] * tR[u][k] * tR[v][k];
+    }
   }
   const T ones[3] = {1, 1, 1};
   T dm[3] = {0, 0, 0};
