@@ -100,6 +100,13 @@ std::vector<FisherCase> fisherCases() {
                      cam, sh, sh % 2 ? std::array<float, 3>{0.3f, 0.1f, 0.6f} : std::array<float, 3>{0, 0, 0}});
   cases.push_back({"dense", test::randomScene<double>(400, 1, 60, 0.7).cast<float>(), test::smallCamera(50, 37), 1,
                    {0.2f, 0.2f, 0.2f}});
+  {
+    // Large Gaussians on a larger view: offsets from the 2D mean of a hundred pixels and
+    // more, where the moments' powers of dx, dy (up to four) are largest.
+    Gaussians big = test::randomScene<double>(40, 2, 65, 1.0).cast<float>();
+    for (float& v : big.log_scales) v += 1.5f;
+    cases.push_back({"large Gaussians 256x192", big, test::smallCamera(256, 192), 2, {0.1f, 0.1f, 0.1f}});
+  }
   const Camera small = test::smallCamera(32, 24);
   for (double rel : {1e-6, 1e-4, 1e-2, 1.0, 1e2, 1e4})
     cases.push_back({"scale " + std::to_string(rel), oneGaussian(Eigen::Vector3d(0.1, 0.0, 0.05), rel * 3.0), small,
