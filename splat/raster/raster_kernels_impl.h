@@ -414,6 +414,8 @@ void fisherTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1
   constexpr int M = kFisherSlot;
   const int w = x1 - x0, h = y1 - y0;
   alignas(64) float Tr[P], finalT[P], walked[P], acc[P];
+  alignas(64) float eb[P], wb[P];  // per block of the current Gaussian: e and wc
+  int block[P / L];                // and the block's storage index
   std::uint32_t jmax = 0;
   for (int k = 0; k < P; ++k) {
     const int r = blockRow(k), c = blockCol(k);
@@ -440,9 +442,11 @@ void fisherTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1
     const vf jv = vs(static_cast<float>(jj));
     const vf ha = vs(-0.5f) * vs(g.a);
     const vf colsum = vs(g.col[0] + g.col[1] + g.col[2]);
-    constexpr int kPadded = (M + L - 1) / L * L;
-    vf m[kPadded];
-    for (int k = 0; k < kPadded; ++k) m[k] = zero;
+    // Two passes over the Gaussian's blocks. The walk keeps each block's e and wc in
+    // scratch; the moments are then summed in three groups small enough to stay in
+    // registers (nineteen accumulators spilled to the stack made every block pay
+    // nineteen stores, which bound the kernel).
+    int nb = 0;
     if (c0 <= c1)
       for (int rb = r0 / kBH; rb <= r1 / kBH; ++rb) {
         int lo, hi;
@@ -451,11 +455,10 @@ void fisherTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1
         const vf dy = (vs(static_cast<float>(y0 + rb * kBH)) + lane_y) - my;
         const vi row_in = absLe(dy, hy);
         const vf qy = rowQuad(g, dy), by = rowCross(g, dy);
-        const vf yy = dy * dy;
         for (int cb = lo & ~(kBW - 1); cb <= hi; cb += kBW) {
           const int k = (rb * kBX + cb / kBW) * L;
           const Lanes Ln = evalLanes((vs(static_cast<float>(x0 + cb)) + lane_x) - mx, ha, qy, by, o, hx, row_in);
-          const vf dx = Ln.dx, alpha = Ln.alpha;
+          const vf alpha = Ln.alpha;
           const vi valid = (jv < load(walked + k)) & Ln.touches;
           const vf a_eff = valid ? alpha : zero;
           const vf t = load(Tr + k) / (one - a_eff);  // transmittance in front of jj
@@ -465,35 +468,75 @@ void fisherTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1
           if constexpr (kBg) dLda = dLda - load(finalT + k) / (one - alpha) * bgs;
           store(acc + k, fma(a_eff, d, a));
           const vi gm = valid & (Ln.oG < vs(kMaxA));
-          const vf e = gm ? Ln.G * dLda : zero;
-          const vf wc = a_eff * t;  // 0 where not valid
-          const vf xx = dx * dx, xy = dx * dy;
-          const vf e2 = e * e, ew = e * wc;
-          const vf e2xx = e2 * xx, e2yy = e2 * yy;
-          m[kE00] += e2;
-          m[kE20] += e2xx;
-          m[kE11] = fma(e2 * dx, dy, m[kE11]);
-          m[kE02] += e2yy;
-          m[kE30] = fma(e2xx, dx, m[kE30]);
-          m[kE21] = fma(e2xx, dy, m[kE21]);
-          m[kE12] = fma(e2yy, dx, m[kE12]);
-          m[kE03] = fma(e2yy, dy, m[kE03]);
-          m[kE40] = fma(e2xx, xx, m[kE40]);
-          m[kE31] = fma(e2xx, xy, m[kE31]);
-          m[kE22] = fma(e2xx, yy, m[kE22]);
-          m[kE13] = fma(e2yy, xy, m[kE13]);
-          m[kE04] = fma(e2yy, yy, m[kE04]);
-          m[kF10] = fma(ew, dx, m[kF10]);
-          m[kF01] = fma(ew, dy, m[kF01]);
-          m[kF20] = fma(ew, xx, m[kF20]);
-          m[kF11] = fma(ew, xy, m[kF11]);
-          m[kF02] = fma(ew, yy, m[kF02]);
-          m[kW] = fma(wc, wc, m[kW]);
+          store(eb + nb * L, gm ? Ln.G * dLda : zero);
+          store(wb + nb * L, a_eff * t);  // 0 where not valid
+          block[nb++] = k;
         }
       }
+    // The offsets of block n's pixels, as the walk computed them.
+    auto offsets = [&](int n, vf& dx, vf& dy) {
+      const int b = block[n] / L;
+      dx = (vs(static_cast<float>(x0 + b % kBX * kBW)) + lane_x) - mx;
+      dy = (vs(static_cast<float>(y0 + b / kBX * kBH)) + lane_y) - my;
+    };
+    constexpr int kPadded = (M + L - 1) / L * L;
+    vf m[kPadded];
+    for (int k = M; k < kPadded; ++k) m[k] = zero;
+    {
+      vf e00 = zero, e20 = zero, e11 = zero, e02 = zero, f10 = zero, f01 = zero, ww = zero;
+      for (int n = 0; n < nb; ++n) {
+        vf dx, dy;
+        offsets(n, dx, dy);
+        const vf e = load(eb + n * L), wc = load(wb + n * L);
+        const vf e2 = e * e, ew = e * wc;
+        e00 += e2;
+        e20 += e2 * (dx * dx);
+        e11 = fma(e2 * dx, dy, e11);
+        e02 += e2 * (dy * dy);
+        f10 = fma(ew, dx, f10);
+        f01 = fma(ew, dy, f01);
+        ww = fma(wc, wc, ww);
+      }
+      m[kE00] = e00, m[kE20] = e20, m[kE11] = e11, m[kE02] = e02, m[kF10] = f10, m[kF01] = f01, m[kW] = ww;
+    }
+    {
+      vf e30 = zero, e21 = zero, e12 = zero, e03 = zero, f20 = zero, f11 = zero, f02 = zero;
+      for (int n = 0; n < nb; ++n) {
+        vf dx, dy;
+        offsets(n, dx, dy);
+        const vf e = load(eb + n * L), wc = load(wb + n * L);
+        const vf e2 = e * e, ew = e * wc;
+        const vf e2xx = e2 * (dx * dx), e2yy = e2 * (dy * dy);
+        e30 = fma(e2xx, dx, e30);
+        e21 = fma(e2xx, dy, e21);
+        e12 = fma(e2yy, dx, e12);
+        e03 = fma(e2yy, dy, e03);
+        f20 = fma(ew, dx * dx, f20);
+        f11 = fma(ew, dx * dy, f11);
+        f02 = fma(ew, dy * dy, f02);
+      }
+      m[kE30] = e30, m[kE21] = e21, m[kE12] = e12, m[kE03] = e03, m[kF20] = f20, m[kF11] = f11, m[kF02] = f02;
+    }
+    {
+      vf e40 = zero, e31 = zero, e22 = zero, e13 = zero, e04 = zero;
+      for (int n = 0; n < nb; ++n) {
+        vf dx, dy;
+        offsets(n, dx, dy);
+        const vf e = load(eb + n * L);
+        const vf e2 = e * e, xx = dx * dx, xy = dx * dy, yy = dy * dy;
+        const vf e2xx = e2 * xx, e2yy = e2 * yy;
+        e40 = fma(e2xx, xx, e40);
+        e31 = fma(e2xx, xy, e31);
+        e22 = fma(e2xx, yy, e22);
+        e13 = fma(e2yy, xy, e13);
+        e04 = fma(e2yy, yy, e04);
+      }
+      m[kE40] = e40, m[kE31] = e31, m[kE22] = e22, m[kE13] = e13, m[kE04] = e04;
+    }
+    float* sl = &slots[static_cast<std::size_t>(entry_slot[jj]) * M];
     alignas(64) float sums[kPadded];
     for (int k = 0; k < kPadded; k += L) store(sums + k, transposeSums(m + k));
-    std::memcpy(&slots[static_cast<std::size_t>(entry_slot[jj]) * M], sums, sizeof(float) * M);
+    std::memcpy(sl, sums, sizeof(float) * M);
   }
 }
 
