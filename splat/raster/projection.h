@@ -398,11 +398,13 @@ void scaleBackward(const GaussiansT<T>& g, std::size_t i, const BackwardFrame<T>
 }
 
 // Adds the parameter gradients of Gaussian i, given the gradients of its projected
-// quantities, to `out`. Exact chain rule of project().
+// quantities, to `out`. Exact chain rule of project(). Flattened: the stages, called
+// apart by projectJacobian, would otherwise stay out-of-line here too (3 % more
+// instructions in the whole training backward pass under callgrind; 1 % with it).
 template <typename T>
-void projectBackward(const GaussiansT<T>& g, std::size_t i, const CameraT<T>& cam,
-                     const RasterSettings& s, const Projected<T>& P, const ProjectedGrad<T>& dP,
-                     const ParamGradRef<T>& out, const BackwardFrame<T>& f) {
+[[gnu::flatten]] void projectBackward(const GaussiansT<T>& g, std::size_t i, const CameraT<T>& cam,
+                                      const RasterSettings& s, const Projected<T>& P, const ProjectedGrad<T>& dP,
+                                      const ParamGradRef<T>& out, const BackwardFrame<T>& f) {
   // Opacity logit.
   if (out.opacity) *out.opacity += dP.opacity * P.opacity * (T(1) - P.opacity);
   T dm[3] = {0, 0, 0};
