@@ -627,7 +627,7 @@ class SlotLease {
   }
   SlotLease(const SlotLease&) = delete;
   SlotLease& operator=(const SlotLease&) = delete;
-  float* data() const { return const_cast<float*>(buf_.data()); }
+  float* data() { return buf_.data(); }
 
  private:
   static std::mutex& mutex() {
@@ -670,7 +670,7 @@ void squaredGradientsFloat(const Gaussians& g, const Camera& cam, const RenderOu
   const RasterStateT<float>& st = *fwd.state;
   const RasterSettings& rs = st.settings;
   const std::size_t n = g.size();
-  const SlotLease lease(static_cast<std::size_t>(st.gauss_start[n]) * kFisherSlot);
+  SlotLease lease(static_cast<std::size_t>(st.gauss_start[n]) * kFisherSlot);
   float* const slots = lease.data();
   fisherMoments(st, fwd.width, fwd.height, slots);
   const CameraT<float> camT(cam, float(rs.guard_band));
