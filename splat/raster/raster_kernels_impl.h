@@ -396,8 +396,9 @@ inline vf pairSums(vf a, vf b) {
 }
 
 // The lane sums of L vectors v[0, L) as one vector (lane k: the sum of v[k]), in a
-// fixed tree order: L - 1 shuffle-adds instead of L horizontal sums, which cost more
-// than the pixel loop for the small Gaussians that cover a tile in a few blocks.
+// fixed tree order (the same tree as hsum): L - 1 shuffle-adds instead of L horizontal
+// sums of a dozen scalar instructions each, paid per (tile, Gaussian) pair, while the
+// small Gaussians of a trained model cover a tile in a few blocks.
 inline vf transposeSums(const vf* v) {
 #if SARESGS_KERNEL_LANES == 4
   return pairSums(pairSums(v[0], v[1]), pairSums(v[2], v[3]));
