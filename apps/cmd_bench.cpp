@@ -2,6 +2,9 @@
 // Not tests: speed is measured here.
 //   step       one training step (forward + loss + backward + Adam) on a reproducible
 //              random scene;
+//   fisher     FisherRF's squared-gradient pass of one view against the backward pass of
+//              the same view, same scene and process (the ratio is what the Fisher
+//              selector costs per candidate relative to a training backward);
 //   occupancy  the prefilter's parts on a room360 scene with simulated SfM points: grid
 //              build, observed dilation, frustum vs visible sets, exact vs hashed scoring,
 //              grid memory.
@@ -26,6 +29,8 @@
 #include "geometry/synth/simulated_sfm.h"
 #include "geometry/synth/synthetic_scene.h"
 #include "geometry/synth/write_dataset.h"
+#include "splat/fisher.h"
+#include "splat/loss.h"
 #include "splat/raster_execution.h"
 #include "splat/train/trainer.h"
 
@@ -187,6 +192,74 @@ int runBench(const BenchArgs& a) {
   return 0;
 }
 
+// The Fisher pass (rasterizeSquaredGradients given a forward render), the full
+// addViewInformation (forward + Fisher pass) and the backward pass of the same view, each
+// timed per iteration in the same loop so that load changes hit all three alike.
+int runFisherBench(const BenchArgs& a) {
+  const Camera cam = benchCamera(a);
+  RasterSettings s;
+  s.sh_degree = a.sh_degree;
+  s.execution.threads = a.threads;
+  const Gaussians g = benchScene(a, a.seed, cam);
+  // dL/drgb as in training: the photometric loss against another random scene's render.
+  const ImageF target = rasterize(benchScene(a, a.seed + 1000, cam), cam, s).rgb;
+  const RenderResult fwd = rasterize(g, cam, s);
+  const ImageF dL = photometricLoss(fwd.rgb, target, 0.2, true).grad;
+  Gaussians H = g.zerosLike(), grad = g.zerosLike();
+  std::vector<double> fisher_ms, view_ms, backward_ms, forward_ms;
+  auto ms = [](auto t0) { return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count(); };
+  for (int it = 0; it < a.warmup + a.steps; ++it) {
+    const bool timed = it >= a.warmup;
+    auto t0 = std::chrono::steady_clock::now();
+    const RenderResult r = rasterize(g, cam, s);
+    if (timed) forward_ms.push_back(ms(t0));
+    clearInformation(H);
+    t0 = std::chrono::steady_clock::now();
+    rasterizeSquaredGradients(g, cam, s, r, H);
+    if (timed) fisher_ms.push_back(ms(t0));
+    clearInformation(grad);
+    t0 = std::chrono::steady_clock::now();
+    rasterizeBackward(g, cam, s, r, dL, grad);
+    if (timed) backward_ms.push_back(ms(t0));
+    clearInformation(H);
+    t0 = std::chrono::steady_clock::now();
+    addViewInformation(g, cam, s, H);
+    if (timed) view_ms.push_back(ms(t0));
+  }
+  auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+  };
+  double c = 0;
+  for (int n : fwd.contributors) c += n;
+  // A checksum of the information, so that runs (and thread counts) can be compared.
+  double checksum = 0;
+  H.forEachArray([&](const std::vector<float>& x, std::size_t) {
+    for (float v : x) checksum += v;
+  });
+  nlohmann::json j;
+  j["benchmark"] = "fisher";
+  j["width"] = a.width;
+  j["height"] = a.height;
+  j["gaussians"] = a.gaussians;
+  j["sh_degree"] = a.sh_degree;
+  j["coverage"] = a.coverage;
+  j["mean_contributors_per_pixel"] = c / static_cast<double>(fwd.contributors.size());
+  j["threads"] = rasterThreadCount(s.execution);
+  j["kernels"] = rasterKernelName(s.execution);
+  j["steps"] = a.steps;
+  j["fisher_ms"] = median(fisher_ms);
+  j["view_information_ms"] = median(view_ms);
+  j["forward_ms"] = median(forward_ms);
+  j["backward_ms"] = median(backward_ms);
+  j["fisher_to_backward_ratio"] = median(fisher_ms) / median(backward_ms);
+  j["information_sum"] = checksum;
+  j["peak_rss_mb"] = peakRssMb();
+  j["cpu"] = cpuName();
+  std::cout << j.dump() << std::endl;
+  return 0;
+}
+
 struct OccupancyBenchArgs {
   int width = 256, height = 192;  // the synthetic views (their depth maps give SA-Points)
   std::size_t points = 12000;     // simulated SfM points at most
@@ -341,6 +414,23 @@ void addBenchCommand(CLI::App& app, Action& action) {
   step->add_option("--seed", a->seed, "Scene seed")->capture_default_str();
   step->add_flag("--residual", a->residual, "Time residual-supervision steps too, and their ratio to plain ones");
   step->callback([&action, a] { action = [a] { return runBench(*a); }; });
+
+  auto f = std::make_shared<BenchArgs>();
+  f->width = 256;
+  f->height = 192;
+  f->gaussians = 40000;
+  CLI::App* fisher = bench->add_subcommand(
+      "fisher", "Time the Fisher (squared-gradient) pass against the backward pass of the same view");
+  fisher->add_option("--width", f->width, "Image width")->check(CLI::Range(1, 16384))->capture_default_str();
+  fisher->add_option("--height", f->height, "Image height")->check(CLI::Range(1, 16384))->capture_default_str();
+  fisher->add_option("--gaussians", f->gaussians, "Number of Gaussians")->check(CLI::Range(1, 100000000))->capture_default_str();
+  fisher->add_option("--sh-degree", f->sh_degree, "SH degree (active)")->check(CLI::Range(0, 3))->capture_default_str();
+  fisher->add_option("--coverage", f->coverage, "Mean 3-sigma ellipses per pixel")->check(CLI::Range(0.01, 1000.0))->capture_default_str();
+  fisher->add_option("--steps", f->steps, "Timed iterations")->check(CLI::Range(1, 100000))->capture_default_str();
+  fisher->add_option("--warmup", f->warmup, "Untimed iterations first")->check(CLI::Range(0, 100000))->capture_default_str();
+  fisher->add_option("--threads", f->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
+  fisher->add_option("--seed", f->seed, "Scene seed")->capture_default_str();
+  fisher->callback([&action, f] { action = [f] { return runFisherBench(*f); }; });
 
   auto o = std::make_shared<OccupancyBenchArgs>();
   CLI::App* occ = bench->add_subcommand(

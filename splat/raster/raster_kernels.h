@@ -53,6 +53,44 @@ using BackwardFn = void (*)(const TileGaussian<float>* q, int nq, int x0, int y0
                             const float bg[3], const BackwardIn& in, const std::uint32_t* entry_slot,
                             float* slots);
 
+// FisherRF's squared-gradient pass (splat/fisher.h) works on the per-pixel gradient of
+// C_r + C_g + C_b, which is linear in a contribution's 2D inputs: dL/dalpha times G (e,
+// where alpha = o G is not clamped, else 0) and the colour weight alpha T (wc). The
+// squared parameter gradient, summed over pixels, is a quadratic form in those inputs
+// whose pixel dependence is polynomial in the offsets (dx, dy) from the 2D mean (degree
+// <= 2 per input: the mean terms are linear, the conic terms quadratic). So a tile needs,
+// per Gaussian, only the sums below; the per-Gaussian Jacobian is applied once to them
+// (rasterizer.cpp) instead of at every pixel. E_ij = sum e^2 dx^i dy^j, F_ij = sum e wc
+// dx^i dy^j, W = sum wc^2.
+enum FisherMoment {
+  kE00, kE20, kE11, kE02, kE30, kE21, kE12, kE03, kE40, kE31, kE22, kE13, kE04,
+  kF10, kF01, kF20, kF11, kF02, kW,
+  kFisherSlot  // floats per pair slot
+};
+
+// What the Fisher kernel reads per pixel (whole-image arrays, row stride W).
+struct FisherIn {
+  int W;
+  const float* final_T;
+  const std::uint32_t* n_walked;
+};
+
+// The back-to-front walk of a tile for the objective C_r + C_g + C_b: for each tile
+// entry jj its kFisherSlot moments go to slots[entry_slot[jj] * kFisherSlot] (every
+// entry's slot is written, zeros where no pixel reaches it).
+using FisherFn = void (*)(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1,
+                          const float bg[3], const FisherIn& in, const std::uint32_t* entry_slot, float* slots);
+
+namespace base4 {
+void fisherTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
+                const FisherIn& in, const std::uint32_t* entry_slot, float* slots);
+}  // namespace base4
+
+namespace avx2 {
+void fisherTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
+                const FisherIn& in, const std::uint32_t* entry_slot, float* slots);
+}  // namespace avx2
+
 namespace base4 {
 void compositeTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
                    const ForwardOut& out);

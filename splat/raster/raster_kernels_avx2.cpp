@@ -25,5 +25,9 @@ void backwardTile(const TileGaussian<float>*, int, int, int, int, int, const flo
                   const std::uint32_t*, float*) {
   std::abort();
 }
+void fisherTile(const TileGaussian<float>*, int, int, int, int, int, const float*, const FisherIn&,
+                const std::uint32_t*, float*) {
+  std::abort();
+}
 }  // namespace saresgs::raster_kernels::avx2
 #endif

@@ -376,4 +376,181 @@ void backwardTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, 
     backwardTileImpl<false>(q, x0, y0, x1, y1, bg, in, entry_slot, slots);
 }
 
+// FisherRF's squared-gradient pass (FisherMoment in raster_kernels.h): the backward walk
+// for the fixed objective C_r + C_g + C_b, accumulating moments instead of gradients.
+// Kept apart from the backward kernel: its weights are all 1, so the three colour
+// accumulators collapse into one (sum_c (col_c - acc_c) = sum col - sum acc, and each
+// acc_c is updated linearly), and the background term is the same for every pixel.
+namespace {
+
+// Pairwise lane sums of two vectors: [a0 + a1, a2 + a3, ..., b0 + b1, b2 + b3, ...].
+// (The preprocessor picks the lane count: shuffle indices must be constants even in a
+// discarded branch outside a template.)
+inline vf pairSums(vf a, vf b) {
+#if SARESGS_KERNEL_LANES == 4
+  return __builtin_shufflevector(a, b, 0, 2, 4, 6) + __builtin_shufflevector(a, b, 1, 3, 5, 7);
+#else
+  return __builtin_shufflevector(a, b, 0, 2, 4, 6, 8, 10, 12, 14) +
+         __builtin_shufflevector(a, b, 1, 3, 5, 7, 9, 11, 13, 15);
+#endif
+}
+
+// The lane sums of L vectors v[0, L) as one vector (lane k: the sum of v[k]), in a
+// fixed tree order (the same tree as hsum): L - 1 shuffle-adds instead of L horizontal
+// sums of a dozen scalar instructions each, paid per (tile, Gaussian) pair, while the
+// small Gaussians of a trained model cover a tile in a few blocks.
+inline vf transposeSums(const vf* v) {
+#if SARESGS_KERNEL_LANES == 4
+  return pairSums(pairSums(v[0], v[1]), pairSums(v[2], v[3]));
+#else
+  return pairSums(pairSums(pairSums(v[0], v[1]), pairSums(v[2], v[3])),
+                  pairSums(pairSums(v[4], v[5]), pairSums(v[6], v[7])));
+#endif
+}
+
+template <bool kBg>
+void fisherTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, float bg_sum,
+                    const FisherIn& in, const std::uint32_t* entry_slot, float* slots) {
+  constexpr int P = kTile * kTile;
+  constexpr int M = kFisherSlot;
+  const int w = x1 - x0, h = y1 - y0;
+  alignas(64) float Tr[P], finalT[P], walked[P], acc[P];
+  alignas(64) float eb[P], wb[P];  // per block of the current Gaussian: e and wc
+  int block[P / L];                // and the block's storage index
+  std::uint32_t jmax = 0;
+  for (int k = 0; k < P; ++k) {
+    const int r = blockRow(k), c = blockCol(k);
+    const bool inside = c < w && r < h;
+    const std::size_t pix = inside ? static_cast<std::size_t>(y0 + r) * in.W + (x0 + c) : 0;
+    Tr[k] = finalT[k] = inside ? in.final_T[pix] : 1.0f;
+    const std::uint32_t nw = inside ? in.n_walked[pix] : 0;
+    walked[k] = static_cast<float>(nw);
+    jmax = nw > jmax ? nw : jmax;
+    acc[k] = 0.0f;
+  }
+  // Entries no pixel walks have no information; their slots are written here all the
+  // same, so that the caller needs no cleared buffer.
+  for (int jj = static_cast<int>(jmax); jj < nq; ++jj)
+    std::memset(&slots[static_cast<std::size_t>(entry_slot[jj]) * M], 0, sizeof(float) * M);
+  const vf lane_x = laneColCentres(), lane_y = laneRowCentres();
+  const vf zero = vs(0.0f), one = vs(1.0f), bgs = vs(bg_sum);
+  for (std::uint32_t jj = jmax; jj-- > 0;) {
+    const TileGaussian<float>& g = q[jj];
+    int c0, c1, r0, r1;
+    tileSpan(g.mx, g.hx, x0, x1, c0, c1);
+    tileSpan(g.my, g.hy, y0, y1, r0, r1);
+    const vf mx = vs(g.mx), my = vs(g.my), hx = vs(g.hx), hy = vs(g.hy), o = vs(g.o);
+    const vf jv = vs(static_cast<float>(jj));
+    const vf ha = vs(-0.5f) * vs(g.a);
+    const vf colsum = vs(g.col[0] + g.col[1] + g.col[2]);
+    // Two passes over the Gaussian's blocks. The walk keeps each block's e and wc in
+    // scratch; the moments are then summed in three groups small enough to stay in
+    // registers (nineteen accumulators spilled to the stack made every block pay
+    // nineteen stores, which bound the kernel).
+    int nb = 0;
+    if (c0 <= c1)
+      for (int rb = r0 / kBH; rb <= r1 / kBH; ++rb) {
+        int lo, hi;
+        blockRowSpan(g, x0, y0, rb, c0, c1, lo, hi);
+        if (lo > hi) continue;
+        const vf dy = (vs(static_cast<float>(y0 + rb * kBH)) + lane_y) - my;
+        const vi row_in = absLe(dy, hy);
+        const vf qy = rowQuad(g, dy), by = rowCross(g, dy);
+        for (int cb = lo & ~(kBW - 1); cb <= hi; cb += kBW) {
+          const int k = (rb * kBX + cb / kBW) * L;
+          const Lanes Ln = evalLanes((vs(static_cast<float>(x0 + cb)) + lane_x) - mx, ha, qy, by, o, hx, row_in);
+          const vf alpha = Ln.alpha;
+          const vi valid = (jv < load(walked + k)) & Ln.touches;
+          const vf a_eff = valid ? alpha : zero;
+          const vf t = load(Tr + k) / (one - a_eff);  // transmittance in front of jj
+          store(Tr + k, t);
+          const vf a = load(acc + k), d = colsum - a;
+          vf dLda = d * t;
+          if constexpr (kBg) dLda = dLda - load(finalT + k) / (one - alpha) * bgs;
+          store(acc + k, fma(a_eff, d, a));
+          const vi gm = valid & (Ln.oG < vs(kMaxA));
+          store(eb + nb * L, gm ? Ln.G * dLda : zero);
+          store(wb + nb * L, a_eff * t);  // 0 where not valid
+          block[nb++] = k;
+        }
+      }
+    // The offsets of block n's pixels, as the walk computed them.
+    auto offsets = [&](int n, vf& dx, vf& dy) {
+      const int b = block[n] / L;
+      dx = (vs(static_cast<float>(x0 + b % kBX * kBW)) + lane_x) - mx;
+      dy = (vs(static_cast<float>(y0 + b / kBX * kBH)) + lane_y) - my;
+    };
+    constexpr int kPadded = (M + L - 1) / L * L;
+    vf m[kPadded];
+    for (int k = M; k < kPadded; ++k) m[k] = zero;
+    {
+      vf e00 = zero, e20 = zero, e11 = zero, e02 = zero, f10 = zero, f01 = zero, ww = zero;
+      for (int n = 0; n < nb; ++n) {
+        vf dx, dy;
+        offsets(n, dx, dy);
+        const vf e = load(eb + n * L), wc = load(wb + n * L);
+        const vf e2 = e * e, ew = e * wc;
+        e00 += e2;
+        e20 += e2 * (dx * dx);
+        e11 = fma(e2 * dx, dy, e11);
+        e02 += e2 * (dy * dy);
+        f10 = fma(ew, dx, f10);
+        f01 = fma(ew, dy, f01);
+        ww = fma(wc, wc, ww);
+      }
+      m[kE00] = e00, m[kE20] = e20, m[kE11] = e11, m[kE02] = e02, m[kF10] = f10, m[kF01] = f01, m[kW] = ww;
+    }
+    {
+      vf e30 = zero, e21 = zero, e12 = zero, e03 = zero, f20 = zero, f11 = zero, f02 = zero;
+      for (int n = 0; n < nb; ++n) {
+        vf dx, dy;
+        offsets(n, dx, dy);
+        const vf e = load(eb + n * L), wc = load(wb + n * L);
+        const vf e2 = e * e, ew = e * wc;
+        const vf e2xx = e2 * (dx * dx), e2yy = e2 * (dy * dy);
+        e30 = fma(e2xx, dx, e30);
+        e21 = fma(e2xx, dy, e21);
+        e12 = fma(e2yy, dx, e12);
+        e03 = fma(e2yy, dy, e03);
+        f20 = fma(ew, dx * dx, f20);
+        f11 = fma(ew, dx * dy, f11);
+        f02 = fma(ew, dy * dy, f02);
+      }
+      m[kE30] = e30, m[kE21] = e21, m[kE12] = e12, m[kE03] = e03, m[kF20] = f20, m[kF11] = f11, m[kF02] = f02;
+    }
+    {
+      vf e40 = zero, e31 = zero, e22 = zero, e13 = zero, e04 = zero;
+      for (int n = 0; n < nb; ++n) {
+        vf dx, dy;
+        offsets(n, dx, dy);
+        const vf e = load(eb + n * L);
+        const vf e2 = e * e, xx = dx * dx, xy = dx * dy, yy = dy * dy;
+        const vf e2xx = e2 * xx, e2yy = e2 * yy;
+        e40 = fma(e2xx, xx, e40);
+        e31 = fma(e2xx, xy, e31);
+        e22 = fma(e2xx, yy, e22);
+        e13 = fma(e2yy, xy, e13);
+        e04 = fma(e2yy, yy, e04);
+      }
+      m[kE40] = e40, m[kE31] = e31, m[kE22] = e22, m[kE13] = e13, m[kE04] = e04;
+    }
+    float* sl = &slots[static_cast<std::size_t>(entry_slot[jj]) * M];
+    alignas(64) float sums[kPadded];
+    for (int k = 0; k < kPadded; k += L) store(sums + k, transposeSums(m + k));
+    std::memcpy(sl, sums, sizeof(float) * M);
+  }
+}
+
+}  // namespace
+
+void fisherTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
+                const FisherIn& in, const std::uint32_t* entry_slot, float* slots) {
+  if (nq == 0) return;
+  const float bg_sum = bg[0] + bg[1] + bg[2];
+  if (bg_sum != 0.0f)
+    fisherTileImpl<true>(q, nq, x0, y0, x1, y1, bg_sum, in, entry_slot, slots);
+  else
+    fisherTileImpl<false>(q, nq, x0, y0, x1, y1, bg_sum, in, entry_slot, slots);
+}
+
 }  // namespace saresgs::raster_kernels::SARESGS_KERNEL_NS

@@ -40,4 +40,10 @@ template <typename T>
 void rasterizeSquaredGradientsT(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& s,
                                 const RenderOutputT<T>& fwd, GaussiansT<T>& sq);
 
+// The same, pixel by pixel with the Jacobian applied at every contribution: what double
+// runs, and the reference for the float path's tile moments (tests only).
+template <typename T>
+void rasterizeSquaredGradientsWalkT(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& s,
+                                    const RenderOutputT<T>& fwd, GaussiansT<T>& sq);
+
 }  // namespace saresgs

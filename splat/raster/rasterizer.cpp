@@ -11,6 +11,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <stdexcept>
 #include <type_traits>
 
@@ -593,9 +594,141 @@ void rasterizeBackwardT(const GaussiansT<T>& g, const Camera& cam, const RasterS
   });
 }
 
+namespace {
+
+// FisherRF's squared gradients in float: the SIMD tile kernels give per-pair moments
+// (raster_kernels::FisherMoment), reduced per Gaussian in slot order, in double, and
+// turned into squared parameter gradients with the Gaussian's Jacobian. Indexed like
+// kKernelSets (raster_execution::kernelIndex).
+constexpr raster_kernels::FisherFn kFisherKernels[] = {raster_kernels::base4::fisherTile,
+                                                       raster_kernels::avx2::fisherTile};
+
+// A slot buffer of at least `size` floats, not cleared, taken from a process-wide pool
+// and given back when the lease ends. A fresh buffer per view (the selector runs one per
+// candidate) cost its page faults and clearing, as much as the kernels' own work; the
+// kernels write every pair's slot, so old contents never leak. A pool rather than one
+// buffer per thread: a thread waiting inside a pass may run another pass's tasks.
+class SlotLease {
+ public:
+  explicit SlotLease(std::size_t size) {
+    {
+      const std::lock_guard<std::mutex> lock(mutex());
+      auto& pool = free();
+      if (!pool.empty()) {
+        buf_ = std::move(pool.back());
+        pool.pop_back();
+      }
+    }
+    if (buf_.size() < size) buf_.resize(size);
+  }
+  ~SlotLease() {
+    const std::lock_guard<std::mutex> lock(mutex());
+    free().push_back(std::move(buf_));
+  }
+  SlotLease(const SlotLease&) = delete;
+  SlotLease& operator=(const SlotLease&) = delete;
+  float* data() { return buf_.data(); }
+
+ private:
+  static std::mutex& mutex() {
+    static std::mutex m;
+    return m;
+  }
+  static std::vector<std::vector<float>>& free() {
+    static std::vector<std::vector<float>> pool;
+    return pool;
+  }
+  std::vector<float> buf_;
+};
+
+void fisherMoments(const RasterStateT<float>& st, int W, int H, float* slots) {
+  const RasterSettings& rs = st.settings;
+  const float bg[3] = {rs.background[0], rs.background[1], rs.background[2]};
+  const raster_kernels::FisherIn in{W, st.final_T.data(), st.n_walked.data()};
+  const raster_kernels::FisherFn kernel = kFisherKernels[st.isa];
+  arena(st).execute([&] {
+    tbb::parallel_for(0, st.tiles_x * st.tiles_y, [&](int tile) {
+      thread_local std::vector<TileGaussian<float>> q;
+      gatherTile(st, tile, q);
+      if (q.empty()) return;
+      int x0, y0, x1, y1;
+      tilePixels(st, tile, W, H, x0, y0, x1, y1);
+      kernel(q.data(), static_cast<int>(q.size()), x0, y0, x1, y1, bg, in, &st.entry_slot[st.tile_start[tile]],
+             slots);
+    });
+  });
+}
+
+// Per parameter p, the per-pixel gradient is o e u_p(dx, dy) + wc Jc_p with
+//   u_p = (a dx + b dy) J_mx + (b dx + c dy) J_my - dx^2 J_ca / 2 - dx dy J_cb - dy^2 J_cc / 2
+// (alphaToProjected's 2D gradients through the Jacobian), so its square summed over the
+// pixels is a quadratic form in the moments: o^2 k^T E k + 2 o Jc k.F + Jc^2 W, with k
+// the coefficients of (dx, dy, dx^2, dx dy, dy^2) in u_p.
+void squaredGradientsFloat(const Gaussians& g, const Camera& cam, const RenderOutputT<float>& fwd,
+                           Gaussians& sq) {
+  using namespace raster_kernels;
+  const RasterStateT<float>& st = *fwd.state;
+  const RasterSettings& rs = st.settings;
+  const std::size_t n = g.size();
+  SlotLease lease(static_cast<std::size_t>(st.gauss_start[n]) * kFisherSlot);
+  float* const slots = lease.data();
+  fisherMoments(st, fwd.width, fwd.height, slots);
+  const CameraT<float> camT(cam, float(rs.guard_band));
+  arena(st).execute([&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& r) {
+      const int K = g.shCoeffs(), active = shCoeffCount(rs.sh_degree);
+      for (std::size_t i = r.begin(); i < r.end(); ++i) {
+        if (st.gauss_start[i] == st.gauss_start[i + 1]) continue;
+        double mo[kFisherSlot] = {};
+        for (std::uint32_t k = st.gauss_start[i]; k < st.gauss_start[i + 1]; ++k)
+          for (int p = 0; p < kFisherSlot; ++p) mo[p] += slots[static_cast<std::size_t>(k) * kFisherSlot + p];
+        const Projected<float>& P = st.proj[i];
+        // One frame for the Jacobian and the SH basis below.
+        const projection::BackwardFrame<float> frame = projection::backwardFrame(g, i, camT, rs);
+        float J[6][6];
+        projection::projectJacobian(g, i, camT, rs, P, frame, J);
+        const double a = P.conic[0], b = P.conic[1], c = P.conic[2], o = P.opacity;
+        // The moments of the monomials (dx, dy, dx^2, dx dy, dy^2) pairwise.
+        const double E[5][5] = {{mo[kE20], mo[kE11], mo[kE30], mo[kE21], mo[kE12]},
+                                {mo[kE11], mo[kE02], mo[kE21], mo[kE12], mo[kE03]},
+                                {mo[kE30], mo[kE21], mo[kE40], mo[kE31], mo[kE22]},
+                                {mo[kE21], mo[kE12], mo[kE31], mo[kE22], mo[kE13]},
+                                {mo[kE12], mo[kE03], mo[kE22], mo[kE13], mo[kE04]}};
+        const double F[5] = {mo[kF10], mo[kF01], mo[kF20], mo[kF11], mo[kF02]};
+        double out[6];
+        for (int p = 0; p < 6; ++p) {
+          const double k[5] = {a * J[0][p] + b * J[1][p], b * J[0][p] + c * J[1][p], -0.5 * J[2][p], -J[3][p],
+                               -0.5 * J[4][p]};
+          double quad = 0, lin = 0;
+          for (int u = 0; u < 5; ++u) {
+            double row = 0;
+            for (int v = 0; v < 5; ++v) row += E[u][v] * k[v];
+            quad += k[u] * row;
+            lin += k[u] * F[u];
+          }
+          const double jc = J[5][p];
+          // A sum of squares: a negative value can only be rounding of the expansion.
+          out[p] = std::max(0.0, o * o * quad + 2.0 * o * jc * lin + jc * jc * mo[kW]);
+        }
+        for (int p = 0; p < 3; ++p) sq.means[3 * i + p] += static_cast<float>(out[p]);
+        for (int p = 0; p < 3; ++p) sq.log_scales[3 * i + p] += static_cast<float>(out[3 + p]);
+        const double dlogit = o * (1.0 - o);
+        sq.opacities[i] += static_cast<float>(dlogit * dlogit * mo[kE00]);
+        // SH: d C / d sh_kc = alpha T Y_k for unclamped channels.
+        for (int k = 0; k < active; ++k)
+          for (int ch = 0; ch < 3; ++ch)
+            if (!P.clamped[ch])
+              sq.sh[(i * K + k) * 3 + ch] += static_cast<float>(mo[kW] * frame.basis[k] * frame.basis[k]);
+      }
+    });
+  });
+}
+
+}  // namespace
+
 template <typename T>
-void rasterizeSquaredGradientsT(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& s,
-                                const RenderOutputT<T>& fwd, GaussiansT<T>& sq) {
+void rasterizeSquaredGradientsWalkT(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& s,
+                                    const RenderOutputT<T>& fwd, GaussiansT<T>& sq) {
   const RasterStateT<T>& st = *fwd.state;
   const RasterSettings& rs = st.settings;
   const int W = fwd.width, H = fwd.height;
@@ -676,6 +809,17 @@ void rasterizeSquaredGradientsT(const GaussiansT<T>& g, const Camera& cam, const
   });
 }
 
+// Float, the product path: the SIMD tile moments (squaredGradientsFloat); double: the
+// per-pixel walk, the reference the tests compare against.
+template <typename T>
+void rasterizeSquaredGradientsT(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& s,
+                                const RenderOutputT<T>& fwd, GaussiansT<T>& sq) {
+  if constexpr (std::is_same_v<T, float>)
+    squaredGradientsFloat(g, cam, fwd, sq);
+  else
+    rasterizeSquaredGradientsWalkT(g, cam, s, fwd, sq);
+}
+
 RenderResult rasterize(const Gaussians& g, const Camera& cam, const RasterSettings& s,
                        std::span<const std::uint8_t> mask) {
   RenderOutputT<float> o = rasterizeT(g, cam, s, mask);
@@ -733,5 +877,9 @@ template void rasterizeSquaredGradientsT(const GaussiansT<float>&, const Camera&
                                          const RenderOutputT<float>&, GaussiansT<float>&);
 template void rasterizeSquaredGradientsT(const GaussiansT<double>&, const Camera&, const RasterSettings&,
                                          const RenderOutputT<double>&, GaussiansT<double>&);
+template void rasterizeSquaredGradientsWalkT(const GaussiansT<float>&, const Camera&, const RasterSettings&,
+                                             const RenderOutputT<float>&, GaussiansT<float>&);
+template void rasterizeSquaredGradientsWalkT(const GaussiansT<double>&, const Camera&, const RasterSettings&,
+                                             const RenderOutputT<double>&, GaussiansT<double>&);
 
 }  // namespace saresgs

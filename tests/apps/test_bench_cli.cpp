@@ -69,3 +69,22 @@ TEST(BenchCli, OccupancyRejectsABadOptionValueByName) {
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.output.find("--points"), std::string::npos) << r.output;
 }
+
+TEST(BenchCli, FisherPrintsOneJsonLineWithTheRatioToTheBackwardPass) {
+  const Result r = run("bench fisher --width 40 --height 32 --gaussians 300 --threads 1 --steps 3 --warmup 1");
+  ASSERT_EQ(r.code, 0) << r.output;
+  ASSERT_FALSE(r.output.empty());
+  EXPECT_EQ(r.output.find('\n'), r.output.size() - 1) << r.output;
+  nlohmann::json j;
+  ASSERT_NO_THROW(j = nlohmann::json::parse(r.output)) << r.output;
+  EXPECT_EQ(j.at("benchmark"), "fisher");
+  EXPECT_EQ(j.at("width"), 40);
+  EXPECT_EQ(j.at("gaussians"), 300);
+  EXPECT_EQ(j.at("threads"), 1);
+  EXPECT_FALSE(j.at("kernels").get<std::string>().empty());
+  for (const char* k : {"fisher_ms", "view_information_ms", "forward_ms", "backward_ms", "fisher_to_backward_ratio"})
+    EXPECT_GT(j.at(k).get<double>(), 0.0) << k;
+  // The scene it timed is seen: an empty view would time nothing.
+  EXPECT_GT(j.at("information_sum").get<double>(), 0.0);
+  EXPECT_GT(j.at("peak_rss_mb").get<double>(), 0.0);
+}

@@ -3,10 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include "raster_test_scenes.h"
 #include "splat/fisher.h"
 #include "splat/fisher_detail.h"
+#include "splat/raster/projection.h"
 
 namespace saresgs {
 namespace {
@@ -60,6 +63,202 @@ TEST(Fisher, ScoreEqualsSumOfSquaredFiniteDifferenceGradients) {
   // Entry-wise too (the score could hide compensating errors).
   for (std::size_t k = 0; k < Hv.means.size(); ++k) EXPECT_NEAR(Hv.means[k], Hv_fd.means[k], 1e-4 * (1 + Hv_fd.means[k]));
   for (std::size_t k = 0; k < Hv.sh.size(); ++k) EXPECT_NEAR(Hv.sh[k], Hv_fd.sh[k], 1e-4 * (1 + Hv_fd.sh[k]));
+}
+
+// The float squared-gradient pass (SIMD tile moments, raster_kernels.h) against the
+// double per-pixel walk, the reference, on the same scene and camera.
+struct FisherCase {
+  std::string name;
+  Gaussians g;
+  Camera cam;
+  int sh_degree = 0;
+  std::array<float, 3> background{0, 0, 0};
+};
+
+Gaussians oneGaussian(const Eigen::Vector3d& mean, double scale, float logit = 2.0f) {
+  Gaussians g;
+  g.resize(1);
+  for (int k = 0; k < 3; ++k) {
+    g.means[k] = static_cast<float>(mean[k]);
+    g.log_scales[k] = static_cast<float>(std::log(scale));
+  }
+  g.rotations = {1, 0, 0, 0};
+  g.opacities = {logit};
+  g.sh = {0.5f, -0.2f, 0.1f};
+  return g;
+}
+
+// Random scenes of every SH degree with and without a background, and the stiff cases of
+// test_raster_stability.cpp: scales from 1e-6 to 1e4 of the scene's distance (and both at
+// once), opacity logits of +-30, Gaussians at and before the near plane, behind the
+// camera, on the borders and at the camera centre.
+std::vector<FisherCase> fisherCases() {
+  std::vector<FisherCase> cases;
+  const Camera cam = test::smallCamera(64, 48);
+  for (int sh = 0; sh <= 3; ++sh)
+    cases.push_back({"random sh" + std::to_string(sh), test::randomScene<double>(120, sh, 50 + sh, 1.2).cast<float>(),
+                     cam, sh, sh % 2 ? std::array<float, 3>{0.3f, 0.1f, 0.6f} : std::array<float, 3>{0, 0, 0}});
+  cases.push_back({"dense", test::randomScene<double>(400, 1, 60, 0.7).cast<float>(), test::smallCamera(50, 37), 1,
+                   {0.2f, 0.2f, 0.2f}});
+  {
+    // Large Gaussians on a larger view: offsets from the 2D mean of a hundred pixels and
+    // more, where the moments' powers of dx, dy (up to four) are largest.
+    Gaussians big = test::randomScene<double>(40, 2, 65, 1.0).cast<float>();
+    for (float& v : big.log_scales) v += 1.5f;
+    cases.push_back({"large Gaussians 256x192", big, test::smallCamera(256, 192), 2, {0.1f, 0.1f, 0.1f}});
+  }
+  const Camera small = test::smallCamera(32, 24);
+  for (double rel : {1e-6, 1e-4, 1e-2, 1.0, 1e2, 1e4})
+    cases.push_back({"scale " + std::to_string(rel), oneGaussian(Eigen::Vector3d(0.1, 0.0, 0.05), rel * 3.0), small,
+                     0, {0.1f, 0.2f, 0.3f}});
+  Gaussians aniso = oneGaussian(Eigen::Vector3d::Zero(), 1.0);
+  aniso.log_scales = {std::log(1e-6f * 3), std::log(1e4f * 3), 0.0f};
+  cases.push_back({"anisotropic 1e-6 / 1e4", aniso, small, 0, {0.1f, 0.2f, 0.3f}});
+  Gaussians logits = test::randomScene<double>(20, 1, 30).cast<float>();
+  for (std::size_t i = 0; i < logits.size(); ++i) logits.opacities[i] = (i % 2) ? 30.0f : -30.0f;
+  cases.push_back({"logits +-30", logits, small, 1, {0.1f, 0.2f, 0.3f}});
+  {
+    const Eigen::Vector3d C = small.center(), f = small.viewDirection();
+    const RasterSettings s;
+    Gaussians g;
+    g.resize(6);
+    const Eigen::Vector3d means[6] = {C + double(s.near_plane) * f, C + 0.5 * double(s.near_plane) * f, C - 1.0 * f,
+                                      small.unproject(Eigen::Vector2d(0, 12), 2.0),
+                                      small.unproject(Eigen::Vector2d(32, 24), 2.0), C};
+    for (int i = 0; i < 6; ++i) {
+      for (int k = 0; k < 3; ++k) {
+        g.means[3 * i + k] = static_cast<float>(means[i][k]);
+        g.log_scales[3 * i + k] = std::log(0.05f);
+      }
+      g.rotations[4 * i] = 1;
+      g.opacities[i] = 3.0f;
+      g.sh[3 * i] = 0.7f;
+    }
+    cases.push_back({"near plane, behind, borders", g, small, 0, {0.1f, 0.2f, 0.3f}});
+  }
+  return cases;
+}
+
+Gaussians floatInformation(const Gaussians& g, const Camera& cam, RasterSettings s, RasterKernels kernels,
+                           int threads) {
+  s.execution.kernels = kernels;
+  s.execution.threads = threads;
+  Gaussians H = g.zerosLike();
+  addViewInformationT(g, cam, s, H);
+  return H;
+}
+
+TEST(Fisher, FloatPassEqualsTheDoubleReferenceOnEveryKernelSet) {
+  for (const FisherCase& fc : fisherCases()) {
+    SCOPED_TRACE(fc.name);
+    RasterSettings s;
+    s.sh_degree = fc.sh_degree;
+    s.background = fc.background;
+    const GaussiansD gd = fc.g.cast<double>();
+    GaussiansD Hd = gd.zerosLike();
+    addViewInformationT(gd, fc.cam, s, Hd);
+    // The float render itself drifts from double where float cannot represent the
+    // projection (a 1e-6 by 1e4 covariance seen along its long axis). There the float
+    // pixel walk, with the same float inputs, is the reference for what does not go
+    // through the projection's Jacobian (opacities, SH); the means and log-scales are
+    // float noise in any float evaluation (the walk, the fast pass and double disagree
+    // by factors), so only their finiteness and sign are checked.
+    const auto rf = rasterizeT(fc.g, fc.cam, s);
+    const auto rd = rasterizeT(gd, fc.cam, s);
+    double render_drift = 0;
+    for (std::size_t k = 0; k < rf.rgb.size(); ++k) render_drift = std::max(render_drift, std::abs(rf.rgb[k] - rd.rgb[k]));
+    const bool drift = render_drift > 1e-4;
+    if (drift) {
+      Gaussians Hw = fc.g.zerosLike();
+      rasterizeSquaredGradientsWalkT(fc.g, fc.cam, s, rf, Hw);
+      Hd = Hw.cast<double>();
+    }
+    EXPECT_EQ(drift, fc.name == "anisotropic 1e-6 / 1e4") << render_drift;
+    for (const auto& [name, kernels] : test::runnableKernels()) {
+      SCOPED_TRACE(name);
+      const Gaussians Hf = floatInformation(fc.g, fc.cam, s, kernels, 0);
+      // Per entry to float precision, relative to the entry and, for entries near zero,
+      // to the largest of its array (float rounds the render's own sums).
+      auto compare = [&](const std::vector<double>& d, const std::vector<float>& f, const char* what,
+                         bool values = true) {
+        double scale = 0;
+        for (double v : d) scale = std::max(scale, std::abs(v));
+        for (std::size_t k = 0; k < d.size(); ++k) {
+          ASSERT_TRUE(std::isfinite(f[k])) << what << "[" << k << "]";
+          ASSERT_GE(f[k], 0.0f) << what << "[" << k << "]";
+          if (values) {
+            EXPECT_NEAR(f[k], d[k], 3e-4 * std::abs(d[k]) + 3e-6 * scale + 1e-12) << what << "[" << k << "]";
+          }
+        }
+      };
+      compare(Hd.means, Hf.means, "means", !drift);
+      compare(Hd.log_scales, Hf.log_scales, "log_scales", !drift);
+      compare(Hd.opacities, Hf.opacities, "opacities");
+      compare(Hd.sh, Hf.sh, "sh");
+      for (float v : Hf.rotations) EXPECT_EQ(v, 0.0f);
+    }
+  }
+}
+
+TEST(Fisher, JacobianEqualsProjectBackwardWithUnitInputs) {
+  // projectJacobian's rows (the conic ones in closed form) against projectBackward run
+  // once per input, in double, on anisotropic rotated Gaussians at every SH degree.
+  const Camera cam = test::smallCamera(64, 48);
+  for (int sh = 0; sh <= 3; ++sh) {
+    SCOPED_TRACE(sh);
+    GaussiansD g = test::randomScene<double>(60, sh, 80 + sh, 1.2);
+    for (std::size_t i = 0; i < g.size(); i += 7) g.log_scales[3 * i] = 70.0;  // clamped scale: no gradient
+    RasterSettings s;
+    s.sh_degree = sh;
+    const projection::CameraT<double> ct(cam, double(s.guard_band));
+    int checked = 0;
+    for (std::size_t i = 0; i < g.size(); ++i) {
+      const projection::Projected<double> P = projection::project(g, i, ct, s);
+      if (!P.visible) continue;
+      ++checked;
+      const auto f = projection::backwardFrame(g, i, ct, s);
+      double J[6][6];
+      projection::projectJacobian(g, i, ct, s, P, f, J);
+      for (int r = 0; r < 6; ++r) {
+        projection::ProjectedGrad<double> dP;
+        if (r < 2) dP.mean2d[r] = 1;
+        else if (r < 5) dP.conic[r - 2] = 1;
+        else dP.color[0] = dP.color[1] = dP.color[2] = 1;
+        double out[6] = {0, 0, 0, 0, 0, 0};
+        projection::ParamGradRef<double> ref;
+        ref.mean = out;
+        ref.log_scale = out + 3;
+        projection::projectBackward(g, i, ct, s, P, dP, ref);
+        double scale = 0;
+        for (double v : out) scale = std::max(scale, std::abs(v));
+        if (i % 7 == 0) {
+          // A scale clamped at e^60 has no gradient; the rest of such a Gaussian's chain is
+          // rounding noise around zero (it covers everything), in either form.
+          EXPECT_EQ(J[r][3], 0.0);
+          EXPECT_EQ(out[3], 0.0);
+          continue;
+        }
+        for (int k = 0; k < 6; ++k) EXPECT_NEAR(J[r][k], out[k], 1e-10 * scale + 1e-300) << i << " row " << r << " col " << k;
+      }
+    }
+    EXPECT_GT(checked, 20);
+  }
+}
+
+TEST(Fisher, FloatPassIsBitIdenticalAcrossRunsAndThreadCounts) {
+  const Gaussians g = test::randomScene<double>(500, 2, 70, 1.5).cast<float>();
+  const Camera cam = test::smallCamera(96, 80);
+  RasterSettings s;
+  s.sh_degree = 2;
+  s.background = {0.2f, 0.3f, 0.1f};
+  auto arrays = [](const Gaussians& H) { return std::make_tuple(H.means, H.log_scales, H.opacities, H.sh); };
+  for (const auto& [name, kernels] : test::runnableKernels()) {
+    SCOPED_TRACE(name);
+    const auto a = arrays(floatInformation(g, cam, s, kernels, 2));
+    EXPECT_TRUE(a == arrays(floatInformation(g, cam, s, kernels, 2)));
+    EXPECT_TRUE(a == arrays(floatInformation(g, cam, s, kernels, 1)));
+    EXPECT_TRUE(a == arrays(floatInformation(g, cam, s, kernels, 0)));
+  }
 }
 
 TEST(Fisher, DuplicateOfATrainViewScoresBelowAViewOfUnseenGaussians) {
