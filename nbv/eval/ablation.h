@@ -118,6 +118,11 @@ Table namedTable(const AblationGrid& g, const AblationTableSpec& spec, const std
 Table psnrVsViewsTable(const AblationGrid& g, const std::vector<JobResult>& results);
 Table timeTable(const AblationGrid& g, const std::vector<JobResult>& results);
 Table sweepTable(const std::vector<JobResult>& results);
+// Paired differences (nbv/eval/paired_stats.h) of every method against random and against
+// fisher (those in the grid), per scene, for the final-fit PSNR and the in-loop PSNR:
+// columns scene, method, baseline, metric, mean_diff, ci_low, ci_high, n, win_rate; an
+// interval over a single seed is "undefined".
+Table pairedTable(const AblationGrid& g, const std::vector<JobResult>& results);
 
 struct NamedPlot {
   std::string name;  // file stem

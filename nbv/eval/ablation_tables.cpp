@@ -7,6 +7,7 @@
 #include <tuple>
 
 #include "nbv/eval/ablation.h"
+#include "nbv/eval/paired_stats.h"
 
 namespace saresgs {
 
@@ -278,6 +279,58 @@ Table sweepTable(const std::vector<JobResult>& results) {
   return t;
 }
 
+Table pairedTable(const AblationGrid& g, const std::vector<JobResult>& results) {
+  Table t{"paired",
+          "Paired differences against a baseline (method minus baseline; same initial model, trainer seed and test "
+          "views per seed): mean over seeds, 95 % Student-t interval over seeds (undefined for one seed), seeds, and "
+          "the share of (seed, test view) pairs the method wins (ties count half). final_fit_psnr: a fresh model "
+          "trained on the chosen views; psnr: the loop's model (the paper's protocol)",
+          {"scene", "method", "baseline", "metric", "mean_diff", "ci_low", "ci_high", "n", "win_rate"},
+          {}};
+  // The run of (scene, method, variant, seed), if finished.
+  auto find = [&](const std::string& scene, const std::string& m, const std::string& v, std::uint64_t seed) -> const RunReport* {
+    for (const JobResult& r : results)
+      if (isActive(r) && r.job.scene == scene && r.job.method == m && r.job.variant == v && r.job.seed == seed) return &r.run;
+    return nullptr;
+  };
+  struct Metric {
+    const char* name;
+    std::optional<double> (*value)(const RunReport&);
+    bool final_fit;
+  };
+  const Metric metrics[] = {{"final_fit_psnr", finalPsnrOf, true}, {"psnr", psnrOf, false}};
+  auto viewPsnrs = [](const RunReport& r, bool final_fit) {
+    std::vector<double> v;
+    for (const ViewReport& x : final_fit ? r.final_fit->views : r.views) v.push_back(x.psnr);
+    return v;
+  };
+  for (const std::string baseline : {"random", "fisher"}) {
+    if (std::find(g.methods.begin(), g.methods.end(), baseline) == g.methods.end()) continue;
+    forEachCombo(g, [&](const std::string& scene, const std::string& m, const std::string& v) {
+      if (m == baseline && v == "default") return;
+      for (const Metric& metric : metrics) {
+        std::vector<double> a, b;
+        std::vector<std::vector<double>> va, vb;
+        for (std::uint64_t seed : g.seeds) {
+          const RunReport* x = find(scene, m, v, seed);
+          const RunReport* y = find(scene, baseline, "default", seed);
+          if (!x || !y || !metric.value(*x) || !metric.value(*y)) continue;
+          a.push_back(*metric.value(*x));
+          b.push_back(*metric.value(*y));
+          va.push_back(viewPsnrs(*x, metric.final_fit));
+          vb.push_back(viewPsnrs(*y, metric.final_fit));
+        }
+        if (a.empty()) continue;
+        const PairedDifference d = pairedDifference(a, b, va, vb);
+        auto opt = [](const std::optional<double>& x, int digits) { return x ? fmt(*x, digits) : std::string("undefined"); };
+        t.rows.push_back({scene, runLabel(m, v), baseline, metric.name, fmt(d.mean, 3), opt(d.ci_low, 3), opt(d.ci_high, 3),
+                          std::to_string(d.n), d.win_rate ? fmt(*d.win_rate, 3) : std::string("n/a")});
+      }
+    });
+  }
+  return t;
+}
+
 std::vector<Table> ablationTables(const AblationGrid& g, const std::vector<JobResult>& results) {
   std::vector<Table> tables{resultsTable(g, results)};
   for (const AblationTableSpec& spec : g.tables) tables.push_back(namedTable(g, spec, results));
@@ -285,6 +338,7 @@ std::vector<Table> ablationTables(const AblationGrid& g, const std::vector<JobRe
   if (Table t = psnrVsViewsTable(g, results); t.header.size() > 2) tables.push_back(std::move(t));
   if (Table t = timeTable(g, results); !t.rows.empty()) tables.push_back(std::move(t));
   if (Table t = sweepTable(results); !t.rows.empty()) tables.push_back(std::move(t));
+  if (Table t = pairedTable(g, results); !t.rows.empty()) tables.push_back(std::move(t));
   return tables;
 }
 
