@@ -581,8 +581,15 @@ void rasterizeBackwardWithSubset(const Gaussians& g, const Camera& cam, const Ra
   // Both branches' slots at the full render's pair slots: for a Gaussian in the subset
   // these are the subset render's own tiles in the same order, so its reduction below
   // adds the same terms in the same order as the subset's own backward would.
-  std::vector<float> slots_full(static_cast<std::size_t>(pairs) * kSlot, 0.0f);
-  std::vector<float> slots_sub(static_cast<std::size_t>(pairs) * kSlot, 0.0f);
+  // Per-thread scratch kept between calls, like the loss's: the two branches' slots are
+  // the largest buffers of a residual step, and allocating them afresh every step made
+  // the allocator hand the memory back and fault it in again each time (about 13 MB of
+  // page faults per 512x384 step, more than the loss itself costs).
+  thread_local std::vector<float> scratch;
+  const std::size_t branch_size = static_cast<std::size_t>(pairs) * kSlot;
+  scratch.assign(2 * branch_size, 0.0f);
+  float* const slots_full_p = scratch.data();
+  float* const slots_sub_p = scratch.data() + branch_size;
   const float bg[3] = {rs.background[0], rs.background[1], rs.background[2]};
   const raster_kernels::BackwardIn in_full{W, st.final_T.data(), st.n_walked.data(), dL_drgb_full.data.data()};
   const raster_kernels::BackwardIn in_sub{W, ss.final_T.data(), ss.n_walked.data(), dL_drgb_subset.data.data()};
@@ -596,7 +603,7 @@ void rasterizeBackwardWithSubset(const Gaussians& g, const Camera& cam, const Ra
       tilePixels(st, tile, W, H, x0, y0, x1, y1);
       const std::uint32_t b = st.tile_start[tile];
       kernel(q.data(), ss.entry_in_subset.data() + b, static_cast<int>(q.size()), x0, y0, x1, y1, bg, in_full,
-             in_sub, &st.entry_slot[b], slots_full.data(), slots_sub.data());
+             in_sub, &st.entry_slot[b], slots_full_p, slots_sub_p);
     });
   });
 
@@ -607,11 +614,11 @@ void rasterizeBackwardWithSubset(const Gaussians& g, const Camera& cam, const Ra
         if (st.gauss_start[i] == st.gauss_start[i + 1]) continue;
         // The full branch, then the subset's: each Gaussian's parameters receive the
         // two separate passes' additions in their order.
-        for (const std::vector<float>* slots : {&slots_full, &slots_sub}) {
-          if (slots == &slots_sub && !ss.mask[i]) break;
+        for (const float* slots : {slots_full_p, slots_sub_p}) {
+          if (slots == slots_sub_p && !ss.mask[i]) break;
           ProjectedGrad<float> dP;
           for (std::uint32_t k = st.gauss_start[i]; k < st.gauss_start[i + 1]; ++k) {
-            const float* sl = &(*slots)[static_cast<std::size_t>(k) * kSlot];
+            const float* sl = &slots[static_cast<std::size_t>(k) * kSlot];
             dP.opacity += sl[0];
             dP.mean2d[0] += sl[1];
             dP.mean2d[1] += sl[2];
