@@ -102,11 +102,12 @@ struct RenderPair {
 // `mask` has one byte per Gaussian (1 = in the subset).
 RenderPair rasterizeWithSubset(const Gaussians& g, const Camera& cam, const RasterSettings& s,
                                std::span<const std::uint8_t> mask);
-// Both renders' backward passes in one walk: the same additions to `grad` and
-// *grad_mean2d, in the same order, as rasterizeBackward of the full render with
-// dL_drgb_full followed by rasterizeBackward of rasterize(g, cam, s, mask) with
-// dL_drgb_subset (each branch's weight folded into its image), so the results are
-// bit-identical to those two calls.
+// Both renders' backward passes in one walk: adds to `grad` and *grad_mean2d what
+// rasterizeBackward of the full render with dL_drgb_full followed by rasterizeBackward
+// of rasterize(g, cam, s, mask) with dL_drgb_subset add (each branch's weight folded into
+// its image), up to float rounding: each Gaussian's two projected gradients are summed
+// before the chain rule instead of after. Deterministic (fixed-order sums), whatever the
+// thread count.
 void rasterizeBackwardWithSubset(const Gaussians& g, const Camera& cam, const RasterSettings& s,
                                  const RenderPair& fwd, const ImageF& dL_drgb_full,
                                  const ImageF& dL_drgb_subset, Gaussians& grad,

@@ -135,9 +135,10 @@ ViewLoss viewLossAndGradient(const Gaussians& g, const Camera& cam, const Raster
     branch(sub.mask, 1.0);
   } else {
     // Both branches from one projection, sort and tile walk, forward and backward
-    // (rasterizeWithSubset): the same renders, losses and gradient additions, in the
-    // same order, as the full branch followed by the subset branch. Drawing the subset
-    // first draws the same numbers, as the full branch uses no randomness.
+    // (rasterizeWithSubset): the same renders and losses as the full branch followed by
+    // the subset branch, and the same gradients up to float rounding (the branches'
+    // projected gradients are summed before the chain rule). Drawing the subset first
+    // draws the same numbers, as the full branch uses no randomness.
     const ResidualSubset sub = selectResidualSubset(g, res, rng);
     auto t0 = Clock::now();
     RenderPair fwd = rasterizeWithSubset(g, cam, s, sub.mask);
