@@ -471,6 +471,8 @@ constexpr PairKernelSet kPairKernelSets[] = {
     {raster_kernels::avx2::compositeTilePair, raster_kernels::avx2::backwardTilePair},
 };
 
+// The conversion rasterize() makes further down, repeated so that this block leaves the
+// single-render code untouched (it can fold into one when both settle).
 RenderResult toRenderResult(RenderOutputT<float>&& o) {
   RenderResult r;
   r.rgb.width = r.alpha.width = r.depth.width = o.width;
