@@ -182,7 +182,7 @@ inline void backStep(PairBackwardState& B, int k, const Lanes& Ln, vf dy, vf jv,
   s.c2 = fma(wcol, ww2, s.c2);
 }
 
-inline void writeSums(const TileGaussian<float>& g, const PairSums& s, float* sl) {
+__attribute__((always_inline)) inline void writeSums(const TileGaussian<float>& g, const PairSums& s, float* sl) {
   const float e = hsum(s.e), ex = hsum(s.x), ey = hsum(s.y), exx = hsum(s.xx), exy = hsum(s.xy), eyy = hsum(s.yy);
   sl[0] = e;
   sl[1] = g.o * (g.a * ex + g.b * ey);
@@ -221,7 +221,9 @@ void backwardTilePairImpl(const TileGaussian<float>* q, const std::uint8_t* in_s
     const vf zero = vs(0.0f);
     PairSums sf{zero, zero, zero, zero, zero, zero, zero, zero, zero};
     PairSums ss = sf;
-    if (c0 <= c1)
+    // The pixel loops, one instantiation per set of live branches, so that a Gaussian
+    // outside the subset (or beyond a branch's walk) runs the single-branch loop.
+    auto walk = [&]<bool kFull, bool kSub>() {
       for (int rb = r0 / kBH; rb <= r1 / kBH; ++rb) {
         int lo, hi;
         blockRowSpan(g, x0, y0, rb, c0, c1, lo, hi);
@@ -232,10 +234,16 @@ void backwardTilePairImpl(const TileGaussian<float>* q, const std::uint8_t* in_s
         for (int cb = lo & ~(kBW - 1); cb <= hi; cb += kBW) {
           const int k = (rb * kBX + cb / kBW) * L;
           const Lanes Ln = evalLanes((vs(static_cast<float>(x0 + cb)) + lane_x) - mx, ha, qy, by, o, hx, row_in);
-          if (do_full) backStep<kBg>(F, k, Ln, dy, jv, col0, col1, col2, sf);
-          if (do_sub) backStep<kBg>(S, k, Ln, dy, jv, col0, col1, col2, ss);
+          if constexpr (kFull) backStep<kBg>(F, k, Ln, dy, jv, col0, col1, col2, sf);
+          if constexpr (kSub) backStep<kBg>(S, k, Ln, dy, jv, col0, col1, col2, ss);
         }
       }
+    };
+    if (c0 <= c1) {
+      if (do_full && do_sub) walk.template operator()<true, true>();
+      else if (do_full) walk.template operator()<true, false>();
+      else walk.template operator()<false, true>();
+    }
     const std::size_t slot = static_cast<std::size_t>(entry_slot[jj]) * kSlot;
     if (do_full) writeSums(g, sf, slots_full + slot);
     if (do_sub) writeSums(g, ss, slots_subset + slot);
