@@ -88,4 +88,29 @@ void rasterizeBackward(const Gaussians& g, const Camera& cam, const RasterSettin
 void rasterizeSquaredGradients(const Gaussians& g, const Camera& cam, const RasterSettings& s,
                                const RenderResult& fwd, Gaussians& sq);
 
+// SA-ResGS's residual supervision renders, per step, the model and a subset of its
+// Gaussians (splat/train/residual.h). The subset is a mask over the same projection,
+// depth order and tile lists, and its alphas are the full render's, so both renders come
+// from one projection, one sort and one tile walk that evaluates each alpha once.
+struct SubsetRasterState;  // what the subset's backward needs (opaque)
+struct RenderPair {
+  RenderResult full;    // bit for bit rasterize(g, cam, s); its state serves rasterizeBackward
+  RenderResult subset;  // bit for bit rasterize(g, cam, s, mask) (images, contributors, radii,
+                        // visible); state is null: its backward is rasterizeBackwardWithSubset's
+  std::shared_ptr<const SubsetRasterState> subset_state;
+};
+// `mask` has one byte per Gaussian (1 = in the subset).
+RenderPair rasterizeWithSubset(const Gaussians& g, const Camera& cam, const RasterSettings& s,
+                               std::span<const std::uint8_t> mask);
+// Both renders' backward passes in one walk: adds to `grad` and *grad_mean2d what
+// rasterizeBackward of the full render with dL_drgb_full followed by rasterizeBackward
+// of rasterize(g, cam, s, mask) with dL_drgb_subset add (each branch's weight folded into
+// its image), up to float rounding: each Gaussian's two projected gradients are summed
+// before the chain rule instead of after. Deterministic (fixed-order sums), whatever the
+// thread count.
+void rasterizeBackwardWithSubset(const Gaussians& g, const Camera& cam, const RasterSettings& s,
+                                 const RenderPair& fwd, const ImageF& dL_drgb_full,
+                                 const ImageF& dL_drgb_subset, Gaussians& grad,
+                                 std::vector<float>* grad_mean2d = nullptr);
+
 }  // namespace saresgs

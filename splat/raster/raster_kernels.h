@@ -107,5 +107,35 @@ void backwardTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, 
                   const BackwardIn& in, const std::uint32_t* entry_slot, float* slots);
 }  // namespace avx2
 
+// A full render and the render of a subset of its Gaussians in one walk of the full tile
+// lists (splat/raster/raster_kernels_pair_impl.h): in_subset[j] (per tile entry) says
+// whether entry j is in the subset. Each output is bit-identical to the single-render
+// kernel's, run on that render's own tile lists, except that the subset's n_walked counts
+// full-list entries. The backward writes each branch's sums to its own slot array at the
+// full render's pair slots (an entry outside the subset leaves its subset slot alone).
+using CompositePairFn = void (*)(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0,
+                                 int y0, int x1, int y1, const float bg[3], const ForwardOut& full,
+                                 const ForwardOut& subset);
+using BackwardPairFn = void (*)(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0,
+                                int y0, int x1, int y1, const float bg[3], const BackwardIn& full,
+                                const BackwardIn& subset, const std::uint32_t* entry_slot, float* slots_full,
+                                float* slots_subset);
+
+namespace base4 {
+void compositeTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0,
+                       int x1, int y1, const float bg[3], const ForwardOut& full, const ForwardOut& subset);
+void backwardTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0, int x1,
+                      int y1, const float bg[3], const BackwardIn& full, const BackwardIn& subset,
+                      const std::uint32_t* entry_slot, float* slots_full, float* slots_subset);
+}  // namespace base4
+
+namespace avx2 {
+void compositeTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0,
+                       int x1, int y1, const float bg[3], const ForwardOut& full, const ForwardOut& subset);
+void backwardTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0, int x1,
+                      int y1, const float bg[3], const BackwardIn& full, const BackwardIn& subset,
+                      const std::uint32_t* entry_slot, float* slots_full, float* slots_subset);
+}  // namespace avx2
+
 }  // namespace raster_kernels
 }  // namespace saresgs

@@ -9,6 +9,7 @@
 #define SARESGS_KERNEL_LANES 8
 #define SARESGS_KERNEL_FMA 1
 #include "splat/raster/raster_kernels_impl.h"
+#include "splat/raster/raster_kernels_pair_impl.h"
 
 namespace saresgs::raster_kernels::avx2 {
 bool compiled() { return true; }
@@ -27,6 +28,17 @@ void backwardTile(const TileGaussian<float>*, int, int, int, int, int, const flo
 }
 void fisherTile(const TileGaussian<float>*, int, int, int, int, int, const float*, const FisherIn&,
                 const std::uint32_t*, float*) {
+  std::abort();
+}
+}  // namespace saresgs::raster_kernels::avx2
+
+namespace saresgs::raster_kernels::avx2 {
+void compositeTilePair(const TileGaussian<float>*, const std::uint8_t*, int, int, int, int, int, const float*,
+                       const ForwardOut&, const ForwardOut&) {
+  std::abort();
+}
+void backwardTilePair(const TileGaussian<float>*, const std::uint8_t*, int, int, int, int, int, const float*,
+                      const BackwardIn&, const BackwardIn&, const std::uint32_t*, float*, float*) {
   std::abort();
 }
 }  // namespace saresgs::raster_kernels::avx2

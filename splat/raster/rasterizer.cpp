@@ -24,6 +24,7 @@
 #define SARESGS_KERNEL_NS base4
 #define SARESGS_KERNEL_LANES 4
 #include "splat/raster/raster_kernels_impl.h"
+#include "splat/raster/raster_kernels_pair_impl.h"
 #undef SARESGS_KERNEL_NS
 #undef SARESGS_KERNEL_LANES
 
@@ -447,6 +448,208 @@ RenderOutputT<T> rasterizeT(const GaussiansT<T>& g, const Camera& cam, const Ras
   return out;
 }
 
+// --- The full render and a subset render in one pass (rasterizeWithSubset) -----------
+// Kept apart from the single-render code above; it reuses its stages (projectAll,
+// binAndSort) and differs only in the tile walks, which run the pair kernels
+// (splat/raster/raster_kernels_pair_impl.h).
+
+struct SubsetRasterState {
+  std::vector<std::uint8_t> mask;              // per Gaussian, as given
+  std::vector<std::uint8_t> entry_in_subset;   // per full tile entry: its Gaussian's mask
+  std::vector<float> final_T;                  // per pixel, of the subset render
+  std::vector<std::uint32_t> n_walked;         // per pixel: full-list entries walked
+};
+
+namespace {
+
+struct PairKernelSet {
+  raster_kernels::CompositePairFn composite;
+  raster_kernels::BackwardPairFn backward;
+};
+// Indexed like kKernelSets (raster_execution::kernelIndex).
+constexpr PairKernelSet kPairKernelSets[] = {
+    {raster_kernels::base4::compositeTilePair, raster_kernels::base4::backwardTilePair},
+    {raster_kernels::avx2::compositeTilePair, raster_kernels::avx2::backwardTilePair},
+};
+
+// The conversion rasterize() makes further down, repeated so that this block leaves the
+// single-render code untouched (it can fold into one when both settle).
+RenderResult toRenderResult(RenderOutputT<float>&& o) {
+  RenderResult r;
+  r.rgb.width = r.alpha.width = r.depth.width = o.width;
+  r.rgb.height = r.alpha.height = r.depth.height = o.height;
+  r.rgb.channels = 3;
+  r.alpha.channels = r.depth.channels = 1;
+  r.rgb.data = std::move(o.rgb);
+  r.alpha.data = std::move(o.alpha);
+  r.depth.data = std::move(o.depth);
+  r.contributors = std::move(o.contributors);
+  r.radii = std::move(o.radii);
+  r.visible = std::move(o.visible);
+  r.state = std::move(o.state);
+  return r;
+}
+
+void allocateImages(int W, int H, RenderOutputT<float>& out) {
+  out.width = W;
+  out.height = H;
+  out.rgb.assign(static_cast<std::size_t>(W) * H * 3, 0.0f);
+  out.alpha.assign(static_cast<std::size_t>(W) * H, 0.0f);
+  out.depth.assign(static_cast<std::size_t>(W) * H, 0.0f);
+  out.contributors.assign(static_cast<std::size_t>(W) * H, 0);
+}
+
+}  // namespace
+
+RenderPair rasterizeWithSubset(const Gaussians& g, const Camera& cam, const RasterSettings& s,
+                               std::span<const std::uint8_t> mask) {
+  if (mask.size() != g.size())
+    throw std::invalid_argument("rasterizeWithSubset: the mask needs one byte per Gaussian");
+  const int W = cam.K.width, H = cam.K.height;
+  auto st = std::make_shared<RasterStateT<float>>();
+  st->settings = s;
+  st->isa = raster_execution::kernelIndex(s.execution.kernels);
+  st->settings.sh_degree = std::clamp(s.sh_degree, 0, g.max_sh_degree);
+  st->tiles_x = (W + kTileSize - 1) / kTileSize;
+  st->tiles_y = (H + kTileSize - 1) / kTileSize;
+  const CameraT<float> camT(cam, s.guard_band);
+
+  RenderOutputT<float> full, sub;
+  const TileCover cover = projectAll(g, camT, {}, W, H, *st, full);
+  binAndSort(cover, *st);
+
+  auto ss = std::make_shared<SubsetRasterState>();
+  ss->mask.assign(mask.begin(), mask.end());
+  ss->entry_in_subset.resize(st->entry_gauss.size());
+  for (std::size_t e = 0; e < st->entry_gauss.size(); ++e)
+    ss->entry_in_subset[e] = mask[st->entry_gauss[e]] != 0;
+  // Per Gaussian, projection does not depend on the mask, so the subset's radii and
+  // visibility are the full render's where the mask keeps the Gaussian (rule 8).
+  sub.radii.assign(g.size(), 0.0f);
+  sub.visible.assign(g.size(), 0);
+  for (std::size_t i = 0; i < g.size(); ++i)
+    if (mask[i]) {
+      sub.radii[i] = full.radii[i];
+      sub.visible[i] = full.visible[i];
+    }
+
+  allocateImages(W, H, full);
+  allocateImages(W, H, sub);
+  st->final_T.assign(static_cast<std::size_t>(W) * H, 1.0f);
+  st->n_walked.assign(static_cast<std::size_t>(W) * H, 0);
+  ss->final_T.assign(static_cast<std::size_t>(W) * H, 1.0f);
+  ss->n_walked.assign(static_cast<std::size_t>(W) * H, 0);
+  const float bg[3] = {s.background[0], s.background[1], s.background[2]};
+  const raster_kernels::ForwardOut fo_full{W, full.rgb.data(), full.alpha.data(), full.depth.data(),
+                                           full.contributors.data(), st->final_T.data(), st->n_walked.data()};
+  const raster_kernels::ForwardOut fo_sub{W, sub.rgb.data(), sub.alpha.data(), sub.depth.data(),
+                                          sub.contributors.data(), ss->final_T.data(), ss->n_walked.data()};
+  const raster_kernels::CompositePairFn kernel = kPairKernelSets[st->isa].composite;
+  arena(*st).execute([&] {
+    tbb::parallel_for(0, st->tiles_x * st->tiles_y, [&](int tile) {
+      thread_local std::vector<TileGaussian<float>> q;
+      gatherTile(*st, tile, q);
+      int x0, y0, x1, y1;
+      tilePixels(*st, tile, W, H, x0, y0, x1, y1);
+      kernel(q.data(), ss->entry_in_subset.data() + st->tile_start[tile], static_cast<int>(q.size()), x0, y0, x1,
+             y1, bg, fo_full, fo_sub);
+    });
+  });
+
+  full.state = st;
+  RenderPair out;
+  out.full = toRenderResult(std::move(full));
+  out.subset = toRenderResult(std::move(sub));
+  out.subset_state = std::move(ss);
+  return out;
+}
+
+void rasterizeBackwardWithSubset(const Gaussians& g, const Camera& cam, const RasterSettings& s,
+                                 const RenderPair& fwd, const ImageF& dL_drgb_full,
+                                 const ImageF& dL_drgb_subset, Gaussians& grad,
+                                 std::vector<float>* grad_mean2d) {
+  const int W = fwd.full.rgb.width, H = fwd.full.rgb.height;
+  for (const ImageF* d : {&dL_drgb_full, &dL_drgb_subset})
+    if (d->width != W || d->height != H || d->channels != 3)
+      throw std::invalid_argument("rasterizeBackwardWithSubset: dL/drgb must match the render (3 channels)");
+  if (!fwd.full.state || !fwd.subset_state)
+    throw std::invalid_argument("rasterizeBackwardWithSubset: not a rasterizeWithSubset result");
+  if (grad_mean2d && grad_mean2d->size() != 2 * g.size()) grad_mean2d->resize(2 * g.size(), 0.0f);
+  const RasterStateT<float>& st = *fwd.full.state;
+  const SubsetRasterState& ss = *fwd.subset_state;
+  const RasterSettings& rs = st.settings;
+  const std::size_t n = g.size();
+  const std::uint32_t pairs = st.gauss_start[n];
+  constexpr int kSlot = 9;  // opacity, mean2d (2), conic (3), colour (3), as rasterizeBackwardT
+  // Both branches' slots at the full render's pair slots: for a Gaussian in the subset
+  // these are the subset render's own tiles in the same order, so each branch's sums are
+  // those of its own backward pass, bit for bit, up to the chain rule below.
+  // Per-thread scratch kept between calls, like the loss's: the two branches' slots are
+  // the largest buffers of a residual step, and allocating them afresh every step made
+  // the allocator hand the memory back and fault it in again each time (about 13 MB of
+  // page faults per 512x384 step, more than the loss itself costs).
+  thread_local std::vector<float> scratch;
+  const std::size_t branch_size = static_cast<std::size_t>(pairs) * kSlot;
+  scratch.assign(2 * branch_size, 0.0f);
+  float* const slots_full_p = scratch.data();
+  float* const slots_sub_p = scratch.data() + branch_size;
+  const float bg[3] = {rs.background[0], rs.background[1], rs.background[2]};
+  const raster_kernels::BackwardIn in_full{W, st.final_T.data(), st.n_walked.data(), dL_drgb_full.data.data()};
+  const raster_kernels::BackwardIn in_sub{W, ss.final_T.data(), ss.n_walked.data(), dL_drgb_subset.data.data()};
+  const raster_kernels::BackwardPairFn kernel = kPairKernelSets[st.isa].backward;
+  arena(st).execute([&] {
+    tbb::parallel_for(0, st.tiles_x * st.tiles_y, [&](int tile) {
+      thread_local std::vector<TileGaussian<float>> q;
+      gatherTile(st, tile, q);
+      if (q.empty()) return;
+      int x0, y0, x1, y1;
+      tilePixels(st, tile, W, H, x0, y0, x1, y1);
+      const std::uint32_t b = st.tile_start[tile];
+      kernel(q.data(), ss.entry_in_subset.data() + b, static_cast<int>(q.size()), x0, y0, x1, y1, bg, in_full,
+             in_sub, &st.entry_slot[b], slots_full_p, slots_sub_p);
+    });
+  });
+
+  arena(st).execute([&] {
+    const CameraT<float> camT(cam, rs.guard_band);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& r) {
+      for (std::size_t i = r.begin(); i < r.end(); ++i) {
+        if (st.gauss_start[i] == st.gauss_start[i + 1]) continue;
+        // Each branch's slots are reduced in slot order, as the single backward does; the
+        // two projected gradients are then added and chained once. The chain rule
+        // (projectBackward) is linear in them and costs about as much per Gaussian as
+        // its whole walk, so one call instead of two saves ~7 ms of a 256x192, 40k
+        // step; the price is rounding: the parameters get chain(full + subset) instead
+        // of chain(full) + chain(subset).
+        ProjectedGrad<float> dP[2];
+        for (int b = 0; b < 2; ++b) {
+          if (b == 1 && !ss.mask[i]) break;
+          const float* slots = b == 0 ? slots_full_p : slots_sub_p;
+          for (std::uint32_t k = st.gauss_start[i]; k < st.gauss_start[i + 1]; ++k) {
+            const float* sl = &slots[static_cast<std::size_t>(k) * kSlot];
+            dP[b].opacity += sl[0];
+            dP[b].mean2d[0] += sl[1];
+            dP[b].mean2d[1] += sl[2];
+            for (int c = 0; c < 3; ++c) dP[b].conic[c] += sl[3 + c];
+            for (int c = 0; c < 3; ++c) dP[b].color[c] += sl[6 + c];
+          }
+        }
+        dP[0].opacity += dP[1].opacity;
+        for (int c = 0; c < 2; ++c) dP[0].mean2d[c] += dP[1].mean2d[c];
+        for (int c = 0; c < 3; ++c) dP[0].conic[c] += dP[1].conic[c];
+        for (int c = 0; c < 3; ++c) dP[0].color[c] += dP[1].color[c];
+        // Both branches' 2D-mean gradients, as the two separate passes would add them
+        // (densification's statistics read their sum).
+        if (grad_mean2d) {
+          (*grad_mean2d)[2 * i] += dP[0].mean2d[0];
+          (*grad_mean2d)[2 * i + 1] += dP[0].mean2d[1];
+        }
+        projection::projectBackward(g, i, camT, rs, st.proj[i], dP[0], projection::ParamGradRef<float>::of(grad, i));
+      }
+    });
+  });
+}
+
 namespace {
 
 // Walks one pixel's contributors back to front and calls
@@ -854,6 +1057,8 @@ void rasterizeBackward(const Gaussians& g, const Camera& cam, const RasterSettin
                        std::vector<float>* grad_mean2d) {
   if (dL_drgb.width != fwd.rgb.width || dL_drgb.height != fwd.rgb.height || dL_drgb.channels != 3)
     throw std::invalid_argument("rasterizeBackward: dL/drgb must match the render (3 channels)");
+  if (!fwd.state)  // the subset of a RenderPair: rasterizeBackwardWithSubset
+    throw std::invalid_argument("rasterizeBackward: the render has no state (a RenderPair's subset?)");
   if (grad_mean2d && grad_mean2d->size() != 2 * g.size()) grad_mean2d->resize(2 * g.size(), 0.0f);
   rasterizeBackwardT(g, cam, s, view(fwd), dL_drgb.data.data(), grad, grad_mean2d);
 }

@@ -32,22 +32,28 @@ std::size_t countOf(double fraction, std::size_t n) {
   return std::min(n, static_cast<std::size_t>(std::llround(f * static_cast<double>(n))));
 }
 
+// The k smallest by (key, index), ascending by index. The order is total, so the set is
+// unique: keys are computed once (not per comparison) and the k-th element is found by
+// selection rather than by a partial sort, which runs every residual training step.
 template <typename Key>
 std::vector<int> topBy(std::size_t n, double fraction, Key key) {
+  const std::size_t k = countOf(fraction, n);
+  std::vector<float> keys(n);
+  for (std::size_t i = 0; i < n; ++i) keys[i] = key(static_cast<int>(i));
   std::vector<int> idx(n);
   std::iota(idx.begin(), idx.end(), 0);
-  const std::size_t k = countOf(fraction, n);
   auto less = [&](int a, int b) {
-    const float ka = key(a), kb = key(b);
+    const float ka = keys[static_cast<std::size_t>(a)], kb = keys[static_cast<std::size_t>(b)];
     return ka != kb ? ka < kb : a < b;
   };
-  std::partial_sort(idx.begin(), idx.begin() + static_cast<std::ptrdiff_t>(k), idx.end(), less);
+  if (k < n) std::nth_element(idx.begin(), idx.begin() + static_cast<std::ptrdiff_t>(k), idx.end(), less);
   idx.resize(k);
   std::sort(idx.begin(), idx.end());
   return idx;
 }
 
-// k distinct indices of [0, n) (partial Fisher-Yates), ascending.
+// k distinct indices of [0, n) (partial Fisher-Yates), ascending. They are listed by
+// marking and scanning rather than by sorting (same set, same order, O(n)).
 std::vector<int> sampleWithoutReplacement(std::size_t n, std::size_t k, std::mt19937_64& rng) {
   std::vector<int> idx(n);
   std::iota(idx.begin(), idx.end(), 0);
@@ -55,8 +61,11 @@ std::vector<int> sampleWithoutReplacement(std::size_t n, std::size_t k, std::mt1
     std::uniform_int_distribution<std::size_t> pick(i, n - 1);
     std::swap(idx[i], idx[pick(rng)]);
   }
-  idx.resize(k);
-  std::sort(idx.begin(), idx.end());
+  std::vector<std::uint8_t> chosen(n, 0);
+  for (std::size_t i = 0; i < k; ++i) chosen[static_cast<std::size_t>(idx[i])] = 1;
+  idx.clear();
+  for (std::size_t i = 0; i < n; ++i)
+    if (chosen[i]) idx.push_back(static_cast<int>(i));
   return idx;
 }
 

@@ -130,10 +130,32 @@ ViewLoss viewLossAndGradient(const Gaussians& g, const Camera& cam, const Raster
   };
   if (!res.enabled) {
     branch({}, 1.0);
-  } else {
-    if (!res.sub_only) branch({}, res.lambda_full);
+  } else if (res.sub_only) {
     const ResidualSubset sub = selectResidualSubset(g, res, rng);
-    branch(sub.mask, res.sub_only ? 1.0 : res.lambda_sub);
+    branch(sub.mask, 1.0);
+  } else {
+    // Both branches from one projection, sort and tile walk, forward and backward
+    // (rasterizeWithSubset): the same renders and losses as the full branch followed by
+    // the subset branch, and the same gradients up to float rounding (the branches'
+    // projected gradients are summed before the chain rule). Drawing the subset first
+    // draws the same numbers, as the full branch uses no randomness.
+    const ResidualSubset sub = selectResidualSubset(g, res, rng);
+    auto t0 = Clock::now();
+    RenderPair fwd = rasterizeWithSubset(g, cam, s, sub.mask);
+    seconds.render += since(t0);
+    t0 = Clock::now();
+    LossResult Lf = photometricLoss(fwd.full.rgb, target, lambda_ssim, true);
+    scaleImage(Lf.grad, static_cast<float>(res.lambda_full));
+    LossResult Ls = photometricLoss(fwd.subset.rgb, target, lambda_ssim, true);
+    scaleImage(Ls.grad, static_cast<float>(res.lambda_sub));
+    seconds.loss += since(t0);
+    t0 = Clock::now();
+    rasterizeBackwardWithSubset(g, cam, s, fwd, Lf.grad, Ls.grad, grad, &grad_mean2d);
+    seconds.backward += since(t0);
+    out.loss += res.lambda_full * Lf.loss;
+    out.loss += res.lambda_sub * Ls.loss;
+    out.radii = std::move(fwd.full.radii);
+    out.visible = std::move(fwd.full.visible);
   }
   return out;
 }

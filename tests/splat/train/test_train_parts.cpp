@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <random>
 #include <set>
 
@@ -352,6 +353,48 @@ TEST(TrainResidual, SameGeneratorStateSameSubset) {
   std::mt19937_64 a(11), b(11);
   EXPECT_EQ(selectResidualSubset(g, o, a).mask, selectResidualSubset(g, o, b).mask);
   EXPECT_NE(selectResidualSubset(g, o, a).random, selectResidualSubset(g, o, a).random);
+}
+
+// selectResidualSubset against a plain restatement of its definition (the partial
+// Fisher-Yates draw; the rankings as a full sort by (key, index)), on keys with many ties
+// and a NaN, so a faster selection cannot change which Gaussians train.
+TEST(TrainResidual, SubsetEqualsItsDefinition) {
+  const std::size_t n = 2000;
+  Gaussians g = rankedModel(static_cast<int>(n));
+  for (std::size_t i = 0; i < n; ++i) {
+    g.opacities[i] = static_cast<float>(i % 17);  // ties
+    for (int k = 0; k < 3; ++k) g.log_scales[3 * i + k] = static_cast<float>((i * (k + 3)) % 23);
+  }
+  g.opacities[77] = NAN;
+  ResidualOptions o;
+  std::mt19937_64 rng(5), ref_rng(5);
+  const ResidualSubset s = selectResidualSubset(g, o, rng);
+
+  std::vector<int> idx(n);
+  std::iota(idx.begin(), idx.end(), 0);
+  const std::size_t k = 1800;
+  for (std::size_t i = 0; i < k; ++i) {
+    std::uniform_int_distribution<std::size_t> pick(i, n - 1);
+    std::swap(idx[i], idx[pick(ref_rng)]);
+  }
+  std::vector<int> random(idx.begin(), idx.begin() + k);
+  std::sort(random.begin(), random.end());
+  EXPECT_EQ(s.random, random);
+  auto top = [&](auto key) {
+    std::vector<int> all(n);
+    std::iota(all.begin(), all.end(), 0);
+    std::stable_sort(all.begin(), all.end(), [&](int a, int b) { return key(a) < key(b); });
+    std::vector<int> t(all.begin(), all.begin() + 200);
+    std::sort(t.begin(), t.end());
+    return t;
+  };
+  const auto a = top([&](int i) { return std::isnan(g.opacities[i]) ? -INFINITY : g.opacities[i]; });
+  const auto b = top([&](int i) {
+    return -std::max({g.log_scales[3 * i], g.log_scales[3 * i + 1], g.log_scales[3 * i + 2]});
+  });
+  std::vector<int> uncertain;
+  std::set_union(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(uncertain));
+  EXPECT_EQ(s.uncertain, uncertain);
 }
 
 }  // namespace
