@@ -41,6 +41,7 @@ ActiveOptions activeOptions(const ActiveArgs& a) {
   o.method = parseMethod(a.method);
   o.seed = a.seed;
   o.trainer.raster.execution.threads = a.threads;
+  o.final_trainer.raster.execution.threads = a.threads;
   o.fisher_lambda = a.fisher_lambda;
   o.reset_after_add = !a.continue_training;
   o.time_exhaustive_fisher = a.time_exhaustive_fisher;
@@ -49,7 +50,10 @@ ActiveOptions activeOptions(const ActiveArgs& a) {
   if (a.interval) o.interval = *a.interval;
   if (a.total) o.total_iterations = *a.total;
   if (a.final_iterations) o.final_iterations = *a.final_iterations;
-  if (a.max_gaussians) o.trainer.densify.max_gaussians = static_cast<std::size_t>(*a.max_gaussians);
+  if (a.max_gaussians) {
+    o.trainer.densify.max_gaussians = static_cast<std::size_t>(*a.max_gaussians);
+    o.final_trainer.densify.max_gaussians = o.trainer.densify.max_gaussians;
+  }
   if (a.beta) o.trainer.residual.beta = *a.beta;
   if (!a.ranking.empty()) o.trainer.residual.ranking = parseUncertaintyRanking(a.ranking);
   if (a.sub_only) o.trainer.residual.sub_only = true;

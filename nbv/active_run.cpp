@@ -42,7 +42,7 @@ ActiveRun::ActiveRun(const Scene& scene, const ActiveOptions& opt, std::string c
 }
 
 TrainerOptions finalFitOptions(const ActiveOptions& o) {
-  TrainerOptions t = o.trainer;
+  TrainerOptions t = o.final_trainer;
   t.seed = o.seed;
   t.residual.enabled = false;
   return t;

@@ -41,6 +41,10 @@ struct ActiveOptions {
   // chosen views for this many iterations (0: none), so that the views can be judged
   // apart from the loop's schedule. Plain 3DGS for every method (finalFitOptions).
   int final_iterations = 0;
+  // Its trainer options: 3DGS's own schedule (a fit of a few thousand iterations on 20
+  // views is 3DGS's first iterations, not a quarter-speed loop phase), with the preset's
+  // model cap and SH degree; residual supervision and the seed are set by finalFitOptions.
+  TrainerOptions final_trainer;
   TrainerOptions trainer;
   std::uint64_t seed = 0;
 };
@@ -85,9 +89,9 @@ struct ActiveResult {
   double seconds = 0;  // end to end, this process
 };
 
-// The trainer options of the final fit: the run's (preset schedule, cap, SH degree, seed)
-// without residual supervision, the same for every method; `saresgs train` with these
-// options on the chosen views trains the same model.
+// The trainer options of the final fit: final_trainer with the run's seed and without
+// residual supervision, the same for every method; `saresgs train` with these options on
+// the chosen views trains the same model.
 TrainerOptions finalFitOptions(const ActiveOptions& o);
 
 class ActiveRun {
