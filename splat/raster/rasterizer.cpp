@@ -472,8 +472,7 @@ constexpr PairKernelSet kPairKernelSets[] = {
     {raster_kernels::avx2::compositeTilePair, raster_kernels::avx2::backwardTilePair},
 };
 
-// The conversion rasterize() makes further down, repeated so that this block leaves the
-// single-render code untouched (it can fold into one when both settle).
+// The public result of a float render (rasterize() and rasterizeWithSubset()).
 RenderResult toRenderResult(RenderOutputT<float>&& o) {
   RenderResult r;
   r.rgb.width = r.alpha.width = r.depth.width = o.width;
@@ -1025,20 +1024,7 @@ void rasterizeSquaredGradientsT(const GaussiansT<T>& g, const Camera& cam, const
 
 RenderResult rasterize(const Gaussians& g, const Camera& cam, const RasterSettings& s,
                        std::span<const std::uint8_t> mask) {
-  RenderOutputT<float> o = rasterizeT(g, cam, s, mask);
-  RenderResult r;
-  r.rgb.width = r.alpha.width = r.depth.width = o.width;
-  r.rgb.height = r.alpha.height = r.depth.height = o.height;
-  r.rgb.channels = 3;
-  r.alpha.channels = r.depth.channels = 1;
-  r.rgb.data = std::move(o.rgb);
-  r.alpha.data = std::move(o.alpha);
-  r.depth.data = std::move(o.depth);
-  r.contributors = std::move(o.contributors);
-  r.radii = std::move(o.radii);
-  r.visible = std::move(o.visible);
-  r.state = std::move(o.state);
-  return r;
+  return toRenderResult(rasterizeT(g, cam, s, mask));
 }
 
 namespace {
