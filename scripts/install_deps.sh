@@ -11,6 +11,8 @@ packages=(
   libopencv-dev libcgal-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev libcli11-dev
   # COLMAP: the tests convert our models with `colmap model_converter`; `--sfm colmap`
   colmap libsqlite3-dev
+  # GNU parallel: shards of an ablation grid on one machine (results/README.md)
+  parallel
   # CC0 meshes (/usr/share/doc/libcgal-dev/data.tar.gz) and photographs for textures
   libcgal-demo opencv-doc
 )

@@ -120,3 +120,27 @@ TEST(AblateCli, AKilledRunnerRestartsWithoutRedoingFinishedJobs) {
   EXPECT_EQ(count(r.output, "finished before, skipped"), 5) << r.output;
   EXPECT_TRUE(fs::exists(out + "/tables/results.md"));
 }
+
+// The GNU-parallel path of results/README.md: two shards into one output folder at once,
+// then a merge; every job runs exactly once (a finished job's folder holds one result).
+TEST(AblateCli, GnuParallelShardsIntoOneFolderThenMerge) {
+  TempDir d;
+  const std::string grid = writeGrid(d);
+  const std::string out = d.file("out");
+  Result r = shell("parallel --version");
+  ASSERT_EQ(r.code, 0) << "GNU parallel is missing (bash scripts/install_deps.sh installs it): " << r.output;
+  r = shell("parallel -j 2 --halt now,fail=1 " + cli() + " ablate --config " + grid + " --out " + out +
+            " --shard {}/2 ::: 0 1");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(count(r.output, "shard 0/2 done"), 1) << r.output;
+  EXPECT_EQ(count(r.output, "shard 1/2 done"), 1) << r.output;
+  r = shell(cli() + " ablate merge --config " + grid + " --out " + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("from 5 of 5 jobs"), std::string::npos) << r.output;
+  int results = 0;
+  for (const auto& e : fs::recursive_directory_iterator(out + "/runs"))
+    results += e.path().filename() == "results.json" || e.path().filename() == "sweep.json";
+  EXPECT_EQ(results, 5);
+  EXPECT_TRUE(fs::exists(out + "/tables/paired.csv"));
+  EXPECT_EQ(readBytes(out + "/tables/paired.csv").rfind("scene,method,baseline,metric,mean_diff,ci_low,ci_high,n,win_rate\n", 0), 0u);
+}
