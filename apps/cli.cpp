@@ -4,6 +4,7 @@
 
 #include <exception>
 #include <iostream>
+#include <string>
 
 #include "apps/commands.h"
 
@@ -21,6 +22,17 @@ int runCli(const std::vector<std::string>& args) {
   addActiveCommand(app, action);
   addCoverageCommand(app, action);
   addAblateCommand(app, action);
+  // An unknown first word would otherwise read "A subcommand is required".
+  std::string names;
+  bool known = false;
+  for (const CLI::App* s : app.get_subcommands({})) {
+    names += (names.empty() ? "" : ", ") + s->get_name();
+    known = known || (!args.empty() && s->get_name() == args[0]);
+  }
+  if (!args.empty() && !args[0].empty() && args[0][0] != '-' && !known) {
+    std::cerr << "saresgs: error: unknown subcommand '" << args[0] << "': expected one of " << names << "\n";
+    return 2;
+  }
   try {
     // CLI11 takes a vector of arguments in reverse order.
     app.parse(std::vector<std::string>(args.rbegin(), args.rend()));

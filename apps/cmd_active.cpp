@@ -4,6 +4,7 @@
 #include <iostream>
 #include <optional>
 
+#include "apps/cli_checks.h"
 #include "apps/commands.h"
 #include "apps/prefilter_flags.h"
 #include "apps/progress.h"
@@ -116,16 +117,16 @@ void addActiveCommand(CLI::App& app, Action& action) {
   sub->add_option("--dataset", a->dataset, "COLMAP, Blender or `saresgs scene` folder")->required();
   sub->add_option("--out", a->out, "Output folder")->required();
   sub->add_option("--method", a->method, methodChoices())->check(CLI::IsMember(methodNames()))->capture_default_str();
-  sub->add_option("--seed", a->seed, "Random seed")->capture_default_str();
+  sub->add_option("--seed", a->seed, "Random seed")->check(wholeNumberAtLeast(0))->capture_default_str();
   sub->add_option("--preset", a->preset, "quick | paper")->capture_default_str();
-  sub->add_option("--max-views", a->max_views, "Views at the end (default 20)")->check(CLI::PositiveNumber);
-  sub->add_option("--interval", a->interval, "Iterations per view held (preset's by default)")->check(CLI::PositiveNumber);
-  sub->add_option("--iterations", a->total, "Total iterations (preset's by default)")->check(CLI::PositiveNumber);
+  sub->add_option("--max-views", a->max_views, "Views at the end (default 20)")->check(wholeNumberAtLeast(1));
+  sub->add_option("--interval", a->interval, "Iterations per view held (preset's by default)")->check(wholeNumberAtLeast(1));
+  sub->add_option("--iterations", a->total, "Total iterations (preset's by default)")->check(wholeNumberAtLeast(1));
   sub->add_option("--final-iterations", a->final_iterations,
                   "Final fit: a fresh model trained on the chosen views for N iterations (0: none; preset's by default)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(wholeNumberAtLeast(0));
   sub->add_option("--max-gaussians", a->max_gaussians, "Cap on the model size (0: none; preset's by default)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0.0, 1e9));
   sub->add_option("--residual-beta", a->beta, "Uncertain fraction of the residual subset (default 0.1)")->check(CLI::Range(0.0, 1.0));
   sub->add_option("--residual-ranking", a->ranking, "Uncertainty ranking: both | opacity | scale | random (default both)")
       ->check(CLI::IsMember({"both", "opacity", "scale", "random"}));
@@ -134,7 +135,7 @@ void addActiveCommand(CLI::App& app, Action& action) {
                 "Keep training the same model after each addition instead of resetting it");
   sub->add_option("--fvs-metric", a->fvs_metric, "euclidean | great-circle")
       ->check(CLI::IsMember({"euclidean", "great-circle"}))->capture_default_str();
-  sub->add_option("--fisher-lambda", a->fisher_lambda, "Fisher damping")->capture_default_str();
+  sub->add_option("--fisher-lambda", a->fisher_lambda, "Fisher damping lambda (> 0)")->check(positiveNumber())->capture_default_str();
   sub->add_option("--prefilter-set", a->prefilter.set, "frustum | visible")->capture_default_str();
   sub->add_option("--prefilter-encoding", a->prefilter.encoding, "hash:K (11..19) | exact")->capture_default_str();
   sub->add_option("--prefilter-score", a->prefilter.score, "xor | new")->capture_default_str();

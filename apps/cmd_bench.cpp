@@ -13,6 +13,8 @@
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -22,7 +24,9 @@
 #include <optional>
 #include <random>
 
+#include "apps/cli_checks.h"
 #include "apps/commands.h"
+#include "geometry/error.h"
 #include "geometry/occupancy/candidate_sets.h"
 #include "geometry/occupancy/coverage_score.h"
 #include "geometry/occupancy/occupancy_grid.h"
@@ -155,7 +159,22 @@ nlohmann::json stageJson(const StageSeconds& s, int steps) {
   return {{"render", s.render * k}, {"loss", s.loss * k}, {"backward", s.backward * k}, {"adam", s.optimizer * k}};
 }
 
+// Refuses, before allocating, a scene the machine cannot hold: about 1.2 kB per Gaussian
+// (parameters, gradients, Adam moments, projections, tile pairs at this coverage) and
+// 200 B per pixel (images, per-pixel state, loss buffers), against half the memory.
+void checkBenchSize(const BenchArgs& a) {
+  const double need = 1200.0 * a.gaussians * std::max(1.0, a.coverage / 16) + 200.0 * a.width * a.height;
+  const double have = static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGE_SIZE));
+  if (have > 0 && need > 0.5 * have) {
+    char msg[256];
+    std::snprintf(msg, sizeof msg, "needs about %.1f GB for %lld Gaussians at %dx%d; the limit is half this machine's memory, %.1f GB",
+                  need / 1e9, static_cast<long long>(a.gaussians), a.width, a.height, 0.5 * have / 1e9);
+    throw InputError("--gaussians/--width/--height", "size", msg);
+  }
+}
+
 int runBench(const BenchArgs& a) {
+  checkBenchSize(a);
   const Camera cam = benchCamera(a);
   RasterSettings s;
   s.sh_degree = a.sh_degree;
@@ -196,6 +215,7 @@ int runBench(const BenchArgs& a) {
 // addViewInformation (forward + Fisher pass) and the backward pass of the same view, each
 // timed per iteration in the same loop so that load changes hit all three alike.
 int runFisherBench(const BenchArgs& a) {
+  checkBenchSize(a);
   const Camera cam = benchCamera(a);
   RasterSettings s;
   s.sh_degree = a.sh_degree;
@@ -411,7 +431,7 @@ void addBenchCommand(CLI::App& app, Action& action) {
   step->add_option("--steps", a->steps, "Timed steps")->check(CLI::Range(1, 100000))->capture_default_str();
   step->add_option("--warmup", a->warmup, "Untimed steps first")->check(CLI::Range(0, 100000))->capture_default_str();
   step->add_option("--threads", a->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
-  step->add_option("--seed", a->seed, "Scene seed")->capture_default_str();
+  step->add_option("--seed", a->seed, "Scene seed")->check(wholeNumberAtLeast(0))->capture_default_str();
   step->add_flag("--residual", a->residual, "Time residual-supervision steps too, and their ratio to plain ones");
   step->callback([&action, a] { action = [a] { return runBench(*a); }; });
 
@@ -429,7 +449,7 @@ void addBenchCommand(CLI::App& app, Action& action) {
   fisher->add_option("--steps", f->steps, "Timed iterations")->check(CLI::Range(1, 100000))->capture_default_str();
   fisher->add_option("--warmup", f->warmup, "Untimed iterations first")->check(CLI::Range(0, 100000))->capture_default_str();
   fisher->add_option("--threads", f->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
-  fisher->add_option("--seed", f->seed, "Scene seed")->capture_default_str();
+  fisher->add_option("--seed", f->seed, "Scene seed")->check(wholeNumberAtLeast(0))->capture_default_str();
   fisher->callback([&action, f] { action = [f] { return runFisherBench(*f); }; });
 
   auto o = std::make_shared<OccupancyBenchArgs>();
@@ -444,7 +464,7 @@ void addBenchCommand(CLI::App& app, Action& action) {
   occ->add_option("--min-points", o->min_points, "SfM points for an occupied coarse voxel")
       ->check(CLI::Range(1, 1000000))->capture_default_str();
   occ->add_option("--threads", o->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
-  occ->add_option("--seed", o->seed, "Scene and SfM seed")->capture_default_str();
+  occ->add_option("--seed", o->seed, "Scene and SfM seed")->check(wholeNumberAtLeast(0))->capture_default_str();
   occ->callback([&action, o] { action = [o] { return runOccupancyBench(*o); }; });
 }
 

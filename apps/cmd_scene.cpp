@@ -1,6 +1,7 @@
 // saresgs scene: writes a ground-truth synthetic dataset (COLMAP model, images, depth).
 #include <iostream>
 
+#include "apps/cli_checks.h"
 #include "apps/commands.h"
 #include "apps/progress.h"
 #include "geometry/synth/assets.h"
@@ -50,14 +51,14 @@ void addSceneCommand(CLI::App& app, Action& action) {
   sub->add_option("--out", args->out, "Output folder")->required();
   sub->add_option("--width", args->scene.width, "Image width")->check(CLI::Range(16, 8192))->capture_default_str();
   sub->add_option("--height", args->scene.height, "Image height")->check(CLI::Range(16, 8192))->capture_default_str();
-  sub->add_option("--seed", args->scene.seed, "Random seed")->capture_default_str();
-  sub->add_option("--views", args->scene.num_views, "Number of views (0: the layout's default)");
+  sub->add_option("--seed", args->scene.seed, "Random seed")->check(wholeNumberAtLeast(0))->capture_default_str();
+  sub->add_option("--views", args->scene.num_views, "Number of views (0: the layout's default)")->check(CLI::Range(0, 100000));
   sub->add_option("--mesh", args->scene.meshes, "Mesh files (OFF/PLY/OBJ) or cgal:NAME; default procedural");
   sub->add_option("--texture", args->scene.textures, "Photographs (PNG/JPEG) or opencv:FILE; default procedural");
   sub->add_option("--up", args->scene.up_axis, "Up axis of the mesh files")->check(CLI::IsMember({"x", "y", "z"}))->capture_default_str();
   sub->add_option("--projection", args->scene.projection, "Photograph mapping")
       ->check(CLI::IsMember({"triplanar", "spherical"}))->capture_default_str();
-  sub->add_option("--spp", args->write.render.samples_per_pixel, "Samples per pixel (>= 4)")->capture_default_str();
+  sub->add_option("--spp", args->write.render.samples_per_pixel, "Samples per pixel (>= 4)")->check(CLI::Range(4, 4096))->capture_default_str();
   sub->add_flag("--specular", args->write.render.specular, "Add a mild specular highlight");
   sub->add_option("--sfm", args->write.sfm, "Sparse points: simulated | colmap | none")
       ->check(CLI::IsMember({"simulated", "colmap", "none"}))->capture_default_str();

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "apps/cli_checks.h"
 #include "apps/commands.h"
 #include "apps/progress.h"
 #include "apps/view_list.h"
@@ -117,11 +118,11 @@ void addTrainCommand(CLI::App& app, Action& action) {
   sub->add_option("--iterations", a->iterations, "Training iterations")->check(CLI::Range(1, 10000000))->capture_default_str();
   sub->add_option("--downscale", a->downscale, "Image downscale factor")->check(CLI::Range(1, 64))->capture_default_str();
   sub->add_option("--sh-degree", a->opt.max_sh_degree, "Maximum SH degree")->check(CLI::Range(0, 3))->capture_default_str();
-  sub->add_option("--seed", a->opt.seed, "Random seed")->capture_default_str();
+  sub->add_option("--seed", a->opt.seed, "Random seed")->check(wholeNumberAtLeast(0))->capture_default_str();
   sub->add_option("--threads", a->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
-  sub->add_option("--densify-until", a->opt.densify.until_iter, "Last densification iteration")->capture_default_str();
-  sub->add_option("--max-gaussians", a->opt.densify.max_gaussians, "Cap on the model size (0: none)")->capture_default_str();
-  sub->add_option("--random-init", a->opt.random_init_points, "Random points when the dataset has none")->capture_default_str();
+  sub->add_option("--densify-until", a->opt.densify.until_iter, "Last densification iteration")->check(wholeNumberAtLeast(0))->capture_default_str();
+  sub->add_option("--max-gaussians", a->opt.densify.max_gaussians, "Cap on the model size (0: none)")->check(CLI::Range(0.0, 1e9))->capture_default_str();
+  sub->add_option("--random-init", a->opt.random_init_points, "Random points when the dataset has none")->check(CLI::Range(1, 10000000))->capture_default_str();
   sub->add_flag("--residual", a->opt.residual.enabled, "Add SA-ResGS residual supervision");
   sub->add_option("--views", a->views,
                   "Train on these train views only, in this order (indices or image names, comma-separated; e.g. an "
@@ -133,7 +134,7 @@ void addTrainCommand(CLI::App& app, Action& action) {
   sub->add_option("--residual-beta", a->opt.residual.beta, "Uncertain fraction of G_sub")->check(CLI::Range(0.0, 1.0))->capture_default_str();
   sub->add_option("--residual-ranking", a->ranking, "both | opacity | scale | random")
       ->check(CLI::IsMember({"both", "opacity", "scale", "random"}))->capture_default_str();
-  sub->add_option("--checkpoint-every", a->checkpoint_every, "Iterations between checkpoints (0: none)")->capture_default_str();
+  sub->add_option("--checkpoint-every", a->checkpoint_every, "Iterations between checkpoints (0: none)")->check(wholeNumberAtLeast(0))->capture_default_str();
   sub->add_flag("--resume", a->resume, "Continue from OUT/checkpoint.bin when it exists");
   sub->callback([&action, a] { action = [a] { return runTrain(*a); }; });
 }

@@ -53,6 +53,36 @@ TEST(Cli, BadInputGivesAClearErrorAndNonZeroExit) {
 
   r = run("");
   EXPECT_NE(r.code, 0);
+
+  // An unknown subcommand is named, with the choices.
+  r = run("nosuch");
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.output.find("unknown subcommand 'nosuch'"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("active"), std::string::npos) << r.output;
+
+  // Values that used to be accepted silently (negative seeds wrapped to 2^64 - 1, a
+  // negative Fisher damping, a negative view count read as the default) are refused by
+  // option name, before any work.
+  for (const auto& [args, option] : std::vector<std::pair<std::string, std::string>>{
+           {"scene --layout object --views -5 --out " + d.file("v"), "--views"},
+           {"scene --layout object --views 2000000000 --out " + d.file("v"), "--views"},
+           {"scene --layout object --seed -1 --out " + d.file("v"), "--seed"},
+           {"train --dataset " + d.file("missing") + " --seed -3 --out " + d.file("t"), "--seed"},
+           {"train --dataset " + d.file("missing") + " --max-gaussians -1 --out " + d.file("t"), "--max-gaussians"},
+           {"active --dataset " + d.file("missing") + " --fisher-lambda -1 --out " + d.file("a"), "--fisher-lambda"},
+           {"active --dataset " + d.file("missing") + " --max-views 0 --out " + d.file("a"), "--max-views"},
+           {"active --dataset " + d.file("missing") + " --seed 12abc --out " + d.file("a"), "--seed"}}) {
+    r = run(args);
+    EXPECT_NE(r.code, 0) << args;
+    EXPECT_NE(r.output.find(option), std::string::npos) << args << ": " << r.output;
+  }
+  EXPECT_FALSE(fs::exists(d.path() / "v"));
+
+  // A benchmark too large for the machine is refused up front, naming the limit.
+  r = run("bench step --width 16384 --height 16384 --gaussians 100000000");
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.output.find("--gaussians"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("half this machine's memory"), std::string::npos) << r.output;
 }
 
 // One small scene for the pipeline commands: train, its outputs read back by real

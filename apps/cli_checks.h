@@ -1,0 +1,46 @@
+#pragma once
+// Option checks with messages a user can read (CLI11's own NonNegativeNumber prints the
+// largest double as the upper bound). Each runs on the text, before the conversion, so a
+// negative value never wraps into an unsigned option.
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <string>
+
+namespace saresgs::apps {
+
+// A whole number >= `min` (seeds, counts, caps).
+inline CLI::Validator wholeNumberAtLeast(long long min) {
+  return CLI::Validator(
+      [min](std::string& s) -> std::string {
+        std::size_t used = 0;
+        long long v = 0;
+        try {
+          v = std::stoll(s, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used != s.size() || s.empty() || v < min) return "'" + s + "': expected a whole number >= " + std::to_string(min);
+        return {};
+      },
+      "INT>=" + std::to_string(min));
+}
+
+// A finite number > 0.
+inline CLI::Validator positiveNumber() {
+  return CLI::Validator(
+      [](std::string& s) -> std::string {
+        std::size_t used = 0;
+        double v = 0;
+        try {
+          v = std::stod(s, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used != s.size() || s.empty() || !std::isfinite(v) || !(v > 0)) return "'" + s + "': expected a number > 0";
+        return {};
+      },
+      "NUMBER>0");
+}
+
+}  // namespace saresgs::apps
