@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
@@ -233,6 +234,35 @@ void ActiveRun::saveCheckpoint() const {
   std::filesystem::remove(checkpoint_ + ".prefilter." + std::to_string(previous), ec);
 }
 
+// Every field read from a checkpoint is checked against the run it belongs to, so that a
+// corrupt or foreign file cannot index out of range or plan a runaway phase.
+void ActiveRun::checkLoadedState() const {
+  const int n_initial = std::min<int>(opt_.initial_views, static_cast<int>(scene_.train.size()));
+  if (static_cast<int>(initial_.size()) != n_initial)
+    throw InputError(checkpoint_, "initial", "expected " + std::to_string(n_initial) + " initial views");
+  if (selected_.size() < initial_.size() || !std::equal(initial_.begin(), initial_.end(), selected_.begin()))
+    throw InputError(checkpoint_, "selected", "does not start with the initial views");
+  if (static_cast<int>(selected_.size()) > std::max(opt_.max_views, n_initial))
+    throw InputError(checkpoint_, "selected", "holds more views than --max-views " + std::to_string(opt_.max_views));
+  std::vector<int> seen;
+  for (int v : selected_) {
+    if (std::find(scene_.train.begin(), scene_.train.end(), v) == scene_.train.end())
+      throw InputError(checkpoint_, "selected", std::to_string(v) + " is not a train view of this dataset");
+    if (std::find(seen.begin(), seen.end(), v) != seen.end())
+      throw InputError(checkpoint_, "selected", std::to_string(v) + " appears twice");
+    seen.push_back(v);
+  }
+  // The phases so far trained k x interval iterations for k = initial .. held - 1.
+  long long expected = 0;
+  for (std::size_t k = initial_.size(); k < selected_.size(); ++k) expected += static_cast<long long>(k) * opt_.interval;
+  if (iterations_done_ != expected)
+    throw InputError(checkpoint_, "iterations_done",
+                     std::to_string(iterations_done_) + ", expected " + std::to_string(expected) +
+                         " for these views at --interval " + std::to_string(opt_.interval));
+  if (observed_upto_ < 0 || observed_upto_ > static_cast<int>(selected_.size()))
+    throw InputError(checkpoint_, "observed_upto", "outside 0.." + std::to_string(selected_.size()));
+}
+
 bool ActiveRun::loadCheckpoint() {
   if (checkpoint_.empty() || !std::filesystem::exists(checkpoint_)) return false;
   const nlohmann::json j = readJsonFile(checkpoint_);
@@ -248,18 +278,29 @@ bool ActiveRun::loadCheckpoint() {
   try {
     initial_ = field("initial").get<std::vector<int>>();
     selected_ = field("selected").get<std::vector<int>>();
-    iterations_done_ = field("iterations_done");
-    observed_upto_ = field("observed_upto");
+    // Read as numbers first: a huge or fractional value must not be converted blindly.
+    for (const char* name : {"iterations_done", "observed_upto"}) {
+      const double x = field(name).get<double>();
+      if (!(x >= 0 && x <= 2e9 && x == std::floor(x))) throw InputError(checkpoint_, name, "not a count: " + j[name].dump());
+    }
+    iterations_done_ = field("iterations_done").get<int>();
+    observed_upto_ = field("observed_upto").get<int>();
     std::istringstream rs(field("rng").get<std::string>());
     rs >> rng_;
   } catch (const nlohmann::json::exception& e) {
     throw InputError(checkpoint_, "state", std::string("unexpected content: ") + e.what());
   }
+  checkLoadedState();
   steps_.clear();
   const nlohmann::json& steps = field("steps");
   if (!steps.is_array()) throw InputError(checkpoint_, "steps", "expected an array");
   for (std::size_t i = 0; i < steps.size(); ++i)
     steps_.push_back(selectionLog(scene_, stepReportFromJson(steps[i], checkpoint_, "steps[" + std::to_string(i) + "]"), checkpoint_));
+  if (steps_.size() != selected_.size() - initial_.size())
+    throw InputError(checkpoint_, "steps", std::to_string(steps_.size()) + " steps for " +
+                                               std::to_string(selected_.size() - initial_.size()) + " added views");
+  if (field("tag") != std::to_string(selected_.size()))
+    throw InputError(checkpoint_, "tag", "expected \"" + std::to_string(selected_.size()) + "\", the number of views held");
   const std::string tag = field("tag");
   trainer_->loadCheckpoint(checkpoint_ + ".trainer." + tag);
   if (prefilter_) prefilter_->load(readFile(checkpoint_ + ".prefilter." + tag));

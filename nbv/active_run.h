@@ -109,6 +109,7 @@ class ActiveRun {
   void report(ActivePhase phase, int done, int total);
   void saveCheckpoint() const;
   bool loadCheckpoint();
+  void checkLoadedState() const;
 
   Scene scene_;
   ActiveOptions opt_;

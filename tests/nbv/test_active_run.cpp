@@ -2,9 +2,11 @@
 // resumed run equals an uninterrupted one bit for bit, and the coverage prefilter prefers
 // the view of the unobserved side.
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <map>
 
 #include "common/test_support.h"
@@ -130,6 +132,45 @@ TEST(ActiveRun, CheckpointOfAnotherMethodIsRefused) {
   ActiveRun(s, o, d.file("c.json")).run();
   ActiveRun other(s, tinyOptions(Method::kFvs), d.file("c.json"));
   EXPECT_TRUE(test::throwsInputError([&] { other.run(); }, d.file("c.json"), "method"));
+}
+
+// Every field of a checkpoint is checked against the run: a flipped or foreign value is
+// an error naming the field, never a runaway phase or an index out of range.
+TEST(ActiveRun, CorruptCheckpointFieldsAreRefusedByName) {
+  const Scene& s = tinyDataset();
+  TempDir d;
+  const std::string ckpt = d.file("c.json");
+  {
+    ActiveRun first(s, tinyOptions(Method::kRandom), ckpt);
+    struct Killed {};
+    EXPECT_THROW(first.run([](const ActiveProgress& p) {
+      if (p.iteration == 40) throw Killed{};
+    }), Killed);
+  }
+  const nlohmann::json good = nlohmann::json::parse(test::readBytes(ckpt));
+  const auto refused = [&](const std::function<void(nlohmann::json&)>& corrupt, const std::string& field,
+                           const ActiveOptions& o = tinyOptions(Method::kRandom)) {
+    nlohmann::json j = good;
+    corrupt(j);
+    test::writeBytes(ckpt, j.dump());
+    ActiveRun run(s, o, ckpt);
+    return test::throwsInputError([&] { run.run(); }, ckpt, field);
+  };
+  EXPECT_TRUE(refused([](nlohmann::json& j) { j["iterations_done"] = -1e9; }, "iterations_done"));
+  EXPECT_TRUE(refused([](nlohmann::json& j) { j["iterations_done"] = 1e30; }, "iterations_done"));
+  EXPECT_TRUE(refused([](nlohmann::json& j) { j["iterations_done"] = j["iterations_done"].get<int>() + 1; }, "iterations_done"));
+  EXPECT_TRUE(refused([](nlohmann::json& j) { j["selected"].back() = 100000; }, "selected"));
+  EXPECT_TRUE(refused([](nlohmann::json& j) { j["selected"].back() = j["selected"][0]; }, "selected"));
+  EXPECT_TRUE(refused([](nlohmann::json& j) { j["observed_upto"] = 99; }, "observed_upto"));
+  EXPECT_TRUE(refused([](nlohmann::json& j) { j["steps"].erase(j["steps"].size() - 1); }, "steps"));
+  EXPECT_TRUE(refused([](nlohmann::json& j) { j["initial"].erase(0); }, "initial"));
+  ActiveOptions other_interval = tinyOptions(Method::kRandom);
+  other_interval.interval = 7;
+  EXPECT_TRUE(refused([](nlohmann::json&) {}, "iterations_done", other_interval));
+  // The untouched checkpoint still resumes.
+  test::writeBytes(ckpt, good.dump());
+  ActiveRun ok(s, tinyOptions(Method::kRandom), ckpt);
+  EXPECT_NO_THROW(ok.run());
 }
 
 TEST(CoveragePrefilter, PrefersTheViewOfTheUnobservedSide) {
