@@ -11,6 +11,7 @@
 #include "apps/commands.h"
 #include "apps/progress.h"
 #include "apps/view_list.h"
+#include "geometry/error.h"
 #include "geometry/io/atomic_file.h"
 #include "geometry/scene/scene.h"
 #include "splat/ply.h"
@@ -57,6 +58,9 @@ int runTrain(TrainArgs& a) {
   Trainer trainer(scene, a.opt);
   if (a.resume && fs::exists(ckpt)) {
     trainer.loadCheckpoint(ckpt);
+    if (trainer.iteration() > a.iterations)
+      throw InputError(ckpt, "iteration", "the checkpoint is at iteration " + std::to_string(trainer.iteration()) +
+                                              ", past --iterations " + std::to_string(a.iterations));
     std::cerr << "resumed " << ckpt << " at iteration " << trainer.iteration() << "\n";
   }
   std::cerr << "training on " << views.size() << " views (" << scene.test.size() << " test), "

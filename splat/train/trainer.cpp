@@ -334,7 +334,9 @@ void Trainer::loadCheckpoint(const std::string& path) {
     throw InputError(path, "views", "written for a scene with " + std::to_string(views) + " views, this one has " +
                                         std::to_string(scene_.views.size()));
   const int iteration = r.pod<std::int32_t>("iteration");
+  if (iteration < 0) throw InputError(path, "iteration", std::to_string(iteration) + " is negative");
   const double ema = r.pod<double>("loss_ema");
+  if (!std::isfinite(ema)) throw InputError(path, "loss_ema", "not a finite number");
   const std::vector<char> rng_text = r.vec<char>("rng");
   std::mt19937_64 rng;
   std::istringstream rs(std::string(rng_text.begin(), rng_text.end()));
@@ -343,6 +345,8 @@ void Trainer::loadCheckpoint(const std::string& path) {
   std::vector<int> view_set = r.vec<int>("view_set"), view_stack = r.vec<int>("view_stack");
   for (int v : view_set)
     if (v < 0 || v >= static_cast<int>(views)) throw InputError(path, "view_set", "view index out of range");
+  for (int v : view_stack)
+    if (v < 0 || v >= static_cast<int>(views)) throw InputError(path, "view_stack", "view index out of range");
   Gaussians g = r.model("gaussians"), m = r.model("adam.m"), v = r.model("adam.v");
   if (m.size() != g.size() || v.size() != g.size() || m.max_sh_degree != g.max_sh_degree ||
       v.max_sh_degree != g.max_sh_degree)
@@ -351,6 +355,15 @@ void Trainer::loadCheckpoint(const std::string& path) {
     throw InputError(path, "gaussians", "SH degree " + std::to_string(g.max_sh_degree) + " differs from the trainer's " +
                                             std::to_string(opt_.max_sh_degree));
   const auto step = r.pod<std::int64_t>("adam.step");
+  if (step < 0) throw InputError(path, "adam.step", "negative");
+  // NaN or infinity in the model or its moments would poison every later step.
+  for (const auto& [model, name] : {std::pair{&g, "gaussians"}, std::pair{&m, "adam.m"}, std::pair{&v, "adam.v"}}) {
+    bool finite = true;
+    model->forEachArray([&](const std::vector<float>& a, std::size_t) {
+      for (float x : a) finite = finite && std::isfinite(x);
+    });
+    if (!finite) throw InputError(path, name, "holds NaN or infinite values");
+  }
   DensifyStats st;
   st.grad_accum = r.vec<float>("stats.grad_accum", g.size());
   st.count = r.vec<std::int32_t>("stats.count", g.size());

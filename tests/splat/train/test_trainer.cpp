@@ -172,6 +172,18 @@ TEST(Trainer, BadCheckpointsAreClearErrors) {
   Trainer other(fewer, quickOptions());
   EXPECT_TRUE(test::throwsInputError([&] { other.loadCheckpoint(d.file("c.bin")); }, d.file("c.bin"), "views"));
   EXPECT_TRUE(test::throwsInputError([&] { t.loadCheckpoint(d.file("missing.bin")); }, d.file("missing.bin"), ""));
+  // The stored iteration follows the 8-byte magic and the 8-byte view count: a flipped
+  // sign bit is refused, not planned as two billion iterations.
+  std::string flipped = bytes;
+  flipped[16 + 3] = static_cast<char>(flipped[16 + 3] | 0x80);
+  test::writeBytes(d.file("neg.bin"), flipped);
+  EXPECT_TRUE(test::throwsInputError([&] { t.loadCheckpoint(d.file("neg.bin")); }, d.file("neg.bin"), "iteration"));
+  // A NaN in the model is refused too (the last float of the file's model block is hard
+  // to find by offset, so the model is made with one and saved).
+  Trainer nan_model(s, quickOptions());
+  nan_model.mutableGaussians().opacities[0] = std::nanf("");
+  nan_model.saveCheckpoint(d.file("nan.bin"));
+  EXPECT_TRUE(test::throwsInputError([&] { t.loadCheckpoint(d.file("nan.bin")); }, d.file("nan.bin"), "gaussians"));
   EXPECT_THROW(t.train({}, 1), std::invalid_argument);
   EXPECT_THROW(t.train({9999}, 1), std::invalid_argument);
 }
