@@ -85,6 +85,7 @@ int runActive(const ActiveArgs& a) {
   dopt.load.downscale = a.downscale;
   const Scene scene = loadDataset(a.dataset, dopt);
   fs::create_directories(a.out);
+  if (const int n = removeStaleTemporaries(a.out)) std::cerr << "removed " << n << " temporaries left by a killed run\n";
   const std::string ckpt = a.out + "/checkpoint.json";
   if (!a.resume && fs::exists(ckpt))
     throw std::runtime_error(ckpt + " exists: pass --resume to continue that run, or choose another --out");

@@ -54,6 +54,7 @@ int runTrain(TrainArgs& a) {
   if (a.schedule_scale != 1.0) a.opt = scaledSchedule(a.opt, a.schedule_scale);
   const std::vector<int> views = a.views.empty() ? scene.train : parseTrainViews(a.views, scene, "--views");
   fs::create_directories(a.out);
+  if (const int n = removeStaleTemporaries(a.out)) std::cerr << "removed " << n << " temporaries left by a killed run\n";
   const std::string ckpt = a.out + "/checkpoint.bin";
   Trainer trainer(scene, a.opt);
   if (a.resume && fs::exists(ckpt)) {

@@ -45,4 +45,20 @@ std::string readFile(const std::string& path) {
   return s.str();
 }
 
+int removeStaleTemporaries(const std::string& dir) {
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) return 0;
+  int removed = 0;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    const auto at = name.rfind(".tmp.");
+    if (at == std::string::npos || !e.is_regular_file(ec)) continue;
+    const std::string pid = name.substr(at + 5);
+    if (pid.empty() || pid.size() > 9 || pid.find_first_not_of("0123456789") != std::string::npos) continue;
+    if (std::stol(pid) == ::getpid() || fs::exists("/proc/" + pid, ec)) continue;  // its writer may still finish
+    if (fs::remove(e.path(), ec)) ++removed;
+  }
+  return removed;
+}
+
 }  // namespace saresgs

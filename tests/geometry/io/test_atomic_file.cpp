@@ -34,3 +34,28 @@ TEST(AtomicFile, CreatesFoldersAndReplaces) {
   EXPECT_EQ(readFile(path), "z");
   EXPECT_TRUE(test::throwsInputError([&] { readFile(d.file("none")); }, "none", "file"));
 }
+
+namespace saresgs {
+namespace {
+
+// A killed writer's temporaries are cleaned up on the next start; a live process's
+// (here, this test's own) and ordinary files are kept.
+TEST(AtomicFile, StaleTemporariesOfDeadWritersAreRemoved) {
+  test::TempDir d;
+  // Above Linux's largest pid_max (2^22): no such process can exist.
+  const std::string dead = d.file("checkpoint.json.trainer.4.tmp.4194999");
+  const std::string live = d.file("checkpoint.json.tmp." + std::to_string(::getpid()));
+  test::writeBytes(dead, std::string(1000, 'x'));
+  test::writeBytes(live, "being written");
+  test::writeBytes(d.file("results.json"), "{}");
+  test::writeBytes(d.file("notes.tmp.abc"), "not a pid");
+  EXPECT_EQ(removeStaleTemporaries(d.str()), 1);
+  EXPECT_FALSE(std::filesystem::exists(dead));
+  EXPECT_TRUE(std::filesystem::exists(live));
+  EXPECT_TRUE(std::filesystem::exists(d.file("results.json")));
+  EXPECT_TRUE(std::filesystem::exists(d.file("notes.tmp.abc")));
+  EXPECT_EQ(removeStaleTemporaries(d.file("no_such_folder")), 0);
+}
+
+}  // namespace
+}  // namespace saresgs
