@@ -129,7 +129,7 @@ TEST(AblateCli, GnuParallelShardsIntoOneFolderThenMerge) {
   const std::string out = d.file("out");
   Result r = shell("parallel --version");
   ASSERT_EQ(r.code, 0) << "GNU parallel is missing (bash scripts/install_deps.sh installs it): " << r.output;
-  r = shell("parallel -j 2 --halt now,fail=1 " + cli() + " ablate --config " + grid + " --out " + out +
+  r = shell("parallel --will-cite -j 2 --halt now,fail=1 " + cli() + " ablate --config " + grid + " --out " + out +
             " --shard {}/2 ::: 0 1");
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_EQ(count(r.output, "shard 0/2 done"), 1) << r.output;
