@@ -12,6 +12,8 @@
 
 #if SARESGS_KERNEL_FMA
 #include <immintrin.h>  // intrinsics are always-inline, no symbols of their own
+#elif defined(__SSE__)
+#include <xmmintrin.h>
 #endif
 
 #ifndef SARESGS_KERNEL_FMA
@@ -90,11 +92,33 @@ inline int hsumInt(vi v) {
   return s;
 }
 
+// a < b ? a : b and a > b ? a : b, lane by lane (b where unordered): one min/max
+// instruction where the target has it (GCC keeps a vector ternary as compare + blend).
+inline vf vmin(vf a, vf b) {
+#if SARESGS_KERNEL_FMA
+  return reinterpret_cast<vf>(_mm256_min_ps(reinterpret_cast<__m256>(a), reinterpret_cast<__m256>(b)));
+#elif defined(__SSE__) && SARESGS_KERNEL_LANES == 4
+  return reinterpret_cast<vf>(_mm_min_ps(reinterpret_cast<__m128>(a), reinterpret_cast<__m128>(b)));
+#else
+  return a < b ? a : b;
+#endif
+}
+inline vf vmax(vf a, vf b) {
+#if SARESGS_KERNEL_FMA
+  return reinterpret_cast<vf>(_mm256_max_ps(reinterpret_cast<__m256>(a), reinterpret_cast<__m256>(b)));
+#elif defined(__SSE__) && SARESGS_KERNEL_LANES == 4
+  return reinterpret_cast<vf>(_mm_max_ps(reinterpret_cast<__m128>(a), reinterpret_cast<__m128>(b)));
+#else
+  return a > b ? a : b;
+#endif
+}
+
 // exp for x <= 0 without a libm call: Cody-Waite range reduction x = n ln2 + r and a
-// degree-6 polynomial (relative error < 3e-7); 0 below -87 (far under every threshold).
+// degree-6 polynomial (relative error < 3e-7). Below -87 it returns e^-87 (~1.6e-38)
+// instead of e^x: the kernels use G only where o G >= 1/255, i.e. x > -6 for o <= 1, so
+// no select is spent on lanes that are masked out anyway.
 inline vf expNonPositive(vf x) {
-  const vf lo = vs(-87.0f);
-  const vf xc = x < lo ? lo : x;
+  const vf xc = vmax(vs(-87.0f), x);  // -87 where x < -87 (x is never NaN here)
   const vf t = xc * vs(1.4426950408889634f);
   const vi ni = __builtin_convertvector(t - vs(0.5f), vi);  // t <= 0: rounds to nearest
   const vf n = __builtin_convertvector(ni, vf);
@@ -111,7 +135,7 @@ inline vf expNonPositive(vf x) {
   p = fma(p, r, vs(1.0f));
   p = fma(p, r, vs(1.0f));
   const vf scale = reinterpret_cast<vf>((ni + 127) << 23);
-  return x < lo ? vs(0.0f) : p * scale;
+  return p * scale;
 }
 
 // The row terms of a Gaussian's exponent, hoisted out of the pixel loops; per lane, as a
@@ -137,9 +161,9 @@ inline Lanes evalLanes(vf dx, vf ha, vf qy, vf by, vf o, vf hx, vi row_in) {
 #else
   const vf power = ha * dx * dx + qy - by * dx;
 #endif
-  l.G = expNonPositive(power < vs(0.0f) ? power : vs(0.0f));
+  l.G = expNonPositive(vmin(power, vs(0.0f)));  // power < 0 ? power : 0
   l.oG = o * l.G;
-  l.alpha = l.oG < vs(kMaxA) ? l.oG : vs(kMaxA);
+  l.alpha = vmin(l.oG, vs(kMaxA));
   const vf adx = reinterpret_cast<vf>(reinterpret_cast<vi>(dx) & 0x7fffffff);
   l.touches = row_in & (adx <= hx) & (power <= vs(0.0f)) & (l.oG >= vs(kMinA));
   return l;
@@ -192,197 +216,131 @@ inline void blockRowSpan(const TileGaussian<float>& g, int x0, int y0, int rb, i
 
 inline vi absLe(vf v, vf bound) { return reinterpret_cast<vf>(reinterpret_cast<vi>(v) & 0x7fffffff) <= bound; }
 
+constexpr int kBlocks = kTile * kTile / L;  // vector blocks per tile
+
+// Calls body(block, lanes, dy) for every block of the tile [x0, x1) x [y0, y1) that
+// Gaussian g may touch (its rectangle, narrowed per block row by blockRowSpan), row by
+// row and left to right: the one pixel loop of every kernel. Pixel centres are whole
+// numbers + 0.5, exact in float, so stepping them by kBW gives the same offsets as
+// computing each afresh.
+template <typename Body>
+__attribute__((always_inline)) inline void forEachBlock(const TileGaussian<float>& g, int x0, int y0, int x1,
+                                                        int y1, Body&& body) {
+  int c0, c1, r0, r1;
+  tileSpan(g.mx, g.hx, x0, x1, c0, c1);
+  tileSpan(g.my, g.hy, y0, y1, r0, r1);
+  if (c0 > c1) return;
+  const vf mx = vs(g.mx), my = vs(g.my), hx = vs(g.hx), hy = vs(g.hy), o = vs(g.o);
+  const vf ha = vs(-0.5f) * vs(g.a);
+  const vf lane_x = laneColCentres(), lane_y = laneRowCentres();
+  for (int rb = r0 / kBH; rb <= r1 / kBH; ++rb) {
+    int lo, hi;
+    blockRowSpan(g, x0, y0, rb, c0, c1, lo, hi);
+    if (lo > hi) continue;
+    const vf dy = (vs(static_cast<float>(y0 + rb * kBH)) + lane_y) - my;
+    const vi row_in = absLe(dy, hy);
+    const vf qy = rowQuad(g, dy), by = rowCross(g, dy);
+    const int cb0 = lo & ~(kBW - 1);
+    vf px = vs(static_cast<float>(x0 + cb0)) + lane_x;
+    int blk = rb * kBX + cb0 / kBW;
+    for (int cb = cb0; cb <= hi; cb += kBW, ++blk, px = px + vs(static_cast<float>(kBW)))
+      body(blk, evalLanes(px - mx, ha, qy, by, o, hx, row_in), dy);
+  }
+}
+
+// --- Forward ------------------------------------------------------------------------
+// One vector block of a tile's compositing state. A stopped pixel keeps its
+// transmittance with the sign flipped (it is >= 1e-4 while the pixel is live), so no
+// separate "active" flag; pixels beyond the image start stopped.
+struct ForwardBlock {
+  vf Tr, C0, C1, C2, D, walked, contrib;
+};
+
+struct ForwardState {
+  ForwardBlock b[kBlocks];
+  int n_active = 0;
+
+  void init(int w, int h) {
+    for (int k = 0; k < kTile * kTile; ++k) {
+      ForwardBlock& B = b[k / L];
+      const int i = k % L;
+      B.Tr[i] = blockCol(k) < w && blockRow(k) < h ? 1.0f : -1.0f;
+      B.C0[i] = B.C1[i] = B.C2[i] = B.D[i] = B.walked[i] = B.contrib[i] = 0.0f;
+    }
+    n_active = w * h;
+  }
+
+  // Rule 7 for one Gaussian (entry jf - 1) at one block; returns the lanes it stops.
+  inline vi step(ForwardBlock& B, const Lanes& Ln, vf col0, vf col1, vf col2, vf dep, vf jf) {
+    const vf alpha = Ln.alpha;
+    const vf t = B.Tr;
+    const vi ok = (t > vs(0.0f)) & Ln.touches;
+    const vf next = t * (vs(1.0f) - alpha);
+    const vi stop = ok & (next < vs(kMinT));
+    const vi take = ok & ~stop;
+    const vf wgt = take ? alpha * t : vs(0.0f);
+    B.C0 = fma(wgt, col0, B.C0);
+    B.C1 = fma(wgt, col1, B.C1);
+    B.C2 = fma(wgt, col2, B.C2);
+    B.D = fma(wgt, dep, B.D);
+    B.Tr = take ? next : (stop ? -t : t);
+    B.walked = take ? jf : B.walked;
+    B.contrib = B.contrib + (take ? vs(1.0f) : vs(0.0f));
+    return stop;
+  }
+
+  void write(int x0, int y0, int w, int h, const float bg[3], const ForwardOut& out) const {
+    for (int k = 0; k < kTile * kTile; ++k) {
+      const int r = blockRow(k), c = blockCol(k);
+      if (r >= h || c >= w) continue;
+      const ForwardBlock& B = b[k / L];
+      const int i = k % L;
+      const float T = std::abs(B.Tr[i]);
+      const std::size_t pix = static_cast<std::size_t>(y0 + r) * out.W + (x0 + c);
+      out.rgb[pix * 3] = B.C0[i] + T * bg[0];
+      out.rgb[pix * 3 + 1] = B.C1[i] + T * bg[1];
+      out.rgb[pix * 3 + 2] = B.C2[i] + T * bg[2];
+      out.alpha[pix] = 1.0f - T;
+      out.depth[pix] = (1.0f - T) >= 1e-6f ? B.D[i] / (1.0f - T) : 0.0f;
+      out.contributors[pix] = static_cast<int>(B.contrib[i]);
+      out.final_T[pix] = T;
+      out.n_walked[pix] = static_cast<std::uint32_t>(B.walked[i]);
+    }
+  }
+};
+
+// A Gaussian's per-block constants of ForwardState::step.
+struct ForwardColour {
+  vf col0, col1, col2, dep, jf;
+  ForwardColour(const TileGaussian<float>& g, int j)
+      : col0(vs(g.col[0])), col1(vs(g.col[1])), col2(vs(g.col[2])), dep(vs(g.depth)),
+        jf(vs(static_cast<float>(j + 1))) {}
+};
+
 }  // namespace
 
-// Front-to-back compositing, Gaussian by Gaussian over the pixels of its rectangle, so
-// the inner loop runs over contiguous pixels without branches; each pixel sees exactly
-// the per-pixel sequence of rule 7. A stopped pixel keeps its transmittance with the
-// sign flipped (it is >= 1e-4 while the pixel is live), so no separate "active" array.
+// Front-to-back compositing, Gaussian by Gaussian over the blocks it may touch, so the
+// inner loop is branch-free vector code; each pixel sees exactly the per-pixel sequence
+// of rule 7.
 void compositeTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
                    const ForwardOut& out) {
-  constexpr int P = kTile * kTile;
-  alignas(64) float Tr[P], C0[P], C1[P], C2[P], D[P], walked[P], contrib[P];
   const int w = x1 - x0, h = y1 - y0;
-  for (int k = 0; k < P; ++k) {
-    const bool inside = blockCol(k) < w && blockRow(k) < h;
-    Tr[k] = inside ? 1.0f : -1.0f;  // pixels beyond the image never composite
-    C0[k] = C1[k] = C2[k] = D[k] = walked[k] = contrib[k] = 0.0f;
-  }
-  int n_active = w * h;
-  const vf lane_x = laneColCentres(), lane_y = laneRowCentres();
-  for (int j = 0; j < nq && n_active > 0; ++j) {
-    const TileGaussian<float>& g = q[j];
-    int c0, c1, r0, r1;
-    tileSpan(g.mx, g.hx, x0, x1, c0, c1);
-    tileSpan(g.my, g.hy, y0, y1, r0, r1);
-    if (c0 > c1) continue;
-    const vf mx = vs(g.mx), my = vs(g.my), hx = vs(g.hx), hy = vs(g.hy), o = vs(g.o);
-    const vf jf = vs(static_cast<float>(j + 1));
-    const vf ha = vs(-0.5f) * vs(g.a);
-    const vf col0 = vs(g.col[0]), col1 = vs(g.col[1]), col2 = vs(g.col[2]), dep = vs(g.depth);
+  ForwardState F;
+  F.init(w, h);
+  for (int j = 0; j < nq && F.n_active > 0; ++j) {
+    const ForwardColour fc(q[j], j);
     vi stopped = vi{} + 0;
-    for (int rb = r0 / kBH; rb <= r1 / kBH; ++rb) {
-      int lo, hi;
-      blockRowSpan(g, x0, y0, rb, c0, c1, lo, hi);
-      if (lo > hi) continue;
-      const vf dy = (vs(static_cast<float>(y0 + rb * kBH)) + lane_y) - my;
-      const vi row_in = absLe(dy, hy);
-      const vf qy = rowQuad(g, dy), by = rowCross(g, dy);
-      for (int cb = lo & ~(kBW - 1); cb <= hi; cb += kBW) {
-        const int k = (rb * kBX + cb / kBW) * L;
-        const Lanes Ln = evalLanes((vs(static_cast<float>(x0 + cb)) + lane_x) - mx, ha, qy, by, o, hx, row_in);
-        const vf alpha = Ln.alpha;
-        vf t = load(Tr + k);
-        const vi ok = (t > vs(0.0f)) & Ln.touches;
-        const vf next = t * (vs(1.0f) - alpha);
-        const vi stop = ok & (next < vs(kMinT));
-        const vi take = ok & ~stop;
-        const vf wgt = take ? alpha * t : vs(0.0f);
-        store(C0 + k, fma(wgt, col0, load(C0 + k)));
-        store(C1 + k, fma(wgt, col1, load(C1 + k)));
-        store(C2 + k, fma(wgt, col2, load(C2 + k)));
-        store(D + k, fma(wgt, dep, load(D + k)));
-        store(Tr + k, take ? next : (stop ? -t : t));
-        store(walked + k, take ? jf : load(walked + k));
-        store(contrib + k, load(contrib + k) + (take ? vs(1.0f) : vs(0.0f)));
-        stopped -= stop;  // masks are -1 where true
-      }
-    }
-    n_active -= hsumInt(stopped);
+    forEachBlock(q[j], x0, y0, x1, y1, [&](int blk, const Lanes& Ln, vf) {
+      stopped -= F.step(F.b[blk], Ln, fc.col0, fc.col1, fc.col2, fc.dep, fc.jf);  // masks are -1 where true
+    });
+    F.n_active -= hsumInt(stopped);
   }
-  for (int k = 0; k < P; ++k) {
-    const int r = blockRow(k), c = blockCol(k);
-    if (r >= h || c >= w) continue;
-    const float T = std::abs(Tr[k]);
-    const std::size_t pix = static_cast<std::size_t>(y0 + r) * out.W + (x0 + c);
-    out.rgb[pix * 3] = C0[k] + T * bg[0];
-    out.rgb[pix * 3 + 1] = C1[k] + T * bg[1];
-    out.rgb[pix * 3 + 2] = C2[k] + T * bg[2];
-    out.alpha[pix] = 1.0f - T;
-    out.depth[pix] = (1.0f - T) >= 1e-6f ? D[k] / (1.0f - T) : 0.0f;
-    out.contributors[pix] = static_cast<int>(contrib[k]);
-    out.final_T[pix] = T;
-    out.n_walked[pix] = static_cast<std::uint32_t>(walked[k]);
-  }
+  F.write(x0, y0, w, h, bg, out);
 }
 
 namespace {
 
-// The back-to-front walk (the scalar walkBack of rasterizer.cpp, per lane), Gaussian by
-// Gaussian. kBg: the background term of dL/dalpha; without a background it is exactly 0
-// and its division is skipped.
-template <bool kBg>
-void backwardTileImpl(const TileGaussian<float>* q, int x0, int y0, int x1, int y1, const float bg[3],
-                      const BackwardIn& in, const std::uint32_t* entry_slot, float* slots) {
-  constexpr int P = kTile * kTile;
-  const int w = x1 - x0, h = y1 - y0;
-  alignas(64) float Tr[P], finalT[P], walked[P], acc0[P], acc1[P], acc2[P], w0[P], w1[P], w2[P], bgdot[P];
-  std::uint32_t jmax = 0;
-  for (int k = 0; k < P; ++k) {
-    const int r = blockRow(k), c = blockCol(k);
-    const bool inside = c < w && r < h;
-    const std::size_t pix = inside ? static_cast<std::size_t>(y0 + r) * in.W + (x0 + c) : 0;
-    Tr[k] = finalT[k] = inside ? in.final_T[pix] : 1.0f;
-    const std::uint32_t nw = inside ? in.n_walked[pix] : 0;
-    walked[k] = static_cast<float>(nw);
-    jmax = nw > jmax ? nw : jmax;
-    acc0[k] = acc1[k] = acc2[k] = 0.0f;
-    w0[k] = inside ? in.dL_drgb[pix * 3] : 0.0f;
-    w1[k] = inside ? in.dL_drgb[pix * 3 + 1] : 0.0f;
-    w2[k] = inside ? in.dL_drgb[pix * 3 + 2] : 0.0f;
-    bgdot[k] = bg[0] * w0[k] + bg[1] * w1[k] + bg[2] * w2[k];
-  }
-  const vf lane_x = laneColCentres(), lane_y = laneRowCentres();
-  for (std::uint32_t jj = jmax; jj-- > 0;) {
-    const TileGaussian<float>& g = q[jj];
-    int c0, c1, r0, r1;
-    tileSpan(g.mx, g.hx, x0, x1, c0, c1);
-    tileSpan(g.my, g.hy, y0, y1, r0, r1);
-    const vf mx = vs(g.mx), my = vs(g.my), hx = vs(g.hx), hy = vs(g.hy), o = vs(g.o);
-    const vf jv = vs(static_cast<float>(jj));
-    const vf ha = vs(-0.5f) * vs(g.a);
-    const vf col0 = vs(g.col[0]), col1 = vs(g.col[1]), col2 = vs(g.col[2]);
-    const vf zero = vs(0.0f), one = vs(1.0f);
-    // Sums over the Gaussian's pixels of e = G dL/dalpha (where alpha = o G is not
-    // clamped) times 1, dx, dy, dx^2, dx dy, dy^2, and of alpha T w_c; the 2D
-    // gradients are linear in them (see below).
-    vf s_e = zero, s_x = zero, s_y = zero, s_xx = zero, s_xy = zero, s_yy = zero, s_c0 = zero, s_c1 = zero,
-       s_c2 = zero;
-    if (c0 <= c1)
-      for (int rb = r0 / kBH; rb <= r1 / kBH; ++rb) {
-        int lo, hi;
-        blockRowSpan(g, x0, y0, rb, c0, c1, lo, hi);
-        if (lo > hi) continue;
-        const vf dy = (vs(static_cast<float>(y0 + rb * kBH)) + lane_y) - my;
-        const vi row_in = absLe(dy, hy);
-        const vf qy = rowQuad(g, dy), by = rowCross(g, dy);
-        for (int cb = lo & ~(kBW - 1); cb <= hi; cb += kBW) {
-          const int k = (rb * kBX + cb / kBW) * L;
-          const Lanes Ln = evalLanes((vs(static_cast<float>(x0 + cb)) + lane_x) - mx, ha, qy, by, o, hx, row_in);
-          const vf dx = Ln.dx, alpha = Ln.alpha;
-          const vi valid = (jv < load(walked + k)) & Ln.touches;
-          const vf a_eff = valid ? alpha : zero;
-          const vf t = load(Tr + k) / (one - a_eff);  // transmittance in front of jj
-          store(Tr + k, t);
-          // acc: the colour composited behind jj (normalised), updated once jj is used.
-          const vf a0 = load(acc0 + k), a1 = load(acc1 + k), a2 = load(acc2 + k);
-          const vf d0 = col0 - a0, d1 = col1 - a1, d2 = col2 - a2;
-          const vf ww0 = load(w0 + k), ww1 = load(w1 + k), ww2 = load(w2 + k);
-          const vf dLdc = fma(d2, ww2, fma(d1, ww1, d0 * ww0));
-          vf dLda = dLdc * t;
-          if constexpr (kBg) dLda = dLda - load(finalT + k) / (one - alpha) * load(bgdot + k);
-          store(acc0 + k, fma(a_eff, d0, a0));
-          store(acc1 + k, fma(a_eff, d1, a1));
-          store(acc2 + k, fma(a_eff, d2, a2));
-          const vi gm = valid & (Ln.oG < vs(kMaxA));
-          const vf e = gm ? Ln.G * dLda : zero;
-          s_e += e;
-          const vf ex = e * dx, ey = e * dy;
-          s_x += ex;
-          s_y += ey;
-          s_xx = fma(ex, dx, s_xx);
-          s_xy = fma(ex, dy, s_xy);
-          s_yy = fma(ey, dy, s_yy);
-          const vf wcol = a_eff * t;  // 0 where not valid
-          s_c0 = fma(wcol, ww0, s_c0);
-          s_c1 = fma(wcol, ww1, s_c1);
-          s_c2 = fma(wcol, ww2, s_c2);
-        }
-      }
-    // dL/dpower = o e; power = -(a dx^2 + 2 b dx dy + c dy^2) / 2 with dx = px - mean.
-    const float e = hsum(s_e), ex = hsum(s_x), ey = hsum(s_y), exx = hsum(s_xx), exy = hsum(s_xy),
-                eyy = hsum(s_yy);
-    float* sl = &slots[static_cast<std::size_t>(entry_slot[jj]) * kSlot];
-    sl[0] = e;
-    sl[1] = g.o * (g.a * ex + g.b * ey);
-    sl[2] = g.o * (g.b * ex + g.c * ey);
-    sl[3] = -0.5f * g.o * exx;
-    sl[4] = -g.o * exy;
-    sl[5] = -0.5f * g.o * eyy;
-    sl[6] = hsum(s_c0);
-    sl[7] = hsum(s_c1);
-    sl[8] = hsum(s_c2);
-  }
-}
-
-}  // namespace
-
-void backwardTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
-                  const BackwardIn& in, const std::uint32_t* entry_slot, float* slots) {
-  if (nq == 0) return;
-  if (bg[0] != 0.0f || bg[1] != 0.0f || bg[2] != 0.0f)
-    backwardTileImpl<true>(q, x0, y0, x1, y1, bg, in, entry_slot, slots);
-  else
-    backwardTileImpl<false>(q, x0, y0, x1, y1, bg, in, entry_slot, slots);
-}
-
-// FisherRF's squared-gradient pass (FisherMoment in raster_kernels.h): the backward walk
-// for the fixed objective C_r + C_g + C_b, accumulating moments instead of gradients.
-// Kept apart from the backward kernel: its weights are all 1, so the three colour
-// accumulators collapse into one (sum_c (col_c - acc_c) = sum col - sum acc, and each
-// acc_c is updated linearly), and the background term is the same for every pixel.
-namespace {
-
+// --- Backward -----------------------------------------------------------------------
 // Pairwise lane sums of two vectors: [a0 + a1, a2 + a3, ..., b0 + b1, b2 + b3, ...].
 // (The preprocessor picks the lane count: shuffle indices must be constants even in a
 // discarded branch outside a template.)
@@ -407,6 +365,150 @@ inline vf transposeSums(const vf* v) {
                   pairSums(pairSums(v[4], v[5]), pairSums(v[6], v[7])));
 #endif
 }
+
+// One vector block of a tile's back-to-front state: the transmittance in front of the
+// current entry, the pixel's final transmittance and walk length, the colour composited
+// behind (normalised), and dL/drgb with its dot product with the background.
+struct BackwardBlock {
+  vf Tr, finalT, walked, acc0, acc1, acc2, w0, w1, w2, bgdot;
+};
+
+struct BackwardState {
+  BackwardBlock b[kBlocks];
+  std::uint32_t jmax = 0;  // the longest walk: entries from it on are never reached
+
+  void init(int x0, int y0, int w, int h, const float bg[3], const BackwardIn& in) {
+    jmax = 0;
+    for (int k = 0; k < kTile * kTile; ++k) {
+      const int r = blockRow(k), c = blockCol(k);
+      const bool inside = c < w && r < h;
+      const std::size_t pix = inside ? static_cast<std::size_t>(y0 + r) * in.W + (x0 + c) : 0;
+      BackwardBlock& B = b[k / L];
+      const int i = k % L;
+      B.Tr[i] = B.finalT[i] = inside ? in.final_T[pix] : 1.0f;
+      const std::uint32_t nw = inside ? in.n_walked[pix] : 0;
+      B.walked[i] = static_cast<float>(nw);
+      jmax = nw > jmax ? nw : jmax;
+      B.acc0[i] = B.acc1[i] = B.acc2[i] = 0.0f;
+      B.w0[i] = inside ? in.dL_drgb[pix * 3] : 0.0f;
+      B.w1[i] = inside ? in.dL_drgb[pix * 3 + 1] : 0.0f;
+      B.w2[i] = inside ? in.dL_drgb[pix * 3 + 2] : 0.0f;
+      B.bgdot[i] = bg[0] * B.w0[i] + bg[1] * B.w1[i] + bg[2] * B.w2[i];
+    }
+  }
+};
+
+// One Gaussian's sums over its pixels of e = G dL/dalpha (where alpha = o G is not
+// clamped) times 1, dx, dy, dx^2, dx dy, dy^2, and of alpha T w_c; its 2D gradients are
+// linear in them (writeSums).
+struct GradSums {
+  vf e, x, y, xx, xy, yy, c0, c1, c2;
+};
+
+// The scalar walkBack of rasterizer.cpp for one Gaussian (entry jv) at one block, per
+// lane. kBg: the background term of dL/dalpha; without a background it is exactly 0 and
+// its division is skipped.
+template <bool kBg>
+inline void backStep(BackwardBlock& B, const Lanes& Ln, vf dy, vf jv, vf col0, vf col1, vf col2, GradSums& s) {
+  const vf zero = vs(0.0f), one = vs(1.0f);
+  const vf dx = Ln.dx, alpha = Ln.alpha;
+  const vi valid = (jv < B.walked) & Ln.touches;
+  const vf a_eff = valid ? alpha : zero;
+  const vf t = B.Tr / (one - a_eff);  // transmittance in front of jj
+  B.Tr = t;
+  // acc: the colour composited behind jj (normalised), updated once jj is used.
+  const vf a0 = B.acc0, a1 = B.acc1, a2 = B.acc2;
+  const vf d0 = col0 - a0, d1 = col1 - a1, d2 = col2 - a2;
+  const vf ww0 = B.w0, ww1 = B.w1, ww2 = B.w2;
+  const vf dLdc = fma(d2, ww2, fma(d1, ww1, d0 * ww0));
+  vf dLda = dLdc * t;
+  if constexpr (kBg) dLda = dLda - B.finalT / (one - alpha) * B.bgdot;
+  B.acc0 = fma(a_eff, d0, a0);
+  B.acc1 = fma(a_eff, d1, a1);
+  B.acc2 = fma(a_eff, d2, a2);
+  const vi gm = valid & (Ln.oG < vs(kMaxA));
+  const vf e = gm ? Ln.G * dLda : zero;
+  s.e += e;
+  const vf ex = e * dx, ey = e * dy;
+  s.x += ex;
+  s.y += ey;
+  s.xx = fma(ex, dx, s.xx);
+  s.xy = fma(ex, dy, s.xy);
+  s.yy = fma(ey, dy, s.yy);
+  const vf wcol = a_eff * t;  // 0 where not valid
+  s.c0 = fma(wcol, ww0, s.c0);
+  s.c1 = fma(wcol, ww1, s.c1);
+  s.c2 = fma(wcol, ww2, s.c2);
+}
+
+// The 9 slot values of one (tile, Gaussian) pair from its sums: opacity, mean2d (2),
+// conic (3), colour (3). dL/dpower = o e; power = -(a dx^2 + 2 b dx dy + c dy^2) / 2
+// with dx = px - mean. The lane sums are hsum's tree, taken L at a time.
+__attribute__((always_inline)) inline void writeSums(const TileGaussian<float>& g, const GradSums& s, float* sl) {
+  constexpr int kSums = 9;
+  constexpr int kPadded = (kSums + L - 1) / L * L;
+  vf v[kPadded] = {s.e, s.x, s.y, s.xx, s.xy, s.yy, s.c0, s.c1, s.c2};
+  alignas(64) float sum[kPadded];
+  for (int k = 0; k < kPadded; k += L) store(sum + k, transposeSums(v + k));
+  const float e = sum[0], ex = sum[1], ey = sum[2], exx = sum[3], exy = sum[4], eyy = sum[5];
+  sl[0] = e;
+  sl[1] = g.o * (g.a * ex + g.b * ey);
+  sl[2] = g.o * (g.b * ex + g.c * ey);
+  sl[3] = -0.5f * g.o * exx;
+  sl[4] = -g.o * exy;
+  sl[5] = -0.5f * g.o * eyy;
+  sl[6] = sum[6];
+  sl[7] = sum[7];
+  sl[8] = sum[8];
+}
+
+// A Gaussian's per-block constants of backStep.
+struct BackwardColour {
+  vf col0, col1, col2, jv;
+  BackwardColour(const TileGaussian<float>& g, std::uint32_t jj)
+      : col0(vs(g.col[0])), col1(vs(g.col[1])), col2(vs(g.col[2])), jv(vs(static_cast<float>(jj))) {}
+};
+
+inline GradSums zeroSums() {
+  const vf z = vs(0.0f);
+  return GradSums{z, z, z, z, z, z, z, z, z};
+}
+
+// The back-to-front walk (the scalar walkBack of rasterizer.cpp, per lane), Gaussian by
+// Gaussian.
+template <bool kBg>
+void backwardTileImpl(const TileGaussian<float>* q, int x0, int y0, int x1, int y1, const float bg[3],
+                      const BackwardIn& in, const std::uint32_t* entry_slot, float* slots) {
+  BackwardState B;
+  B.init(x0, y0, x1 - x0, y1 - y0, bg, in);
+  for (std::uint32_t jj = B.jmax; jj-- > 0;) {
+    const TileGaussian<float>& g = q[jj];
+    const BackwardColour bc(g, jj);
+    GradSums s = zeroSums();
+    forEachBlock(g, x0, y0, x1, y1, [&](int blk, const Lanes& Ln, vf dy) {
+      backStep<kBg>(B.b[blk], Ln, dy, bc.jv, bc.col0, bc.col1, bc.col2, s);
+    });
+    writeSums(g, s, &slots[static_cast<std::size_t>(entry_slot[jj]) * kSlot]);
+  }
+}
+
+}  // namespace
+
+void backwardTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
+                  const BackwardIn& in, const std::uint32_t* entry_slot, float* slots) {
+  if (nq == 0) return;
+  if (bg[0] != 0.0f || bg[1] != 0.0f || bg[2] != 0.0f)
+    backwardTileImpl<true>(q, x0, y0, x1, y1, bg, in, entry_slot, slots);
+  else
+    backwardTileImpl<false>(q, x0, y0, x1, y1, bg, in, entry_slot, slots);
+}
+
+// FisherRF's squared-gradient pass (FisherMoment in raster_kernels.h): the backward walk
+// for the fixed objective C_r + C_g + C_b, accumulating moments instead of gradients.
+// Kept apart from the backward kernel: its weights are all 1, so the three colour
+// accumulators collapse into one (sum_c (col_c - acc_c) = sum col - sum acc, and each
+// acc_c is updated linearly), and the background term is the same for every pixel.
+namespace {
 
 template <bool kBg>
 void fisherTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, float bg_sum,
@@ -436,44 +538,30 @@ void fisherTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1
   const vf zero = vs(0.0f), one = vs(1.0f), bgs = vs(bg_sum);
   for (std::uint32_t jj = jmax; jj-- > 0;) {
     const TileGaussian<float>& g = q[jj];
-    int c0, c1, r0, r1;
-    tileSpan(g.mx, g.hx, x0, x1, c0, c1);
-    tileSpan(g.my, g.hy, y0, y1, r0, r1);
-    const vf mx = vs(g.mx), my = vs(g.my), hx = vs(g.hx), hy = vs(g.hy), o = vs(g.o);
     const vf jv = vs(static_cast<float>(jj));
-    const vf ha = vs(-0.5f) * vs(g.a);
     const vf colsum = vs(g.col[0] + g.col[1] + g.col[2]);
+    const vf mx = vs(g.mx), my = vs(g.my);
     // Two passes over the Gaussian's blocks. The walk keeps each block's e and wc in
     // scratch; the moments are then summed in three groups small enough to stay in
     // registers (nineteen accumulators spilled to the stack made every block pay
     // nineteen stores, which bound the kernel).
     int nb = 0;
-    if (c0 <= c1)
-      for (int rb = r0 / kBH; rb <= r1 / kBH; ++rb) {
-        int lo, hi;
-        blockRowSpan(g, x0, y0, rb, c0, c1, lo, hi);
-        if (lo > hi) continue;
-        const vf dy = (vs(static_cast<float>(y0 + rb * kBH)) + lane_y) - my;
-        const vi row_in = absLe(dy, hy);
-        const vf qy = rowQuad(g, dy), by = rowCross(g, dy);
-        for (int cb = lo & ~(kBW - 1); cb <= hi; cb += kBW) {
-          const int k = (rb * kBX + cb / kBW) * L;
-          const Lanes Ln = evalLanes((vs(static_cast<float>(x0 + cb)) + lane_x) - mx, ha, qy, by, o, hx, row_in);
-          const vf alpha = Ln.alpha;
-          const vi valid = (jv < load(walked + k)) & Ln.touches;
-          const vf a_eff = valid ? alpha : zero;
-          const vf t = load(Tr + k) / (one - a_eff);  // transmittance in front of jj
-          store(Tr + k, t);
-          const vf a = load(acc + k), d = colsum - a;
-          vf dLda = d * t;
-          if constexpr (kBg) dLda = dLda - load(finalT + k) / (one - alpha) * bgs;
-          store(acc + k, fma(a_eff, d, a));
-          const vi gm = valid & (Ln.oG < vs(kMaxA));
-          store(eb + nb * L, gm ? Ln.G * dLda : zero);
-          store(wb + nb * L, a_eff * t);  // 0 where not valid
-          block[nb++] = k;
-        }
-      }
+    forEachBlock(g, x0, y0, x1, y1, [&](int blk, const Lanes& Ln, vf) {
+      const int k = blk * L;
+      const vf alpha = Ln.alpha;
+      const vi valid = (jv < load(walked + k)) & Ln.touches;
+      const vf a_eff = valid ? alpha : zero;
+      const vf t = load(Tr + k) / (one - a_eff);  // transmittance in front of jj
+      store(Tr + k, t);
+      const vf a = load(acc + k), d = colsum - a;
+      vf dLda = d * t;
+      if constexpr (kBg) dLda = dLda - load(finalT + k) / (one - alpha) * bgs;
+      store(acc + k, fma(a_eff, d, a));
+      const vi gm = valid & (Ln.oG < vs(kMaxA));
+      store(eb + nb * L, gm ? Ln.G * dLda : zero);
+      store(wb + nb * L, a_eff * t);  // 0 where not valid
+      block[nb++] = k;
+    });
     // The offsets of block n's pixels, as the walk computed them.
     auto offsets = [&](int n, vf& dx, vf& dy) {
       const int b = block[n] / L;
