@@ -48,7 +48,8 @@ struct BackwardIn {
 using CompositeFn = void (*)(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1,
                              const float bg[3], const ForwardOut& out);
 // The back-to-front walk of a tile: for each tile entry jj its 9 gradient sums
-// (opacity, mean2d 2, conic 3, colour 3) go to slots[entry_slot[jj] * 9].
+// (opacity, mean2d 2, conic 3, colour 3) go to slots[entry_slot[jj] * 9] (every entry's
+// slot is written, zeros where no pixel reaches it).
 using BackwardFn = void (*)(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1,
                             const float bg[3], const BackwardIn& in, const std::uint32_t* entry_slot,
                             float* slots);

@@ -113,35 +113,36 @@ inline vf vmax(vf a, vf b) {
 #endif
 }
 
-// exp for x <= 0 without a libm call: Cody-Waite range reduction x = n ln2 + r and a
-// degree-6 polynomial (relative error < 3e-7). Below -87 it returns e^-87 (~1.6e-38)
-// instead of e^x: the kernels use G only where o G >= 1/255, i.e. x > -6 for o <= 1, so
-// no select is spent on lanes that are masked out anyway.
-inline vf expNonPositive(vf x) {
-  const vf xc = vmax(vs(-87.0f), x);  // -87 where x < -87 (x is never NaN here)
-  const vf t = xc * vs(1.4426950408889634f);
-  const vi ni = __builtin_convertvector(t - vs(0.5f), vi);  // t <= 0: rounds to nearest
-  const vf n = __builtin_convertvector(ni, vf);
-#if SARESGS_KERNEL_FMA
-  const vf r = fma(n, vs(-1.428606765330187e-06f), fma(n, vs(-0.693145751953125f), xc));
-#else
-  const vf r = (xc - n * vs(0.693145751953125f)) - n * vs(1.428606765330187e-06f);
-#endif
-  vf p = vs(1.0f / 720.0f);
-  p = fma(p, r, vs(1.0f / 120.0f));
-  p = fma(p, r, vs(1.0f / 24.0f));
-  p = fma(p, r, vs(1.0f / 6.0f));
-  p = fma(p, r, vs(0.5f));
-  p = fma(p, r, vs(1.0f));
-  p = fma(p, r, vs(1.0f));
-  const vf scale = reinterpret_cast<vf>((ni + 127) << 23);
+// 2^x for x <= 0 without a libm call, on a short dependency chain (the kernels are
+// bound by its latency, not by instruction count): x = n + r with n = round(x) by the
+// 1.5 * 2^23 trick (the sum's low mantissa bits are n; r = x - n is exact), and 2^r,
+// |r| <= 1/2, by its degree-6 Taylor polynomial in Estrin's form (relative error
+// < 2e-7). x is clamped to -125 so that 2^n stays a normal float: below it the result
+// is 2^-125 (~2.4e-38) instead of 2^x, which the kernels never see, as they use G only
+// where o G >= 1/255.
+inline vf exp2NonPositive(vf x) {
+  const vf xc = vmax(vs(-125.0f), x);  // -125 where x < -125 (x is never NaN here)
+  const vf magic = vs(12582912.0f);     // 1.5 * 2^23
+  const vf m = xc + magic;              // rounds to the nearest whole number (even on ties)
+  const vf n = m - magic;
+  const vf r = xc - n;
+  const vf r2 = r * r;
+  const vf lo = fma(vs(0.6931471805599453f), r, vs(1.0f));
+  const vf mid = fma(vs(0.05550410866482158f), r, vs(0.2402265069591007f));
+  const vf hi = fma(vs(0.0013333558146428443f), r, vs(0.009618129107628477f));
+  const vf p = fma(r2 * r2, fma(vs(0.00015403530393381608f), r2, hi), fma(r2, mid, lo));
+  const vf scale = reinterpret_cast<vf>((reinterpret_cast<vi>(m) - (0x4B400000 - 127)) << 23);
   return p * scale;
 }
 
-// The row terms of a Gaussian's exponent, hoisted out of the pixel loops; per lane, as a
-// block spans kBH rows, in the same operation order for every block shape.
-inline vf rowQuad(const TileGaussian<float>& q, vf dy) { return (vs(-0.5f * q.c) * dy) * dy; }
-inline vf rowCross(const TileGaussian<float>& q, vf dy) { return vs(q.b) * dy; }
+// A Gaussian's exponent is evaluated in base 2 (power * log2 e, so G = 2^power2): the
+// factor is folded into its per-Gaussian coefficients, not paid per pixel.
+constexpr float kLog2e = 1.4426950408889634f;
+
+// The row terms of a Gaussian's base-2 exponent, hoisted out of the pixel loops; per
+// lane, as a block spans kBH rows, in the same operation order for every block shape.
+inline vf rowQuad(const TileGaussian<float>& q, vf dy) { return (vs(-0.5f * kLog2e * q.c) * dy) * dy; }
+inline vf rowCross(const TileGaussian<float>& q, vf dy) { return vs(kLog2e * q.b) * dy; }
 
 // One Gaussian at L pixel centres of a row: the quantities both kernels need, computed
 // in one place so that the forward and backward passes make identical threshold
@@ -155,13 +156,13 @@ struct Lanes {
 inline Lanes evalLanes(vf dx, vf ha, vf qy, vf by, vf o, vf hx, vi row_in) {
   Lanes l;
   l.dx = dx;
-  // ((-0.5 a) dx) dx + row_quad - row_cross dx.
+  // ((-0.5 a log2e) dx) dx + row_quad - row_cross dx: the exponent in base 2.
 #if SARESGS_KERNEL_FMA
   const vf power = fma(-by, dx, fma(ha * dx, dx, qy));
 #else
   const vf power = ha * dx * dx + qy - by * dx;
 #endif
-  l.G = expNonPositive(vmin(power, vs(0.0f)));  // power < 0 ? power : 0
+  l.G = exp2NonPositive(vmin(power, vs(0.0f)));  // power < 0 ? power : 0
   l.oG = o * l.G;
   l.alpha = vmin(l.oG, vs(kMaxA));
   const vf adx = reinterpret_cast<vf>(reinterpret_cast<vi>(dx) & 0x7fffffff);
@@ -231,7 +232,7 @@ __attribute__((always_inline)) inline void forEachBlock(const TileGaussian<float
   tileSpan(g.my, g.hy, y0, y1, r0, r1);
   if (c0 > c1) return;
   const vf mx = vs(g.mx), my = vs(g.my), hx = vs(g.hx), hy = vs(g.hy), o = vs(g.o);
-  const vf ha = vs(-0.5f) * vs(g.a);
+  const vf ha = vs(-0.5f * kLog2e) * vs(g.a);
   const vf lane_x = laneColCentres(), lane_y = laneRowCentres();
   for (int rb = r0 / kBH; rb <= r1 / kBH; ++rb) {
     int lo, hi;
@@ -406,12 +407,14 @@ struct GradSums {
 };
 
 // The scalar walkBack of rasterizer.cpp for one Gaussian (entry jv) at one block, per
-// lane. kBg: the background term of dL/dalpha; without a background it is exactly 0 and
-// its division is skipped.
+// lane: updates the block's state and gives the contribution's e = G dL/dalpha (0 where
+// alpha is clamped or the entry does not touch the pixel) and colour weight alpha T.
+// kBg: the background term of dL/dalpha; without a background it is exactly 0 and its
+// division is skipped.
 template <bool kBg>
-inline void backStep(BackwardBlock& B, const Lanes& Ln, vf dy, vf jv, vf col0, vf col1, vf col2, GradSums& s) {
+inline void backStep(BackwardBlock& B, const Lanes& Ln, vf jv, vf col0, vf col1, vf col2, vf& e, vf& wcol) {
   const vf zero = vs(0.0f), one = vs(1.0f);
-  const vf dx = Ln.dx, alpha = Ln.alpha;
+  const vf alpha = Ln.alpha;
   const vi valid = (jv < B.walked) & Ln.touches;
   const vf a_eff = valid ? alpha : zero;
   const vf t = B.Tr / (one - a_eff);  // transmittance in front of jj
@@ -419,15 +422,20 @@ inline void backStep(BackwardBlock& B, const Lanes& Ln, vf dy, vf jv, vf col0, v
   // acc: the colour composited behind jj (normalised), updated once jj is used.
   const vf a0 = B.acc0, a1 = B.acc1, a2 = B.acc2;
   const vf d0 = col0 - a0, d1 = col1 - a1, d2 = col2 - a2;
-  const vf ww0 = B.w0, ww1 = B.w1, ww2 = B.w2;
-  const vf dLdc = fma(d2, ww2, fma(d1, ww1, d0 * ww0));
+  const vf dLdc = fma(d2, B.w2, fma(d1, B.w1, d0 * B.w0));
   vf dLda = dLdc * t;
   if constexpr (kBg) dLda = dLda - B.finalT / (one - alpha) * B.bgdot;
   B.acc0 = fma(a_eff, d0, a0);
   B.acc1 = fma(a_eff, d1, a1);
   B.acc2 = fma(a_eff, d2, a2);
   const vi gm = valid & (Ln.oG < vs(kMaxA));
-  const vf e = gm ? Ln.G * dLda : zero;
+  e = gm ? Ln.G * dLda : zero;
+  wcol = a_eff * t;  // 0 where not valid
+}
+
+// A contribution's terms of the sums (each sum's own sequence of operations, whichever
+// loop adds them).
+inline void addMoments(GradSums& s, vf e, vf dx, vf dy) {
   s.e += e;
   const vf ex = e * dx, ey = e * dy;
   s.x += ex;
@@ -435,10 +443,11 @@ inline void backStep(BackwardBlock& B, const Lanes& Ln, vf dy, vf jv, vf col0, v
   s.xx = fma(ex, dx, s.xx);
   s.xy = fma(ex, dy, s.xy);
   s.yy = fma(ey, dy, s.yy);
-  const vf wcol = a_eff * t;  // 0 where not valid
-  s.c0 = fma(wcol, ww0, s.c0);
-  s.c1 = fma(wcol, ww1, s.c1);
-  s.c2 = fma(wcol, ww2, s.c2);
+}
+inline void addColours(GradSums& s, vf wcol, const BackwardBlock& B) {
+  s.c0 = fma(wcol, B.w0, s.c0);
+  s.c1 = fma(wcol, B.w1, s.c1);
+  s.c2 = fma(wcol, B.w2, s.c2);
 }
 
 // The 9 slot values of one (tile, Gaussian) pair from its sums: opacity, mean2d (2),
@@ -475,18 +484,24 @@ inline GradSums zeroSums() {
 }
 
 // The back-to-front walk (the scalar walkBack of rasterizer.cpp, per lane), Gaussian by
-// Gaussian.
+// Gaussian. Entries beyond the longest walk get zero slots, so the caller needs no
+// cleared buffer.
 template <bool kBg>
-void backwardTileImpl(const TileGaussian<float>* q, int x0, int y0, int x1, int y1, const float bg[3],
+void backwardTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
                       const BackwardIn& in, const std::uint32_t* entry_slot, float* slots) {
   BackwardState B;
   B.init(x0, y0, x1 - x0, y1 - y0, bg, in);
+  for (int jj = static_cast<int>(B.jmax); jj < nq; ++jj)
+    std::memset(&slots[static_cast<std::size_t>(entry_slot[jj]) * kSlot], 0, sizeof(float) * kSlot);
   for (std::uint32_t jj = B.jmax; jj-- > 0;) {
     const TileGaussian<float>& g = q[jj];
     const BackwardColour bc(g, jj);
     GradSums s = zeroSums();
     forEachBlock(g, x0, y0, x1, y1, [&](int blk, const Lanes& Ln, vf dy) {
-      backStep<kBg>(B.b[blk], Ln, dy, bc.jv, bc.col0, bc.col1, bc.col2, s);
+      vf e, wcol;
+      backStep<kBg>(B.b[blk], Ln, bc.jv, bc.col0, bc.col1, bc.col2, e, wcol);
+      addMoments(s, e, Ln.dx, dy);
+      addColours(s, wcol, B.b[blk]);
     });
     writeSums(g, s, &slots[static_cast<std::size_t>(entry_slot[jj]) * kSlot]);
   }
@@ -498,9 +513,9 @@ void backwardTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, 
                   const BackwardIn& in, const std::uint32_t* entry_slot, float* slots) {
   if (nq == 0) return;
   if (bg[0] != 0.0f || bg[1] != 0.0f || bg[2] != 0.0f)
-    backwardTileImpl<true>(q, x0, y0, x1, y1, bg, in, entry_slot, slots);
+    backwardTileImpl<true>(q, nq, x0, y0, x1, y1, bg, in, entry_slot, slots);
   else
-    backwardTileImpl<false>(q, x0, y0, x1, y1, bg, in, entry_slot, slots);
+    backwardTileImpl<false>(q, nq, x0, y0, x1, y1, bg, in, entry_slot, slots);
 }
 
 // FisherRF's squared-gradient pass (FisherMoment in raster_kernels.h): the backward walk

@@ -66,8 +66,17 @@ void backwardTilePairImpl(const TileGaussian<float>* q, const std::uint8_t* in_s
     // outside the subset (or beyond a branch's walk) runs the single-branch loop.
     auto walk = [&]<bool kFull, bool kSub>() {
       forEachBlock(g, x0, y0, x1, y1, [&](int blk, const Lanes& Ln, vf dy) {
-        if constexpr (kFull) backStep<kBg>(F.b[blk], Ln, dy, bc.jv, bc.col0, bc.col1, bc.col2, sf);
-        if constexpr (kSub) backStep<kBg>(S.b[blk], Ln, dy, bc.jv, bc.col0, bc.col1, bc.col2, ss);
+        vf e, wcol;
+        if constexpr (kFull) {
+          backStep<kBg>(F.b[blk], Ln, bc.jv, bc.col0, bc.col1, bc.col2, e, wcol);
+          addMoments(sf, e, Ln.dx, dy);
+          addColours(sf, wcol, F.b[blk]);
+        }
+        if constexpr (kSub) {
+          backStep<kBg>(S.b[blk], Ln, bc.jv, bc.col0, bc.col1, bc.col2, e, wcol);
+          addMoments(ss, e, Ln.dx, dy);
+          addColours(ss, wcol, S.b[blk]);
+        }
       });
     };
     if (do_full && do_sub) walk.template operator()<true, true>();

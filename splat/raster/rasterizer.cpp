@@ -765,10 +765,21 @@ void rasterizeBackwardT(const GaussiansT<T>& g, const Camera& cam, const RasterS
   const int W = fwd.width, H = fwd.height;
   const std::size_t n = g.size();
   const std::uint32_t pairs = st.gauss_start[n];
-  // Per pair slot: opacity, mean2d (2), conic (3), colour (3).
+  // Per pair slot: opacity, mean2d (2), conic (3), colour (3). The float kernels write
+  // every slot, so their buffer is per-thread scratch kept between calls (not cleared,
+  // and not handed back to the allocator and faulted in again each step); the generic
+  // walk adds into cleared slots.
   constexpr int kSlot = 9;
-  std::vector<T> slots(static_cast<std::size_t>(pairs) * kSlot, T(0));
-  backwardSlots(st, W, H, dL_drgb, slots.data());
+  const std::size_t slot_count = static_cast<std::size_t>(pairs) * kSlot;
+  thread_local std::vector<T> scratch;
+  std::vector<T> cleared;
+  if constexpr (std::is_same_v<T, float>) {
+    if (scratch.size() < slot_count) scratch.resize(slot_count);
+  } else {
+    cleared.assign(slot_count, T(0));
+  }
+  T* const slots = std::is_same_v<T, float> ? scratch.data() : cleared.data();
+  backwardSlots(st, W, H, dL_drgb, slots);
 
   arena(st).execute([&] {
     // Reduce each Gaussian's slots in slot order, then chain to its parameters.
