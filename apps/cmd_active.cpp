@@ -140,7 +140,7 @@ void addActiveCommand(CLI::App& app, Action& action) {
   sub->add_option("--prefilter-set", a->prefilter.set, "frustum | visible")->capture_default_str();
   sub->add_option("--prefilter-encoding", a->prefilter.encoding, "hash:K (11..19) | exact")->capture_default_str();
   sub->add_option("--prefilter-score", a->prefilter.score, "xor | new")->capture_default_str();
-  sub->add_option("--prefilter-lifting", a->prefilter.lifting, "SA-Point lifting: flow (DIS + epipolar refinement) | depth (the trainer's rendered depth)")
+  sub->add_option("--prefilter-lifting", a->prefilter.lifting, "SA-Point lifting: flow (DIS + epipolar refinement) | depth (the trainer's rendered depth) | oracle (the dataset's ground-truth depth maps)")
       ->capture_default_str();
   sub->add_option("--prefilter-keep", a->prefilter_keep, "Fraction kept for Fisher (default 0.2)")->check(CLI::Range(0.0, 1.0));
   sub->add_flag("--time-exhaustive-fisher", a->time_exhaustive_fisher, "Also time Fisher over all candidates");

@@ -114,7 +114,7 @@ void addCoverageCommand(CLI::App& app, Action& action) {
   sub->add_option("--set", a->flags.set, "frustum | visible")->capture_default_str();
   sub->add_option("--encoding", a->flags.encoding, "hash:K (K = 11..19) | exact")->capture_default_str();
   sub->add_option("--score", a->flags.score, "xor | new")->capture_default_str();
-  sub->add_option("--lifting", a->flags.lifting, "flow | depth")->capture_default_str();
+  sub->add_option("--lifting", a->flags.lifting, "flow | depth | oracle (the dataset's ground-truth depth maps)")->capture_default_str();
   sub->add_option("--keep", a->config.keep_fraction, "Fraction of candidates kept (top N %)")->check(CLI::Range(0.0, 1.0))->capture_default_str();
   sub->add_option("--resolution", a->config.resolution, "Grid resolution along the longest side")->check(CLI::Range(4, 4096))->capture_default_str();
   sub->add_option("--min-points", a->config.min_points, "SfM points per occupied voxel (paper: 2 outdoor, 5 indoor)")->check(CLI::Range(1, 1000))->capture_default_str();

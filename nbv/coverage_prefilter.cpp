@@ -29,14 +29,22 @@ class SaPointPrefilter : public CoveragePrefilter {
     oo.resolution = o.resolution;
     oo.min_points = o.min_points;
     oo.upsample = o.upsample;
+    if (o.lifting == LiftingSource::kOracle)
+      for (int v : scene.train)
+        if (!scene.hasDepth(v))
+          throw InputError(scene.source, "depth",
+                           "the oracle lifting source needs a ground-truth depth map for every train view (view " +
+                               std::to_string(v) + " has none)");
     grids_ = std::make_unique<OccupancyGrids>(OccupancyGrids::fromSfm(pts, oo));
     sets_ = std::make_unique<CandidateSetBuilder>(*grids_);
   }
 
   void observe(const std::vector<int>& views, const ViewRenderer& render, const DepthRenderer& depth,
                SelectionSeconds& t) override {
-    const LiftingModule module = config_.lifting == LiftingSource::kDepth ? depthModule(depth) : flowModule();
     for (int v : views) {
+      const LiftingModule module = config_.lifting == LiftingSource::kFlow    ? flowModule()
+                                   : config_.lifting == LiftingSource::kDepth ? depthModule(depth)
+                                                                              : depthModule(groundTruthDepth(v));
       const Camera& cam = scene_.views.at(static_cast<std::size_t>(v)).camera;
       const LiftingResult r = liftView(cam, scene_.imageFloat(v), scene_.extent, render, module, lifting_, v);
       t.lifting += r.report.seconds_render + r.report.seconds_correspondence;
@@ -78,6 +86,11 @@ class SaPointPrefilter : public CoveragePrefilter {
   }
 
  private:
+  // View v's ground-truth depth map; the lifting asks only for the real view's depth.
+  DepthRenderer groundTruthDepth(int v) const {
+    return [this, v](const Camera&) { return scene_.depth(v); };
+  }
+
   // A candidate's voxel set depends only on the static scene grid: computed once.
   const VoxelSet& candidateSet(int view) {
     auto it = cache_.find(view);
@@ -121,9 +134,17 @@ const char* toString(CandidateSetKind k) { return k == CandidateSetKind::kFrustu
 LiftingSource parseLiftingSource(std::string_view text) {
   if (text == "flow") return LiftingSource::kFlow;
   if (text == "depth") return LiftingSource::kDepth;
-  throw std::invalid_argument("lifting '" + std::string(text) + "': expected flow or depth");
+  if (text == "oracle") return LiftingSource::kOracle;
+  throw std::invalid_argument("lifting '" + std::string(text) + "': expected flow, depth or oracle");
 }
-const char* toString(LiftingSource s) { return s == LiftingSource::kFlow ? "flow" : "depth"; }
+const char* toString(LiftingSource s) {
+  switch (s) {
+    case LiftingSource::kFlow: return "flow";
+    case LiftingSource::kDepth: return "depth";
+    case LiftingSource::kOracle: return "oracle";
+  }
+  return "?";
+}
 
 CoverageCriterion parseCoverageCriterion(std::string_view text) {
   if (text == "xor") return CoverageCriterion::Hamming;

@@ -23,7 +23,11 @@ class OccupancyGrids;    // geometry/occupancy/occupancy_grid.h
 class VisibilityTracer;  // geometry/occupancy/candidate_sets.h
 
 enum class CandidateSetKind { kFrustum, kVisible };
-enum class LiftingSource { kFlow, kDepth };  // DIS flow + epipolar refinement | depth oracle
+// Where SA-Points come from: DIS flow + epipolar refinement on the model's renders (the
+// paper); the depth the caller supplies (in an active run, the trainer's rendered depth);
+// or the dataset's ground-truth depth maps (perfect SA-Points: the upper bound of the
+// idea, for synthetic data that has them).
+enum class LiftingSource { kFlow, kDepth, kOracle };
 
 struct PrefilterConfig {
   CandidateSetKind set = CandidateSetKind::kFrustum;
@@ -44,7 +48,7 @@ struct PrefilterConfig {
 // (the active loop takes the paper's 2^11..2^19; the sweep goes beyond); it sets the
 // encoding and table size of `scoring` and leaves its criterion alone.
 CandidateSetKind parseCandidateSet(std::string_view text);        // frustum | visible
-LiftingSource parseLiftingSource(std::string_view text);          // flow | depth
+LiftingSource parseLiftingSource(std::string_view text);          // flow | depth | oracle
 CoverageCriterion parseCoverageCriterion(std::string_view text);  // xor | new
 void parseCoverageEncoding(std::string_view text, CoverageScoring& scoring, int min_bits = 11, int max_bits = 19);
 const char* toString(CandidateSetKind k);
@@ -90,7 +94,8 @@ class CoveragePrefilter {
   virtual void load(const std::string& bytes) = 0;
 };
 
-// Throws InputError when the scene has no sparse points (the occupancy grid needs them).
+// Throws InputError when the scene has no sparse points (the occupancy grid needs them),
+// or for the oracle source when a train view has no ground-truth depth map.
 std::unique_ptr<CoveragePrefilter> makeCoveragePrefilter(const Scene& scene, const PrefilterConfig& config);
 
 }  // namespace saresgs

@@ -4,6 +4,7 @@
 #include <map>
 
 #include "nbv/eval/ablation.h"
+#include "nbv/eval/paired_stats.h"
 #include "nbv/eval/plots.h"
 
 namespace saresgs {
@@ -22,23 +23,33 @@ std::vector<std::string> labelsFor(const std::vector<JobResult>& results, const 
   return out;
 }
 
-// PSNR per method, PSNR against views and PSNR against selection time: one panel per
-// scene in each.
+// Half the width of the 95 % Student-t interval of a mean over runs; NaN (no bar) for
+// fewer than two runs, where it is undefined.
+double halfInterval95(const std::vector<double>& v) {
+  if (v.size() < 2) return std::nan("");
+  return studentT975(static_cast<int>(v.size()) - 1) * meanStd(v).second / std::sqrt(static_cast<double>(v.size()));
+}
+
+// In-loop PSNR per method, final-fit PSNR per method, PSNR against views (bands over
+// seeds) and PSNR against selection time: one panel per scene in each.
 void addActivePlots(const AblationGrid& g, const std::vector<JobResult>& results, std::vector<NamedPlot>& plots) {
-  std::vector<PlotPanel> psnr, views, time;
+  std::vector<PlotPanel> psnr, final_fit, views, time;
   for (const AblationScene& sc : g.scenes) {
     const std::vector<std::string> labels = labelsFor(results, sc.name);
     if (labels.empty()) continue;
     PlotPanel p{sc.name + ": test PSNR (mean +- std over seeds)", "method", "PSNR dB", false, labels, {}};
     PlotSeries ps{"PSNR", {}, {}, {}, {}, false};
-    PlotPanel v{sc.name + ": PSNR on progress views against views", "training views", "PSNR dB", false, {}, {}};
+    PlotPanel f{sc.name + ": final-fit PSNR (95% t interval, seeds)", "method", "PSNR dB", false, labels, {}};
+    PlotSeries fs{"final fit", {}, {}, {}, {}, false};
+    PlotPanel v{sc.name + ": progress PSNR (band: +- std, seeds)", "training views", "PSNR dB", false, {}, {}};
     PlotPanel t{sc.name + ": PSNR against selection time", "selection seconds per run (log)", "PSNR dB", true, {}, {}};
     for (std::size_t li = 0; li < labels.size(); ++li) {
-      std::vector<double> p_runs, sel_runs;
+      std::vector<double> p_runs, sel_runs, f_runs;
       std::map<int, std::vector<double>> by_views;
       for (const JobResult& r : results) {
         if (r.job.kind != AblationJob::Kind::kActive || r.job.scene != sc.name || label(r.job) != labels[li]) continue;
         p_runs.push_back(r.run.psnr);
+        if (r.run.final_fit) f_runs.push_back(r.run.final_fit->psnr);
         sel_runs.push_back(r.run.seconds.selection());
         for (const StepReport& st : r.run.steps) by_views[st.views_before].push_back(st.progress_psnr);
       }
@@ -46,10 +57,17 @@ void addActivePlots(const AblationGrid& g, const std::vector<JobResult>& results
       ps.x.push_back(static_cast<double>(li));
       ps.y.push_back(pm);
       ps.err.push_back(pstd);
+      if (!f_runs.empty()) {
+        fs.x.push_back(static_cast<double>(li));
+        fs.y.push_back(meanStd(f_runs).first);
+        fs.err.push_back(halfInterval95(f_runs));
+      }
       PlotSeries vs{labels[li], {}, {}, {}, {}, true};
+      vs.band = true;
       for (const auto& [k, vals] : by_views) {
         vs.x.push_back(k);
         vs.y.push_back(meanStd(vals).first);
+        vs.err.push_back(meanStd(vals).second);
       }
       v.series.push_back(vs);
       // Methods without a selection cost (random) sit at 1 ms so that the log axis shows them.
@@ -57,10 +75,15 @@ void addActivePlots(const AblationGrid& g, const std::vector<JobResult>& results
     }
     p.series.push_back(ps);
     psnr.push_back(p);
+    if (!fs.x.empty()) {
+      f.series.push_back(fs);
+      final_fit.push_back(f);
+    }
     views.push_back(v);
     time.push_back(t);
   }
   plots.push_back({"psnr", drawPlot(psnr)});
+  if (!final_fit.empty()) plots.push_back({"final_fit_psnr", drawPlot(final_fit)});
   plots.push_back({"psnr_vs_views", drawPlot(views)});
   plots.push_back({"psnr_vs_selection_time", drawPlot(time)});
 }

@@ -85,12 +85,21 @@ void drawPanel(cv::Mat& img, const PlotPanel& p) {
     cv::line(img, a, b, grey, 1);
     cv::putText(img, tick(y), cv::Point(4, a.y + 4), font, 0.38, black, 1, cv::LINE_AA);
   }
+  // Category names wider than their slot alternate between two rows, so neighbours do
+  // not overlap; the axis label then moves down a row.
+  bool stagger = false;
+  for (const std::string& name : p.x_categories) {
+    int base = 0;
+    stagger = stagger || cv::getTextSize(name, font, 0.38, 1, &base).width >
+                             static_cast<double>(pw) / static_cast<double>(p.x_categories.size()) - 4;
+  }
   if (!p.x_categories.empty()) {
     for (std::size_t i = 0; i < p.x_categories.size(); ++i) {
       const cv::Point a = Praw(static_cast<double>(i), y0);
       int base = 0;
       const cv::Size sz = cv::getTextSize(p.x_categories[i], font, 0.38, 1, &base);
-      cv::putText(img, p.x_categories[i], cv::Point(a.x - sz.width / 2, top + ph + 16), font, 0.38, black, 1, cv::LINE_AA);
+      const int y = top + ph + 16 + (stagger && i % 2 ? 13 : 0);
+      cv::putText(img, p.x_categories[i], cv::Point(a.x - sz.width / 2, y), font, 0.38, black, 1, cv::LINE_AA);
     }
   } else if (p.log_x) {
     // Decades, plus 2 and 5 within them when the axis spans less than two decades.
@@ -112,7 +121,7 @@ void drawPanel(cv::Mat& img, const PlotPanel& p) {
     }
   }
   cv::rectangle(img, cv::Point(left, top), cv::Point(left + pw, top + ph), black, 1);
-  cv::putText(img, p.xlabel, cv::Point(left + pw / 2 - 4 * static_cast<int>(p.xlabel.size()), top + ph + 36), font, 0.42, black, 1,
+  cv::putText(img, p.xlabel, cv::Point(left + pw / 2 - 4 * static_cast<int>(p.xlabel.size()), top + ph + (stagger ? 46 : 36)), font, 0.42, black, 1,
               cv::LINE_AA);
   cv::putText(img, p.ylabel, cv::Point(4, top - 8 + 0), font, 0.38, black, 1, cv::LINE_AA);
   // The legend goes in a row under the axis label, where it hides no data.
@@ -121,11 +130,28 @@ void drawPanel(cv::Mat& img, const PlotPanel& p) {
   for (std::size_t si = 0; si < p.series.size(); ++si) {
     const PlotSeries& s = p.series[si];
     const cv::Scalar c = kPalette[si % std::size(kPalette)];
+    if (s.band) {
+      // y - err along the series, then y + err back: one polygon, blended at 20 %.
+      std::vector<cv::Point> lower, upper;
+      for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
+        if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i]) || (p.log_x && s.x[i] <= 0)) continue;
+        const double e = i < s.err.size() && std::isfinite(s.err[i]) ? s.err[i] : 0.0;
+        lower.push_back(P(s.x[i], s.y[i] - e));
+        upper.push_back(P(s.x[i], s.y[i] + e));
+      }
+      if (lower.size() > 1) {
+        std::vector<cv::Point> poly(lower.begin(), lower.end());
+        poly.insert(poly.end(), upper.rbegin(), upper.rend());
+        cv::Mat layer = img.clone();
+        cv::fillPoly(layer, std::vector<std::vector<cv::Point>>{poly}, c, cv::LINE_AA);
+        cv::addWeighted(layer, 0.2, img, 0.8, 0.0, img);
+      }
+    }
     std::vector<cv::Point> pts;
     for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
       if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i]) || (p.log_x && s.x[i] <= 0)) continue;
       const cv::Point q = P(s.x[i], s.y[i]);
-      if (i < s.err.size() && std::isfinite(s.err[i]) && s.err[i] > 0) {
+      if (!s.band && i < s.err.size() && std::isfinite(s.err[i]) && s.err[i] > 0) {
         cv::line(img, P(s.x[i], s.y[i] - s.err[i]), P(s.x[i], s.y[i] + s.err[i]), c, 1, cv::LINE_AA);
         cv::line(img, P(s.x[i], s.y[i] - s.err[i]) + cv::Point(-4, 0), P(s.x[i], s.y[i] - s.err[i]) + cv::Point(4, 0), c, 1);
         cv::line(img, P(s.x[i], s.y[i] + s.err[i]) + cv::Point(-4, 0), P(s.x[i], s.y[i] + s.err[i]) + cv::Point(4, 0), c, 1);

@@ -15,6 +15,7 @@ struct PlotSeries {
   std::vector<double> err;                // optional: +- error bars on y
   std::vector<std::string> point_labels;  // optional: text beside each point
   bool lines = true;                      // join the points
+  bool band = false;                      // draw err as a shaded band instead of bars
 };
 
 struct PlotPanel {

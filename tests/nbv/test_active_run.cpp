@@ -8,9 +8,11 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <stdexcept>
 
 #include "common/test_support.h"
 #include "common/tiny_dataset.h"
+#include "geometry/error.h"
 #include "nbv/active_run.h"
 
 namespace saresgs {
@@ -219,6 +221,39 @@ TEST(CoveragePrefilter, PrefersTheViewOfTheUnobservedSide) {
   }
   PrefilterConfig bad;
   EXPECT_THROW(parseCoverageEncoding("hash:40", bad.scoring), std::invalid_argument);
+}
+
+// The oracle source lifts from the dataset's own depth maps: the same SA-Points as the
+// depth source fed the synthetic scene's true depth, without calling the caller's depth;
+// a scene without depth maps is refused by name.
+TEST(CoveragePrefilter, OracleLiftingUsesTheDatasetsGroundTruthDepth) {
+  const Scene& s = tinyDataset();
+  const SyntheticScene truth = makeSyntheticScene(test::tinyDatasetOptions());
+  const ViewRenderer render = [&](const Camera& c) { return truth.render(c); };
+  const DepthRenderer true_depth = [&](const Camera& c) { return truth.renderDepth(c); };
+  const DepthRenderer unused = [](const Camera&) -> ImageF { throw std::logic_error("depth renderer called"); };
+  ASSERT_TRUE(s.hasDepth(s.train[0]));
+  PrefilterConfig pc;
+  pc.resolution = 32;
+  pc.lifting = LiftingSource::kDepth;
+  auto by_depth = makeCoveragePrefilter(s, pc);
+  pc.lifting = LiftingSource::kOracle;
+  auto by_oracle = makeCoveragePrefilter(s, pc);
+  SelectionSeconds t;
+  by_depth->observe({s.train[0], s.train[1]}, render, true_depth, t);
+  by_oracle->observe({s.train[0], s.train[1]}, render, unused, t);
+  EXPECT_GT(by_oracle->liftingReport().kept, 0u);
+  EXPECT_EQ(by_oracle->liftingReport().kept, by_depth->liftingReport().kept);
+  EXPECT_EQ(by_oracle->save(), by_depth->save());
+
+  Scene no_depth = s;
+  for (auto& v : no_depth.views) v.depth_path.clear();
+  try {
+    makeCoveragePrefilter(no_depth, pc);
+    ADD_FAILURE() << "a scene without depth maps was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("depth"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -14,7 +14,7 @@ namespace {
 TEST(CoveragePrefilter, TextualOptionsParseAndNameRoundTrip) {
   for (CandidateSetKind k : {CandidateSetKind::kFrustum, CandidateSetKind::kVisible})
     EXPECT_EQ(parseCandidateSet(toString(k)), k);
-  for (LiftingSource l : {LiftingSource::kFlow, LiftingSource::kDepth}) EXPECT_EQ(parseLiftingSource(toString(l)), l);
+  for (LiftingSource l : {LiftingSource::kFlow, LiftingSource::kDepth, LiftingSource::kOracle}) EXPECT_EQ(parseLiftingSource(toString(l)), l);
   for (CoverageCriterion c : {CoverageCriterion::Hamming, CoverageCriterion::NewCount})
     EXPECT_EQ(parseCoverageCriterion(toString(c)), c);
   for (int bits = 11; bits <= 19; ++bits) {
@@ -50,7 +50,7 @@ TEST(CoveragePrefilter, BadOptionsNameTheValue) {
   };
   CoverageScoring s;
   EXPECT_NE(message([&] { parseCandidateSet("frustrum"); }).find("'frustrum'"), std::string::npos);
-  EXPECT_NE(message([&] { parseLiftingSource("sift"); }).find("flow or depth"), std::string::npos);
+  EXPECT_NE(message([&] { parseLiftingSource("sift"); }).find("flow, depth or oracle"), std::string::npos);
   EXPECT_NE(message([&] { parseCoverageCriterion("and"); }).find("xor or new"), std::string::npos);
   for (const char* bad : {"hash:10", "hash:20", "hash:", "hash:13x", "hash:-3", "hash:999999999999", "exacto", ""})
     EXPECT_NE(message([&] { parseCoverageEncoding(bad, s); }).find("prefilter encoding"), std::string::npos) << bad;
