@@ -16,11 +16,16 @@ namespace saresgs {
 // on mx + chord_slope dy with half width sqrt(chord_k0 - chord_k1 dy^2), widened so the
 // float per-pixel test never passes outside it (chordTerms in rasterizer.cpp). They only
 // shorten the kernels' loops; the per-pixel test decides.
+// The pixel spans (image columns px0..px1, rows py0..py1, inclusive; empty when
+// px0 > px1) hold every pixel whose centre can pass the float test |i + 0.5 - mean| <=
+// half: the exact bound widened by 1e-6 relative and 1e-3 px, computed once per Gaussian
+// (pixelSpan in rasterizer.cpp) so that a tile's loops start from integer clipping.
 template <typename T>
 struct TileGaussian {
   T mx, my, a, b, c, o, hx, hy, depth;
   T col[3];
   T chord_slope, chord_k0, chord_k1;
+  std::int32_t px0 = 1, px1 = 0, py0 = 1, py1 = 0;
 };
 
 namespace raster_kernels {

@@ -170,21 +170,15 @@ inline Lanes evalLanes(vf dx, vf ha, vf qy, vf by, vf o, vf hx, vi row_in) {
   return l;
 }
 
-// Offsets from `origin` (clipped to [0, limit - origin)) of the pixels whose centres can
-// pass the float test |i + 0.5 - mean| <= half: the difference rounds by at most 2^-24
-// relative, so the exact bound widened by 1e-6 relative and 1e-3 px is a superset. The
-// per-pixel test decides; this only bounds the loops (empty when lo > hi).
-inline void tileSpan(float mean, float half, int origin, int limit, int& lo, int& hi) {
-  const double h = static_cast<double>(half) * (1.0 + 1e-6) + 1e-3;
-  double l = std::ceil(static_cast<double>(mean) - h - 0.5) - origin;
-  double u = std::floor(static_cast<double>(mean) + h - 0.5) - origin;
-  const double top = limit - origin - 1;
-  if (!(l >= 0)) l = 0;  // NaN too
-  if (l > top + 1) l = top + 1;
-  if (!(u <= top)) u = u > top ? top : -1;  // NaN: empty
-  if (u < -1) u = -1;
-  lo = static_cast<int>(l);
-  hi = static_cast<int>(u);
+// A Gaussian's pixel span (TileGaussian::px0.., a superset of the pixels that can pass
+// the per-pixel rectangle test) as offsets from `origin`, clipped to [0, limit - origin):
+// integer clipping only, no branches. The per-pixel test decides; this only bounds the
+// loops (empty when lo > hi).
+inline void tileSpan(std::int32_t span_lo, std::int32_t span_hi, int origin, int limit, int& lo, int& hi) {
+  lo = span_lo - origin;
+  hi = span_hi - origin;
+  lo = lo > 0 ? lo : 0;
+  hi = hi < limit - origin - 1 ? hi : limit - origin - 1;
 }
 
 // The columns [lo, hi] (tile offsets, within the Gaussian's span [c0, c1]) that the
@@ -192,27 +186,30 @@ inline void tileSpan(float mean, float half, int origin, int limit, int& lo, int
 // (TileGaussian::chord_*, widened against rounding) all lie within [min centre - widest
 // half, max centre + widest half], plus 0.01 px for the centres' own rounding. One square
 // root per block row; empty (lo > hi) when no row of the block meets the ellipse. Loop
-// bounds only: the per-pixel test decides.
+// bounds only: the per-pixel test decides. Written with selects rather than early
+// returns: per (tile, Gaussian) pair and block row, its branches mispredicted often
+// enough to cost more than its arithmetic.
 inline void blockRowSpan(const TileGaussian<float>& g, int x0, int y0, int rb, int c0, int c1, int& lo,
                          int& hi) {
-  lo = c1 + 1;
-  hi = c0 - 1;
   const float dy0 = static_cast<float>(y0 + rb * kBH) + 0.5f - g.my;
   const float dy1 = dy0 + static_cast<float>(kBH - 1);
-  // The row nearest the centre has the widest chord.
+  // The row nearest the centre has the widest chord: dy0 > 0 ? dy0 : (dy1 < 0 ? dy1 : 0).
   const float dmin = dy0 > 0.0f ? dy0 : (dy1 < 0.0f ? dy1 : 0.0f);
   const float t = g.chord_k0 - g.chord_k1 * (dmin * dmin);
-  if (t < 0.0f) return;
-  const float half = std::sqrt(t) + 0.01f;
+  const float half = std::sqrt(t > 0.0f ? t : 0.0f) + 0.01f;
   const float xa = g.mx + g.chord_slope * dy0 - static_cast<float>(x0);
   const float xb = g.mx + g.chord_slope * dy1 - static_cast<float>(x0);
+  const float c0f = static_cast<float>(c0), c1f = static_cast<float>(c1);
   float l = (xa < xb ? xa : xb) - half - 0.5f, u = (xa < xb ? xb : xa) + half - 0.5f;
-  if (!(l >= static_cast<float>(c0))) l = static_cast<float>(c0);  // NaN: no bound
-  if (!(u <= static_cast<float>(c1))) u = static_cast<float>(c1);
-  if (l > static_cast<float>(c1) || u < static_cast<float>(c0)) return;
-  lo = static_cast<int>(l);  // l >= 0: truncation, then up to the ceiling
-  if (static_cast<float>(lo) < l) ++lo;
-  hi = static_cast<int>(u);
+  l = l >= c0f ? l : c0f;  // NaN: no bound
+  u = u <= c1f ? u : c1f;
+  l = l <= c1f + 1.0f ? l : c1f + 1.0f;  // keeps the conversions in range
+  u = u >= c0f - 1.0f ? u : c0f - 1.0f;
+  const int li = static_cast<int>(l) + (static_cast<float>(static_cast<int>(l)) < l ? 1 : 0);  // ceiling, l >= 0
+  const int ui = static_cast<int>(u) - (static_cast<float>(static_cast<int>(u)) > u ? 1 : 0);  // floor, u >= -1
+  const bool none = !(t >= 0.0f);  // no row of the block meets the ellipse
+  lo = none ? c1 + 1 : li;
+  hi = none ? c0 - 1 : ui;
 }
 
 inline vi absLe(vf v, vf bound) { return reinterpret_cast<vf>(reinterpret_cast<vi>(v) & 0x7fffffff) <= bound; }
@@ -228,9 +225,9 @@ template <typename Body>
 __attribute__((always_inline)) inline void forEachBlock(const TileGaussian<float>& g, int x0, int y0, int x1,
                                                         int y1, Body&& body) {
   int c0, c1, r0, r1;
-  tileSpan(g.mx, g.hx, x0, x1, c0, c1);
-  tileSpan(g.my, g.hy, y0, y1, r0, r1);
-  if (c0 > c1) return;
+  tileSpan(g.px0, g.px1, x0, x1, c0, c1);
+  tileSpan(g.py0, g.py1, y0, y1, r0, r1);
+  if (c0 > c1 || r0 > r1) return;
   const vf mx = vs(g.mx), my = vs(g.my), hx = vs(g.hx), hy = vs(g.hy), o = vs(g.o);
   const vf ha = vs(-0.5f * kLog2e) * vs(g.a);
   const vf lane_x = laneColCentres(), lane_y = laneRowCentres();

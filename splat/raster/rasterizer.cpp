@@ -78,6 +78,22 @@ void pixelRange(T mean, T half, int n, int& lo, int& hi) {
   hi = std::min(n - 1, static_cast<int>(std::floor(mean + half - T(0.5))));
 }
 
+// Pixels i (clipped to [0, n)) whose centres can pass the float test |i + 0.5 - mean| <=
+// half: the difference rounds by at most 2^-24 relative, so the exact bound widened by
+// 1e-6 relative and 1e-3 px is a superset. Empty (lo > hi) when nothing is finite.
+template <typename T>
+void pixelSpan(T mean, T half, int n, std::int32_t& lo, std::int32_t& hi) {
+  const double h = static_cast<double>(half) * (1.0 + 1e-6) + 1e-3;
+  const double l = std::ceil(static_cast<double>(mean) - h - 0.5);
+  const double u = std::floor(static_cast<double>(mean) + h - 0.5);
+  if (!(l <= u) || !std::isfinite(l) || !std::isfinite(u) || u < 0 || l > n - 1) {
+    lo = 1, hi = 0;
+    return;
+  }
+  lo = static_cast<std::int32_t>(std::max(l, 0.0));
+  hi = static_cast<std::int32_t>(std::min(u, static_cast<double>(n - 1)));
+}
+
 // A projected Gaussian as the tile kernels read it. The chord terms (splat/raster/raster_kernels.h):
 // a pixel at offset (dx, dy) can pass o G >= 1/255 only where a dx^2 + 2 b dx dy + c dy^2
 // <= k2 = 2 ln(255 o), i.e. |dx + (b/a) dy| <= sqrt(k2/a - (det/a^2) dy^2), det = ac - b^2.
@@ -87,10 +103,12 @@ void pixelRange(T mean, T half, int n, int& lo, int& hi) {
 // Beyond (needle-like Gaussians) or for anything not finite, no chord: the loops then
 // cover the whole rectangle, as they would without these terms.
 template <typename T>
-TileGaussian<T> tileData(const Projected<T>& P) {
+TileGaussian<T> tileData(const Projected<T>& P, int W, int H) {
   TileGaussian<T> q{P.mean2d[0], P.mean2d[1], P.conic[0], P.conic[1], P.conic[2], P.opacity, P.half[0],
                     P.half[1], P.depth, {P.color[0], P.color[1], P.color[2]}, T(0),
                     std::numeric_limits<T>::max(), T(0)};
+  pixelSpan(P.mean2d[0], P.half[0], W, q.px0, q.px1);
+  pixelSpan(P.mean2d[1], P.half[1], H, q.py0, q.py1);
   const double a = P.conic[0], b = P.conic[1], c = P.conic[2], o = P.opacity;
   const double det = a * c - b * b;
   const double k2 = 2.0 * std::log(255.0 * o) * 1.01 + 1e-4;
@@ -337,7 +355,7 @@ TileCover projectAll(const GaussiansT<T>& g, const CameraT<T>& camT, std::span<c
         }
         Projected<T>& P = st.proj[i] = projection::project(g, i, camT, rs);
         if (!P.visible) continue;
-        st.tile_data[i] = tileData(P);
+        st.tile_data[i] = tileData(P, W, H);
         out.visible[i] = 1;
         out.radii[i] = P.radius;
         int px0, px1, py0, py1;
