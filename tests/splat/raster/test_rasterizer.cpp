@@ -191,6 +191,49 @@ INSTANTIATE_TEST_SUITE_P(Scenes, FloatPath,
                          ::testing::Values(FloatCase{60, 3, 0.9, 0.0f, 5}, FloatCase{300, 0, 0.6, 0.7f, 6},
                                            FloatCase{150, 1, 1.5, 0.3f, 7}));
 
+// Gaussians wider than 32 pixels take the kernels' chord bounds (per block row, only the
+// columns the alpha ellipse can reach); smaller ones the plain rectangle. Long thin
+// Gaussians at every angle, against the double path: a chord that cut off a pixel the
+// per-pixel test passes would show here.
+TEST(FloatPath, LongThinGaussiansMatchDouble) {
+  const Camera cam = test::smallCamera(96, 72);
+  GaussiansD gd = test::randomScene<double>(40, 0, 11, 0.5);
+  for (int i = 0; i < 40; ++i) {
+    gd.log_scales[3 * i] = std::log(0.6 + 0.02 * i);
+    gd.log_scales[3 * i + 1] = std::log(0.01);
+    gd.log_scales[3 * i + 2] = std::log(0.01);
+    gd.opacities[i] = 2.0;
+  }
+  const Gaussians gf = gd.cast<float>();
+  const auto w = lossWeights(96, 72, 12);
+  const std::vector<float> wf(w.begin(), w.end());
+  for (const auto& [name, kernels] : test::runnableKernels()) {
+    RasterSettings s;
+    s.execution.kernels = kernels;
+    const auto rd = rasterizeT(gd, cam, s);
+    const auto rf = rasterizeT(gf, cam, s);
+    int wide = 0;
+    for (float r : rf.radii) wide += r > 16.0f;
+    ASSERT_GE(wide, 20) << name << ": the scene must exercise the chord bounds";
+    double max_diff = 0;
+    for (std::size_t k = 0; k < rd.rgb.size(); ++k) max_diff = std::max(max_diff, std::abs(rd.rgb[k] - rf.rgb[k]));
+    EXPECT_LT(max_diff, 1e-4) << name;
+    int differ = 0;
+    for (std::size_t k = 0; k < rd.contributors.size(); ++k) differ += rd.contributors[k] != rf.contributors[k];
+    EXPECT_LE(differ, static_cast<int>(rd.contributors.size() / 500)) << name;
+    GaussiansD gradd = gd.zerosLike();
+    Gaussians gradf = gf.zerosLike();
+    rasterizeBackwardT(gd, cam, s, rd, w.data(), gradd);
+    rasterizeBackwardT(gf, cam, s, rf, wf.data(), gradf);
+    double scale = 0, diff = 0;
+    for (std::size_t k = 0; k < gradd.means.size(); ++k) {
+      scale = std::max(scale, std::abs(gradd.means[k]));
+      diff = std::max(diff, std::abs(gradd.means[k] - gradf.means[k]));
+    }
+    EXPECT_LE(diff, 2e-3 * scale + 1e-6) << name;
+  }
+}
+
 TEST(Rasterizer, BitIdenticalAcrossRunsAndThreadCounts) {
   const Camera cam = test::smallCamera(96, 80);
   const Gaussians g = test::randomScene<double>(400, 1, 8, 1.5).cast<float>();
