@@ -55,6 +55,21 @@ GaussiansT<T> randomScene(int n, int sh_degree, std::uint64_t seed, double sprea
   return g;
 }
 
+// One isotropic float Gaussian of the given scale and opacity logit (SH degree 0): the
+// building block of the stiff scenes (test_raster_stability.cpp, test_fisher.cpp).
+inline Gaussians oneGaussian(const Eigen::Vector3d& mean, double scale, float logit = 2.0f) {
+  Gaussians g;
+  g.resize(1);
+  for (int k = 0; k < 3; ++k) {
+    g.means[k] = static_cast<float>(mean[k]);
+    g.log_scales[k] = static_cast<float>(std::log(scale));
+  }
+  g.rotations = {1, 0, 0, 0};
+  g.opacities = {logit};
+  g.sh = {0.5f, -0.2f, 0.1f};
+  return g;
+}
+
 struct GradCheck {
   int checked = 0, kinks = 0, bad = 0;
 };

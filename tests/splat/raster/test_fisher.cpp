@@ -75,19 +75,6 @@ struct FisherCase {
   std::array<float, 3> background{0, 0, 0};
 };
 
-Gaussians oneGaussian(const Eigen::Vector3d& mean, double scale, float logit = 2.0f) {
-  Gaussians g;
-  g.resize(1);
-  for (int k = 0; k < 3; ++k) {
-    g.means[k] = static_cast<float>(mean[k]);
-    g.log_scales[k] = static_cast<float>(std::log(scale));
-  }
-  g.rotations = {1, 0, 0, 0};
-  g.opacities = {logit};
-  g.sh = {0.5f, -0.2f, 0.1f};
-  return g;
-}
-
 // Random scenes of every SH degree with and without a background, and the stiff cases of
 // test_raster_stability.cpp: scales from 1e-6 to 1e4 of the scene's distance (and both at
 // once), opacity logits of +-30, Gaussians at and before the near plane, behind the
@@ -109,9 +96,9 @@ std::vector<FisherCase> fisherCases() {
   }
   const Camera small = test::smallCamera(32, 24);
   for (double rel : {1e-6, 1e-4, 1e-2, 1.0, 1e2, 1e4})
-    cases.push_back({"scale " + std::to_string(rel), oneGaussian(Eigen::Vector3d(0.1, 0.0, 0.05), rel * 3.0), small,
+    cases.push_back({"scale " + std::to_string(rel), test::oneGaussian(Eigen::Vector3d(0.1, 0.0, 0.05), rel * 3.0), small,
                      0, {0.1f, 0.2f, 0.3f}});
-  Gaussians aniso = oneGaussian(Eigen::Vector3d::Zero(), 1.0);
+  Gaussians aniso = test::oneGaussian(Eigen::Vector3d::Zero(), 1.0);
   aniso.log_scales = {std::log(1e-6f * 3), std::log(1e4f * 3), 0.0f};
   cases.push_back({"anisotropic 1e-6 / 1e4", aniso, small, 0, {0.1f, 0.2f, 0.3f}});
   Gaussians logits = test::randomScene<double>(20, 1, 30).cast<float>();

@@ -40,19 +40,6 @@ RenderOutputT<float> renderChecked(const Gaussians& g, const Camera& cam, int sh
   return r;
 }
 
-Gaussians oneGaussian(const Eigen::Vector3d& mean, double scale, float logit = 2.0f) {
-  Gaussians g;
-  g.resize(1);
-  for (int k = 0; k < 3; ++k) {
-    g.means[k] = static_cast<float>(mean[k]);
-    g.log_scales[k] = static_cast<float>(std::log(scale));
-  }
-  g.rotations = {1, 0, 0, 0};
-  g.opacities = {logit};
-  g.sh = {0.5f, -0.2f, 0.1f};
-  return g;
-}
-
 }  // namespace
 
 TEST(RasterStability, ScalesFromTinyToHuge) {
@@ -60,13 +47,13 @@ TEST(RasterStability, ScalesFromTinyToHuge) {
   const double extent = 3.0;  // the test camera's distance to the scene
   for (double rel : {1e-6, 1e-4, 1e-2, 1.0, 1e2, 1e4}) {
     SCOPED_TRACE(rel);
-    const auto r = renderChecked(oneGaussian(Eigen::Vector3d(0.1, 0.0, 0.05), rel * extent), cam);
+    const auto r = renderChecked(test::oneGaussian(Eigen::Vector3d(0.1, 0.0, 0.05), rel * extent), cam);
     if (rel >= 1.0) {
       EXPECT_GT(r.alpha[12 * 32 + 16], 0.0f);  // a big Gaussian covers the centre
     }
   }
   // Anisotropic: one axis tiny, one huge.
-  Gaussians g = oneGaussian(Eigen::Vector3d::Zero(), 1.0);
+  Gaussians g = test::oneGaussian(Eigen::Vector3d::Zero(), 1.0);
   g.log_scales = {std::log(1e-6f * 3), std::log(1e4f * 3), 0.0f};
   renderChecked(g, cam);
 }
@@ -81,7 +68,7 @@ TEST(RasterStability, OpacityLogitsOfPlusMinusThirty) {
 
 TEST(RasterStability, ZeroQuaternionIsTheIdentity) {
   const Camera cam = test::smallCamera(32, 24);
-  Gaussians a = oneGaussian(Eigen::Vector3d(0.1, 0, 0), 0.3);
+  Gaussians a = test::oneGaussian(Eigen::Vector3d(0.1, 0, 0), 0.3);
   a.log_scales = {std::log(0.5f), std::log(0.1f), std::log(0.2f)};
   Gaussians z = a;
   z.rotations = {0, 0, 0, 0};
