@@ -4,9 +4,10 @@
 // eight lanes with AVX2 (splat/raster/raster_kernels_avx2.cpp, its own compile flags), chosen
 // at run time. Each compilation lives in its own namespace and shares no code with the
 // other, so no function compiled for AVX2 can be picked by the linker for the baseline
-// path. No FMA contraction in either: every lane does the same operations in the same
-// order, so the two paths' forward outputs are bit-identical; the backward's per-pair
-// sums differ only in the order the lanes are added.
+// path. No implicit FMA contraction in either; the AVX2 build fuses the multiply-adds
+// written as fma() and the baseline rounds them twice, so the two paths agree to float
+// rounding (FloatPath.KernelSetsAgree), while each is bit-identical across runs and
+// thread counts.
 #include <cstdint>
 
 namespace saresgs {
@@ -14,8 +15,9 @@ namespace saresgs {
 // One Gaussian's data gathered per tile, in the tile's order. The chord terms bound, per
 // pixel row at offset dy from the mean, the columns where o G >= 1/255 can hold: centred
 // on mx + chord_slope dy with half width sqrt(chord_k0 - chord_k1 dy^2), widened so the
-// float per-pixel test never passes outside it (chordTerms in rasterizer.cpp). They only
-// shorten the kernels' loops; the per-pixel test decides.
+// float per-pixel test never passes outside it (tileData in rasterizer.cpp); the kernels
+// use them for Gaussians wider than 32 pixels. They only shorten the kernels' loops; the
+// per-pixel test decides.
 // The pixel spans (image columns px0..px1, rows py0..py1, inclusive; empty when
 // px0 > px1) hold every pixel whose centre can pass the float test |i + 0.5 - mean| <=
 // half: the exact bound widened by 1e-6 relative and 1e-3 px, computed once per Gaussian
