@@ -85,8 +85,9 @@ float meansLearningRate(const TrainerOptions& opt, int iteration, double extent)
 
 class Trainer {
  public:
-  // Builds the initial model from the scene's sparse points (or random points when it
-  // has none). The scene is copied (copies share its image cache).
+  // Builds the initial model from the scene's sparse points (or, when it has none,
+  // random_init_points random points in a cube about where the train cameras look:
+  // viewFocus in geometry/camera/camera.h). The scene is copied (copies share its image cache).
   Trainer(const Scene& scene, const TrainerOptions& opt);
 
   // Trains `iterations` iterations on `views` (indices into scene.views); `progress` is
