@@ -86,11 +86,11 @@ TEST(Trainer, WithoutPointsStartsFromRandomPointsWhereTheCamerasLook) {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e30), hi = -lo;
   for (std::size_t i = 0; i < 500; ++i) {
     const Eigen::Vector3d p(t.gaussians().means[3 * i], t.gaussians().means[3 * i + 1], t.gaussians().means[3 * i + 2]);
-    for (int k = 0; k < 3; ++k) EXPECT_LE(std::abs(p[k] - f.center[k]), f.radius * (1 + 1e-6) + 1e-6);
+    EXPECT_LE((p - f.center).norm(), f.radius * (1 + 1e-6) + 1e-6);
     lo = lo.cwiseMin(p);
     hi = hi.cwiseMax(p);
   }
-  // The points fill the cube, not a corner of it.
+  // The points fill the ball, not a corner of it.
   EXPECT_GT((hi - lo).minCoeff(), f.radius);
 }
 
