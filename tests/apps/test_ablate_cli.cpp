@@ -37,7 +37,7 @@ std::string writeGrid(const TempDir& d) {
     "methods": ["random", "fvs"],
     "seeds": [0, 1],
     "threads": 1,
-    "variants": [{"name": "default", "args": ["--max-views", "5", "--interval", "3", "--iterations", "30", "--final-iterations", "20"]}],
+    "variants": [{"name": "default", "args": ["--max-views", "5", "--interval", "3", "--min-iterations", "30", "--final-iterations", "20"]}],
     "tables": [{"name": "criteria", "title": "Prefilter criteria", "methods": ["random", "fvs"]}],
     "sweep": {"views": [4], "encodings": ["hash:11", "hash:16", "exact"], "lifting": "depth", "timing_repeats": 1}
   })");
