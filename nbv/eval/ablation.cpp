@@ -4,12 +4,14 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <set>
 #include <sstream>
 #include <stdexcept>
 
 #include "geometry/error.h"
 #include "geometry/io/json_file.h"
+#include "geometry/scene/manifest.h"
 
 namespace saresgs {
 
@@ -48,6 +50,21 @@ T fieldAs(const nlohmann::json& j, const std::string& file, const std::string& f
 std::vector<std::string> stringList(const nlohmann::json& j, const std::string& file, const std::string& field) {
   if (!j.is_array()) throw InputError(file, field, "expected an array of strings");
   return fieldAs<std::vector<std::string>>(j, file, field);
+}
+
+// The most threads a job may ask for (as `saresgs active --threads`).
+constexpr long long kMaxThreads = 1024;
+
+// A list whose items must differ (a repeat would run the same job twice).
+template <class T>
+void noRepeats(const std::vector<T>& items, const std::string& file, const std::string& field) {
+  for (std::size_t i = 0; i < items.size(); ++i)
+    for (std::size_t k = 0; k < i; ++k)
+      if (items[i] == items[k]) {
+        std::ostringstream s;
+        s << items[i];
+        throw InputError(file, jsonPath(field, i), s.str() + " appears twice");
+      }
 }
 
 // Folder-safe: letters, digits, '.', '-', '_' only.
@@ -154,9 +171,10 @@ SweepSpec readSweep(const nlohmann::json& s, const std::vector<AblationScene>& s
   for (const auto& n : sw.scenes)
     if (std::none_of(scenes.begin(), scenes.end(), [&](const AblationScene& sc) { return sc.name == n; }))
       throw InputError(path, "sweep.scenes", "'" + n + "' is not one of the scenes");
-  if (s.contains("views")) sw.view_counts = fieldAs<std::vector<int>>(s["views"], path, "sweep.views");
-  for (int c : sw.view_counts)
-    if (c < 1) throw InputError(path, "sweep.views", "view counts must be >= 1");
+  if (s.contains("views")) {
+    sw.view_counts.clear();
+    for (long long c : jsonIntegers(s["views"], path, "sweep.views", 1, kMaxSyntheticViews)) sw.view_counts.push_back(static_cast<int>(c));
+  }
   if (sw.view_counts.empty()) throw InputError(path, "sweep.views", "expected at least one view count");
   if (s.contains("encodings")) {
     sw.encodings.clear();
@@ -183,8 +201,11 @@ SweepSpec readSweep(const nlohmann::json& s, const std::vector<AblationScene>& s
     const std::string l = fieldAs<std::string>(s["lifting"], path, "sweep.lifting");
     sw.lifting = parsedAs([&] { return parseLiftingSource(l); }, path, "sweep.lifting");
   }
-  if (s.contains("keep")) sw.keep_fraction = fieldAs<double>(s["keep"], path, "sweep.keep");
-  if (s.contains("timing_repeats")) sw.timing_repeats = fieldAs<int>(s["timing_repeats"], path, "sweep.timing_repeats");
+  if (s.contains("keep")) {
+    sw.keep_fraction = jsonNumberIn(s["keep"], path, "sweep.keep", 0, 1);
+    if (!(sw.keep_fraction > 0)) throw InputError(path, "sweep.keep", "expected a fraction in (0, 1]");
+  }
+  if (s.contains("timing_repeats")) sw.timing_repeats = static_cast<int>(jsonInteger(s["timing_repeats"], path, "sweep.timing_repeats", 1, 1000));
   return sw;
 }
 
@@ -201,15 +222,15 @@ AblationGrid readAblationGrid(const std::string& path) {
       throw InputError(path, key, "unknown field");
   if (j.contains("preset")) g.preset = fieldAs<std::string>(j["preset"], path, "preset");
   if (g.preset != "quick" && g.preset != "paper") throw InputError(path, "preset", "expected quick or paper");
-  if (j.contains("threads")) g.threads = fieldAs<int>(j["threads"], path, "threads");
-  if (g.threads < 0) throw InputError(path, "threads", "expected >= 0");
+  if (j.contains("threads")) g.threads = static_cast<int>(jsonInteger(j["threads"], path, "threads", 0, kMaxThreads));
   g.scenes = readScenes(j, path);
   if (j.contains("methods")) g.methods = stringList(j["methods"], path, "methods");
   for (const auto& m : g.methods) checkMethod(m, path, "methods");
-  if (j.contains("seeds")) {
-    if (!j["seeds"].is_array()) throw InputError(path, "seeds", "expected an array of integers");
-    g.seeds = fieldAs<std::vector<std::uint64_t>>(j["seeds"], path, "seeds");
-  }
+  noRepeats(g.methods, path, "methods");
+  if (j.contains("seeds"))
+    for (long long s : jsonIntegers(j["seeds"], path, "seeds", 0, std::numeric_limits<long long>::max()))
+      g.seeds.push_back(static_cast<std::uint64_t>(s));
+  noRepeats(g.seeds, path, "seeds");
   if (g.seeds.empty()) g.seeds = {0};
   if (j.contains("method_args")) {
     if (!j["method_args"].is_object()) throw InputError(path, "method_args", "expected {method: [args]}");
