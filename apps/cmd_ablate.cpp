@@ -120,9 +120,29 @@ int writeSummary(const AblationGrid& g, const std::vector<AblationJob>& jobs, co
   return 0;
 }
 
+// Every active job's command line (preset, seed, threads, method_args, a variant's args) is
+// parsed when the config is read, so that a bad value stops the grid before any job runs.
+void checkJobArguments(const AblationGrid& g, const std::vector<AblationJob>& jobs) {
+  for (const AblationJob& j : jobs) {
+    if (j.kind != AblationJob::Kind::kActive) continue;
+    try {
+      checkActiveArguments(j.args);
+    } catch (const std::exception& e) {
+      std::string field;
+      if (g.method_args.count(j.method)) field = "method_args." + j.method;
+      for (std::size_t v = 0; v < g.variants.size(); ++v)
+        if (g.variants[v].name == j.variant && !g.variants[v].args.empty())
+          field += (field.empty() ? "" : " + ") + std::string("variants[") + std::to_string(v) + "].args";
+      if (field.empty()) field = "preset/threads/seeds";
+      throw InputError(g.source, field, "job " + j.id + ": " + e.what());
+    }
+  }
+}
+
 int runAblate(const AblateArgs& a) {
   const AblationGrid g = readAblationGrid(a.config);
   const std::vector<AblationJob> all = expandGrid(g);
+  checkJobArguments(g, all);
   int si = 0, sn = 1;
   if (!a.shard.empty()) std::tie(si, sn) = parseShard(a.shard);
   const std::vector<AblationJob> jobs = shardJobs(all, si, sn);
@@ -174,6 +194,7 @@ int runAblate(const AblateArgs& a) {
 int runMerge(const AblateArgs& a) {
   const AblationGrid g = readAblationGrid(a.config);
   const std::vector<AblationJob> all = expandGrid(g);
+  checkJobArguments(g, all);
   std::stringstream ss(a.inputs);
   for (std::string in; std::getline(ss, in, ',');) {
     if (in.empty()) continue;

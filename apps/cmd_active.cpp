@@ -1,4 +1,5 @@
 // saresgs active: one active reconstruction run (the product's main job).
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -30,7 +31,7 @@ struct ActiveArgs {
   bool resume = false, continue_training = false, sub_only = false, time_exhaustive_fisher = false;
   std::uint64_t seed = 0;
   double fisher_lambda = 1e-6;
-  std::optional<int> max_views, interval, total, final_iterations;
+  std::optional<int> max_views, interval, total, final_iterations, renamed_iterations;
   std::optional<long long> max_gaussians;
   std::optional<double> beta, prefilter_keep;
   PrefilterFlags prefilter;
@@ -38,6 +39,10 @@ struct ActiveArgs {
 
 // The run's options: the preset, then every option given on the command line.
 ActiveOptions activeOptions(const ActiveArgs& a) {
+  if (a.renamed_iterations)
+    throw std::invalid_argument(
+        "--iterations is now --min-iterations: the loop trains at least that many iterations in all, the last phase "
+        "what is left and never less than views x --interval (results.json: iterations, phase_iterations)");
   ActiveOptions o = presetOptions(parsePreset(a.preset));
   o.method = parseMethod(a.method);
   o.seed = a.seed;
@@ -64,8 +69,12 @@ ActiveOptions activeOptions(const ActiveArgs& a) {
 }
 
 void printSummary(const RunReport& r, const std::string& out) {
-  std::printf("\n%s run, preset %s, seed %llu, %d iterations in the loop, %zu views\n", r.method.c_str(), r.preset.c_str(),
-              static_cast<unsigned long long>(r.seed), r.iterations, r.selected_view_indices.size());
+  std::string phases;
+  if (r.phase_iterations)
+    for (int p : *r.phase_iterations) phases += (phases.empty() ? "" : " + ") + std::to_string(p);
+  std::printf("\n%s run, preset %s, seed %llu, %d iterations in the loop (%s; at least %d asked), %zu views\n", r.method.c_str(),
+              r.preset.c_str(), static_cast<unsigned long long>(r.seed), r.iterations, phases.c_str(), r.options.total_iterations,
+              r.selected_view_indices.size());
   std::printf("%-34s %8s %8s %8s %10s %10s %10s\n", "model", "PSNR", "SSIM", "AUSE", "select s", "train s", "total s");
   std::printf("%-34s %8.2f %8.4f %8s %10.1f %10.1f %10.1f\n", "in the loop (paper's protocol)", r.psnr, r.ssim,
               r.ause ? std::to_string(*r.ause).substr(0, 6).c_str() : "n/a", r.seconds.selection(), r.seconds.training,
@@ -112,8 +121,10 @@ int runActive(const ActiveArgs& a) {
 
 }  // namespace
 
-void addActiveCommand(CLI::App& app, Action& action) {
-  auto a = std::make_shared<ActiveArgs>();
+namespace {
+
+// The subcommand and its options, filling `a`.
+CLI::App* addActiveOptions(CLI::App& app, const std::shared_ptr<ActiveArgs>& a) {
   CLI::App* sub = app.add_subcommand("active", "Active reconstruction: select views one by one while training");
   sub->add_option("--dataset", a->dataset, "COLMAP, Blender or `saresgs scene` folder")->required();
   sub->add_option("--out", a->out, "Output folder")->required();
@@ -122,7 +133,11 @@ void addActiveCommand(CLI::App& app, Action& action) {
   sub->add_option("--preset", a->preset, "quick | paper")->capture_default_str();
   sub->add_option("--max-views", a->max_views, "Views at the end (default 20)")->check(wholeNumberAtLeast(1));
   sub->add_option("--interval", a->interval, "Iterations per view held (preset's by default)")->check(wholeNumberAtLeast(1));
-  sub->add_option("--iterations", a->total, "Total iterations (preset's by default)")->check(wholeNumberAtLeast(1));
+  sub->add_option("--min-iterations", a->total,
+                  "Least total iterations of the loop: the last phase trains what is left and never less than views x "
+                  "interval, so more may run (preset's by default; results.json: iterations, phase_iterations)")
+      ->check(wholeNumberAtLeast(1));
+  sub->add_option("--iterations", a->renamed_iterations, "Renamed --min-iterations")->group("");
   sub->add_option("--final-iterations", a->final_iterations,
                   "Final fit: a fresh model trained on the chosen views for N iterations (0: none; preset's by default)")
       ->check(wholeNumberAtLeast(0));
@@ -147,7 +162,30 @@ void addActiveCommand(CLI::App& app, Action& action) {
   sub->add_option("--downscale", a->downscale, "Image downscale factor")->check(CLI::Range(1, 64))->capture_default_str();
   sub->add_option("--threads", a->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
   sub->add_flag("--resume", a->resume, "Continue the run in OUT from its checkpoint");
+  return sub;
+}
+
+}  // namespace
+
+void addActiveCommand(CLI::App& app, Action& action) {
+  auto a = std::make_shared<ActiveArgs>();
+  CLI::App* sub = addActiveOptions(app, a);
   sub->callback([&action, a] { action = [a] { return runActive(*a); }; });
+}
+
+void checkActiveArguments(const std::vector<std::string>& args) {
+  auto a = std::make_shared<ActiveArgs>();
+  CLI::App app;
+  addActiveOptions(app, a);
+  std::vector<std::string> argv{"active"};
+  argv.insert(argv.end(), args.begin(), args.end());
+  if (std::find(args.begin(), args.end(), "--out") == args.end()) argv.insert(argv.end(), {"--out", "."});
+  try {
+    app.parse(std::vector<std::string>(argv.rbegin(), argv.rend()));
+  } catch (const CLI::ParseError& e) {
+    throw std::invalid_argument(e.what());
+  }
+  (void)activeOptions(*a);
 }
 
 }  // namespace saresgs::apps

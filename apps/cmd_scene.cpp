@@ -1,9 +1,11 @@
-// saresgs scene: writes a ground-truth synthetic dataset (COLMAP model, images, depth).
+// saresgs scene: writes a ground-truth synthetic dataset (COLMAP model, images, depth; or a
+// NeRF-synthetic folder with --format blender).
 #include <iostream>
 
 #include "apps/cli_checks.h"
 #include "apps/commands.h"
 #include "apps/progress.h"
+#include "geometry/scene/manifest.h"
 #include "geometry/synth/assets.h"
 #include "geometry/synth/write_dataset.h"
 
@@ -15,9 +17,11 @@ struct SceneArgs {
   SyntheticOptions scene;
   WriteDatasetOptions write;
   std::string out;
+  bool no_points = false;
 };
 
 int runScene(SceneArgs& a) {
+  if (a.no_points) a.write.sfm = "none";
   for (auto& m : a.scene.meshes) m = resolveAsset(m);
   for (auto& t : a.scene.textures) t = resolveAsset(t);
   std::cerr << "building " << a.scene.layout << " scene (seed " << a.scene.seed << ")\n";
@@ -28,7 +32,7 @@ int runScene(SceneArgs& a) {
   };
   a.write.simulated.seed = a.scene.seed;
   const WriteDatasetReport r = writeSyntheticDataset(scene, a.out, a.write);
-  std::cout << "wrote " << a.out << ": layout " << a.scene.layout << ", " << r.views << " views ("
+  std::cout << "wrote " << a.out << " (" << a.write.format << "): layout " << a.scene.layout << ", " << r.views << " views ("
             << scene.train.size() << " train, " << scene.test.size() << " test), "
             << a.scene.width << "x" << a.scene.height << "\n"
             << "  render: " << r.render_seconds << " s total, median " << r.median_view_ms
@@ -52,7 +56,7 @@ void addSceneCommand(CLI::App& app, Action& action) {
   sub->add_option("--width", args->scene.width, "Image width")->check(CLI::Range(16, 8192))->capture_default_str();
   sub->add_option("--height", args->scene.height, "Image height")->check(CLI::Range(16, 8192))->capture_default_str();
   sub->add_option("--seed", args->scene.seed, "Random seed")->check(wholeNumberAtLeast(0))->capture_default_str();
-  sub->add_option("--views", args->scene.num_views, "Number of views (0: the layout's default)")->check(CLI::Range(0, 100000));
+  sub->add_option("--views", args->scene.num_views, "Number of views (0: the layout's default)")->check(CLI::Range(0, kMaxSyntheticViews));
   sub->add_option("--mesh", args->scene.meshes, "Mesh files (OFF/PLY/OBJ) or cgal:NAME; default procedural");
   sub->add_option("--texture", args->scene.textures, "Photographs (PNG/JPEG) or opencv:FILE; default procedural");
   sub->add_option("--up", args->scene.up_axis, "Up axis of the mesh files")->check(CLI::IsMember({"x", "y", "z"}))->capture_default_str();
@@ -60,8 +64,12 @@ void addSceneCommand(CLI::App& app, Action& action) {
       ->check(CLI::IsMember({"triplanar", "spherical"}))->capture_default_str();
   sub->add_option("--spp", args->write.render.samples_per_pixel, "Samples per pixel (>= 4)")->check(CLI::Range(4, 4096))->capture_default_str();
   sub->add_flag("--specular", args->write.render.specular, "Add a mild specular highlight");
-  sub->add_option("--sfm", args->write.sfm, "Sparse points: simulated | colmap | none")
+  CLI::Option* sfm = sub->add_option("--sfm", args->write.sfm, "Sparse points: simulated | colmap | none")
       ->check(CLI::IsMember({"simulated", "colmap", "none"}))->capture_default_str();
+  sub->add_flag("--no-points", args->no_points, "No sparse points (the same as --sfm none)")->excludes(sfm);
+  sub->add_option("--format", args->write.format,
+                  "colmap (sparse/0, images/) | blender (NeRF-synthetic: transforms_*.json, RGBA train/ and test/, points3d.ply)")
+      ->check(CLI::IsMember({"colmap", "blender"}))->capture_default_str();
   sub->callback([&action, args] { action = [args] { return runScene(*args); }; });
 }
 

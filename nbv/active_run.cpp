@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -188,6 +189,14 @@ ActiveResult ActiveRun::run(const std::function<void(const ActiveProgress&)>& pr
   r.steps = steps_;
   for (const auto& s : steps_) r.total_seconds += s.seconds;
   r.iterations = iterations_done_;
+  // The phases before the last trained k x interval for k views held (checkLoadedState
+  // holds a resumed run to that); the last trained the rest.
+  int before_last = 0;
+  for (std::size_t k = initial_.size(); k < selected_.size(); ++k) {
+    r.phase_iterations.push_back(static_cast<int>(k) * opt_.interval);
+    before_last += r.phase_iterations.back();
+  }
+  r.phase_iterations.push_back(iterations_done_ - before_last);
   report(ActivePhase::kFinalEvaluation, 0, 1);
   r.test = trainer_->evaluate(scene_.test.empty() ? scene_.train : scene_.test);
   r.ause = depthAuse(*trainer_, selected_, scene_.test.empty() ? scene_.train : scene_.test, opt_.fisher_lambda);
@@ -265,45 +274,46 @@ void ActiveRun::checkLoadedState() const {
 
 bool ActiveRun::loadCheckpoint() {
   if (checkpoint_.empty() || !std::filesystem::exists(checkpoint_)) return false;
-  const nlohmann::json j = readJsonFile(checkpoint_);
-  auto field = [&](const char* name) -> const nlohmann::json& {
-    if (!j.contains(name)) throw InputError(checkpoint_, name, "missing");
-    return j[name];
+  const std::string& f = checkpoint_;
+  const nlohmann::json j = readJsonFile(f);
+  jsonObject(j, f, "json");
+  auto field = [&](const char* name) -> const nlohmann::json& { return jsonMember(j, name, f, ""); };
+  auto text = [&](const char* name) { return jsonString(field(name), f, name); };
+  if (text("format") != kCheckpointFormat) throw InputError(f, "format", "not an active-run checkpoint");
+  if (text("method") != toString(opt_.method))
+    throw InputError(f, "method", "written by method " + j["method"].dump() + ", this run is " + toString(opt_.method));
+  constexpr long long kMaxCount = 2'000'000'000;
+  if (static_cast<std::uint64_t>(jsonInteger(field("seed"), f, "seed", 0, std::numeric_limits<long long>::max())) != opt_.seed)
+    throw InputError(f, "seed", "written with seed " + j["seed"].dump());
+  if (jsonInteger(field("views"), f, "views", 0, kMaxCount) != static_cast<long long>(scene_.views.size()))
+    throw InputError(f, "views", "written for another scene");
+  // View indices are read in range of this scene's views; checkLoadedState checks the rest.
+  const long long last_view = static_cast<long long>(scene_.views.size()) - 1;
+  auto views = [&](const char* name) {
+    std::vector<int> v;
+    for (long long x : jsonIntegers(field(name), f, name, 0, last_view)) v.push_back(static_cast<int>(x));
+    return v;
   };
-  if (field("format") != kCheckpointFormat) throw InputError(checkpoint_, "format", "not an active-run checkpoint");
-  if (field("method") != toString(opt_.method))
-    throw InputError(checkpoint_, "method", "written by method " + j["method"].dump() + ", this run is " + toString(opt_.method));
-  if (field("seed") != opt_.seed) throw InputError(checkpoint_, "seed", "written with seed " + j["seed"].dump());
-  if (field("views") != scene_.views.size()) throw InputError(checkpoint_, "views", "written for another scene");
-  try {
-    initial_ = field("initial").get<std::vector<int>>();
-    selected_ = field("selected").get<std::vector<int>>();
-    // Read as numbers first: a huge or fractional value must not be converted blindly.
-    for (const char* name : {"iterations_done", "observed_upto"}) {
-      const double x = field(name).get<double>();
-      if (!(x >= 0 && x <= 2e9 && x == std::floor(x))) throw InputError(checkpoint_, name, "not a count: " + j[name].dump());
-    }
-    iterations_done_ = field("iterations_done").get<int>();
-    observed_upto_ = field("observed_upto").get<int>();
-    std::istringstream rs(field("rng").get<std::string>());
-    rs >> rng_;
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(checkpoint_, "state", std::string("unexpected content: ") + e.what());
-  }
+  initial_ = views("initial");
+  selected_ = views("selected");
+  iterations_done_ = static_cast<int>(jsonInteger(field("iterations_done"), f, "iterations_done", 0, kMaxCount));
+  observed_upto_ = static_cast<int>(jsonInteger(field("observed_upto"), f, "observed_upto", 0, kMaxCount));
+  std::istringstream rs(text("rng"));
+  rs >> rng_;
+  if (rs.fail()) throw InputError(f, "rng", "expected the state of a 64-bit Mersenne Twister");
   checkLoadedState();
   steps_.clear();
-  const nlohmann::json& steps = field("steps");
-  if (!steps.is_array()) throw InputError(checkpoint_, "steps", "expected an array");
+  const nlohmann::json& steps = jsonArray(field("steps"), f, "steps", selected_.size());
   for (std::size_t i = 0; i < steps.size(); ++i)
-    steps_.push_back(selectionLog(scene_, stepReportFromJson(steps[i], checkpoint_, "steps[" + std::to_string(i) + "]"), checkpoint_));
+    steps_.push_back(selectionLog(scene_, stepReportFromJson(steps[i], f, jsonPath("steps", i)), f));
   if (steps_.size() != selected_.size() - initial_.size())
-    throw InputError(checkpoint_, "steps", std::to_string(steps_.size()) + " steps for " +
-                                               std::to_string(selected_.size() - initial_.size()) + " added views");
-  if (field("tag") != std::to_string(selected_.size()))
-    throw InputError(checkpoint_, "tag", "expected \"" + std::to_string(selected_.size()) + "\", the number of views held");
-  const std::string tag = field("tag");
+    throw InputError(f, "steps", std::to_string(steps_.size()) + " steps for " +
+                                     std::to_string(selected_.size() - initial_.size()) + " added views");
+  const std::string tag = text("tag");
+  if (tag != std::to_string(selected_.size()))
+    throw InputError(f, "tag", "expected \"" + std::to_string(selected_.size()) + "\", the number of views held");
   trainer_->loadCheckpoint(checkpoint_ + ".trainer." + tag);
-  if (prefilter_) prefilter_->load(readFile(checkpoint_ + ".prefilter." + tag));
+  if (prefilter_) prefilter_->load(readFile(checkpoint_ + ".prefilter." + tag), checkpoint_ + ".prefilter." + tag);
   return true;
 }
 

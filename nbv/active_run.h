@@ -27,6 +27,9 @@ struct ActiveOptions {
   int initial_views = 4;
   int max_views = 20;
   int interval = 100;             // iterations per view held
+  // The loop's least total: the last phase trains what is left of it and never less than
+  // its views x interval, so a run trains max(total_iterations, the phases' sum)
+  // (`--min-iterations`; ActiveResult::iterations says what ran).
   int total_iterations = 20000;
   bool reset_after_add = true;
   // After each reset the SH degree restarts at 0 and rises on the run's global iteration
@@ -86,6 +89,7 @@ struct ActiveResult {
   std::optional<FinalFit> final_fit;
   SelectionSeconds total_seconds;
   int iterations = 0;  // training iterations over the whole run
+  std::vector<int> phase_iterations;  // per phase: k x interval for k views held, then the last
   double seconds = 0;  // end to end, this process
 };
 

@@ -76,11 +76,14 @@ class SaPointPrefilter : public CoveragePrefilter {
     if (!bytes.empty()) std::memcpy(bytes.data(), observed_points_.data(), bytes.size());
     return bytes;
   }
-  void load(const std::string& bytes) override {
-    if (bytes.size() % sizeof(Eigen::Vector3d)) throw InputError("prefilter state", "points", "truncated");
+  void load(const std::string& bytes, const std::string& source) override {
+    if (bytes.size() % sizeof(Eigen::Vector3d))
+      throw InputError(source, "points", "truncated: " + std::to_string(bytes.size()) + " bytes is not a whole number of points");
     observed_points_.resize(bytes.size() / sizeof(Eigen::Vector3d));
     // Vector3d is three packed doubles: the bytes are the points as save() wrote them.
     if (!bytes.empty()) std::memcpy(static_cast<void*>(observed_points_.data()), bytes.data(), bytes.size());
+    for (std::size_t i = 0; i < observed_points_.size(); ++i)
+      if (!observed_points_[i].allFinite()) throw InputError(source, "points", "point " + std::to_string(i) + " is NaN or Inf");
     grids_->clearObserved();
     grids_->addObserved(observed_points_);
   }

@@ -91,7 +91,8 @@ class CoveragePrefilter {
   virtual const LiftingReport& liftingReport() const = 0;  // summed over observed views
   // Serialised observed state, so a resumed run continues with the same grids.
   virtual std::string save() const = 0;
-  virtual void load(const std::string& bytes) = 0;
+  // `source` names the file in errors (a truncated state, a non-finite point).
+  virtual void load(const std::string& bytes, const std::string& source) = 0;
 };
 
 // Throws InputError when the scene has no sparse points (the occupancy grid needs them),

@@ -1,8 +1,13 @@
 #include "nbv/run_report.h"
 
+#include <algorithm>
+#include <cstdint>
+#include <limits>
 #include <map>
+#include <type_traits>
 
 #include "geometry/error.h"
+#include "geometry/io/json_file.h"
 #include "splat/train/residual.h"
 
 namespace saresgs {
@@ -11,24 +16,33 @@ namespace {
 
 using json = nlohmann::json;
 
-// j[key] as T; InputError(source, path.key) when it is missing or of another type.
+// j[key] as T; InputError(source, path.key) when it is missing, of another type or, for
+// counts, negative or fractional.
 template <class T>
 T field(const json& j, const char* key, const std::string& source, const std::string& path) {
-  const std::string name = path.empty() ? key : path + "." + key;
-  if (!j.is_object() || !j.contains(key)) throw InputError(source, name, "missing");
-  try {
-    return j[key].get<T>();
-  } catch (const json::exception&) {
-    throw InputError(source, name, std::string("unexpected type ") + j[key].type_name());
+  const std::string name = jsonPath(path, key);
+  const json& v = jsonMember(j, key, source, path);
+  if constexpr (std::is_same_v<T, std::string>) return jsonString(v, source, name);
+  else if constexpr (std::is_same_v<T, bool>) return jsonBool(v, source, name);
+  else if constexpr (std::is_same_v<T, double>) return jsonNumber(v, source, name);
+  else if constexpr (std::is_integral_v<T>)
+    return static_cast<T>(jsonInteger(v, source, name, 0, static_cast<long long>(std::min<std::uint64_t>(std::numeric_limits<T>::max(), std::numeric_limits<long long>::max()))));
+  else if constexpr (std::is_same_v<T, std::vector<std::string>>) return jsonStrings(v, source, name);
+  else if constexpr (std::is_same_v<T, std::vector<double>>) return jsonNumbers(v, source, name);
+  else {
+    static_assert(std::is_same_v<T, std::vector<int>>);
+    std::vector<int> out;
+    for (long long x : jsonIntegers(v, source, name, 0, std::numeric_limits<int>::max())) out.push_back(static_cast<int>(x));
+    return out;
   }
 }
 
 // The optional per-view array `j["views"]` (named `path` in messages).
 void readViews(const json& j, const std::string& src, const std::string& path, std::vector<ViewReport>& out) {
   if (!j.contains("views")) return;
-  if (!j["views"].is_array()) throw InputError(src, path, "expected an array");
+  jsonArray(j["views"], src, path);
   for (std::size_t i = 0; i < j["views"].size(); ++i) {
-    const std::string p = path + "[" + std::to_string(i) + "]";
+    const std::string p = jsonPath(path, i);
     const json& v = j["views"][i];
     out.push_back({field<std::string>(v, "name", src, p), field<double>(v, "psnr", src, p), field<double>(v, "ssim", src, p)});
   }
@@ -75,6 +89,7 @@ RunReport makeRunReport(const Scene& scene, const ActiveOptions& opt, const Acti
   rep.end_to_end_seconds = r.seconds;
   rep.gaussians = c.gaussians;
   rep.iterations = r.iterations;
+  rep.phase_iterations = r.phase_iterations;
   rep.threads = c.threads;
   for (const ViewMetrics& m : r.test.views)
     rep.views.push_back({scene.views.at(static_cast<std::size_t>(m.view)).name, m.psnr, m.ssim});
@@ -103,11 +118,7 @@ StepReport stepReportFromJson(const json& j, const std::string& source, const st
   StepReport s;
   s.views_before = field<int>(j, "views_before", source, path);
   s.progress_psnr = field<double>(j, "progress_psnr", source, path);
-  try {
-    s.seconds = secondsFrom(j.at("seconds"));
-  } catch (const json::exception&) {
-    throw InputError(source, path + ".seconds", "expected an object with a number per stage");
-  }
+  s.seconds = secondsFrom(jsonMember(j, "seconds", source, path), source, jsonPath(path, "seconds"));
   if (j.contains("selected")) {
     s.selected = field<std::string>(j, "selected", source, path);
     s.candidates = field<std::vector<std::string>>(j, "candidates", source, path);
@@ -148,6 +159,7 @@ json toJson(const RunReport& r) {
   j["seconds"]["end_to_end_this_process"] = r.end_to_end_seconds;
   j["gaussians"] = r.gaussians;
   j["iterations"] = r.iterations;
+  if (r.phase_iterations) j["phase_iterations"] = *r.phase_iterations;
   j["threads"] = r.threads;
   for (const ViewReport& v : r.views) j["views"].push_back({{"name", v.name}, {"psnr", v.psnr}, {"ssim", v.ssim}});
   for (const StepReport& s : r.steps) j["steps"].push_back(toJson(s));
@@ -166,7 +178,7 @@ RunReport runReportFromJson(const json& j, const std::string& src) {
   r.method = field<std::string>(j, "method", src, "");
   r.seed = field<std::uint64_t>(j, "seed", src, "");
   r.preset = field<std::string>(j, "preset", src, "");
-  const json& o = j.contains("options") ? j["options"] : json();
+  const json& o = jsonMember(j, "options", src, "");
   RunOptionsReport& ro = r.options;
   ro.interval = field<int>(o, "interval", src, "options");
   ro.total_iterations = field<int>(o, "total_iterations", src, "options");
@@ -189,19 +201,15 @@ RunReport runReportFromJson(const json& j, const std::string& src) {
   r.initial_views = field<std::vector<std::string>>(j, "initial_views", src, "");
   r.selected_views = field<std::vector<std::string>>(j, "selected_views", src, "");
   r.selected_view_indices = field<std::vector<int>>(j, "selected_view_indices", src, "");
-  try {
-    r.seconds = secondsFrom(j.at("seconds"));
-  } catch (const json::exception&) {
-    throw InputError(src, "seconds", "expected an object with a number per stage");
-  }
+  r.seconds = secondsFrom(jsonMember(j, "seconds", src, ""), src, "seconds");
   r.end_to_end_seconds = field<double>(j["seconds"], "end_to_end_this_process", src, "seconds");
   r.gaussians = field<std::size_t>(j, "gaussians", src, "");
   r.iterations = field<int>(j, "iterations", src, "");
+  if (j.contains("phase_iterations")) r.phase_iterations = field<std::vector<int>>(j, "phase_iterations", src, "");
   r.threads = field<int>(j, "threads", src, "");
   readViews(j, src, "views", r.views);
-  if (!j.contains("steps") || !j["steps"].is_array()) throw InputError(src, "steps", "expected an array");
-  for (std::size_t i = 0; i < j["steps"].size(); ++i)
-    r.steps.push_back(stepReportFromJson(j["steps"][i], src, "steps[" + std::to_string(i) + "]"));
+  const json& steps = jsonArray(jsonMember(j, "steps", src, ""), src, "steps");
+  for (std::size_t i = 0; i < steps.size(); ++i) r.steps.push_back(stepReportFromJson(steps[i], src, jsonPath("steps", i)));
   if (j.contains("final_fit")) {
     const json& f = j["final_fit"];
     FinalFitReport ff;

@@ -29,6 +29,8 @@ struct StepReport {
 
 // The options that shaped the run, as the tables name them.
 struct RunOptionsReport {
+  // total_iterations: the loop's least total (`--min-iterations`); what ran is
+  // RunReport::iterations.
   int interval = 0, total_iterations = 0, max_views = 0;
   std::size_t max_gaussians = 0;
   bool reset_after_add = true, residual = false;
@@ -63,7 +65,10 @@ struct RunReport {
   SelectionSeconds seconds;                 // summed over steps
   double end_to_end_seconds = 0;            // this process (a resumed run: since resuming)
   std::size_t gaussians = 0;
-  int iterations = 0;
+  int iterations = 0;  // trained in the loop, every phase: at least options.total_iterations
+  // Each phase's iterations, the last one's model evaluated (after a reset it trained only
+  // that phase); absent in reports written before it was recorded.
+  std::optional<std::vector<int>> phase_iterations;
   int threads = 0;
   std::vector<ViewReport> views;  // per test view
   std::vector<StepReport> steps;

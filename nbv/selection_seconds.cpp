@@ -1,5 +1,9 @@
 #include "nbv/selection_seconds.h"
 
+#include <limits>
+
+#include "geometry/io/json_file.h"
+
 namespace saresgs {
 
 SelectionSeconds& SelectionSeconds::operator+=(const SelectionSeconds& o) {
@@ -17,14 +21,17 @@ nlohmann::json toJson(const SelectionSeconds& s) {
           {"fisher", s.fisher},     {"training", s.training},           {"exhaustive_fisher", s.exhaustive_fisher}};
 }
 
-SelectionSeconds secondsFrom(const nlohmann::json& j) {
+SelectionSeconds secondsFrom(const nlohmann::json& j, const std::string& file, const std::string& field) {
   SelectionSeconds s;
-  s.lifting = j.at("lifting").get<double>();
-  s.triangulation = j.at("triangulation").get<double>();
-  s.prefilter = j.at("prefilter").get<double>();
-  s.fisher = j.at("fisher").get<double>();
-  s.training = j.at("training").get<double>();
-  s.exhaustive_fisher = j.at("exhaustive_fisher").get<double>();
+  auto stage = [&](const char* key) {
+    return jsonNumberIn(jsonMember(j, key, file, field), file, jsonPath(field, key), 0, std::numeric_limits<double>::max());
+  };
+  s.lifting = stage("lifting");
+  s.triangulation = stage("triangulation");
+  s.prefilter = stage("prefilter");
+  s.fisher = stage("fisher");
+  s.training = stage("training");
+  s.exhaustive_fisher = stage("exhaustive_fisher");
   return s;
 }
 

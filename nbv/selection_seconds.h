@@ -2,6 +2,8 @@
 // Stage times of one view selection (and, summed, of a run), seconds.
 #include <nlohmann/json.hpp>
 
+#include <string>
+
 namespace saresgs {
 
 struct SelectionSeconds {
@@ -12,9 +14,9 @@ struct SelectionSeconds {
   SelectionSeconds& operator+=(const SelectionSeconds& o);
 };
 
-// One JSON object with a number per stage, and back; the reader throws
-// nlohmann::json::exception when a stage is missing or not a number.
+// One JSON object with a number per stage, and back; the reader throws InputError(file,
+// field.stage) when a stage is missing or not a finite number >= 0.
 nlohmann::json toJson(const SelectionSeconds& s);
-SelectionSeconds secondsFrom(const nlohmann::json& j);
+SelectionSeconds secondsFrom(const nlohmann::json& j, const std::string& file, const std::string& field);
 
 }  // namespace saresgs

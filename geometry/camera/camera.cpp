@@ -1,7 +1,12 @@
 #include "geometry/camera/camera.h"
 
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <vector>
 
 #include "geometry/error.h"
 
@@ -31,7 +36,7 @@ Intrinsics Intrinsics::scaled(double factor) const {
 }
 
 bool Intrinsics::valid() const {
-  return width > 0 && height > 0 && std::isfinite(fx) && std::isfinite(fy) && fx > 0 &&
+  return width > 0 && height > 0 && width <= kMaxImageSide && height <= kMaxImageSide && std::isfinite(fx) && std::isfinite(fy) && fx > 0 &&
          fy > 0 && std::isfinite(cx) && std::isfinite(cy);
 }
 
@@ -143,10 +148,68 @@ double sceneExtent(std::span<const Camera> cameras) {
   return 1.1 * r;
 }
 
+ViewFocus viewFocus(std::span<const Camera> cameras) {
+  ViewFocus f;
+  if (cameras.empty()) return f;
+  const double n = static_cast<double>(cameras.size());
+  Eigen::Vector3d mean_c = Eigen::Vector3d::Zero(), mean_d = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  for (const Camera& c : cameras) {
+    // The squared distance of p from the axis c + s d is |(I - d d^T)(p - c)|^2.
+    const Eigen::Vector3d d = c.viewDirection().normalized();
+    const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - d * d.transpose();
+    A += P;
+    b += P * c.center();
+    mean_c += c.center();
+    mean_d += d;
+  }
+  mean_c /= n;
+  mean_d /= n;
+  double spread = 0;
+  for (const Camera& c : cameras) spread = std::max(spread, (c.center() - mean_c).norm());
+  auto medianOf = [](std::vector<double> v) {
+    std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+    return v[v.size() / 2];
+  };
+  auto halfTan = [](const Camera& c) { return std::tan(0.5 * std::min(c.K.fovX(), c.K.fovY())); };
+
+  // A's eigenvalues are n times the mean squared sine of the angles between the axes and
+  // each eigenvector; the smallest is about n sin^2(spread of the view directions). Below
+  // about 3 degrees of spread the intersection is set by noise in the poses.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(A);
+  const double min_sin2 = std::pow(std::sin(3.0 * M_PI / 180.0), 2);
+  if (eig.eigenvalues()[0] > min_sin2 * n) {
+    const Eigen::Vector3d p = A.ldlt().solve(b);
+    std::vector<double> depth, radius;
+    for (const Camera& c : cameras) {
+      depth.push_back(c.viewDirection().normalized().dot(p - c.center()));
+      radius.push_back((p - c.center()).norm() * halfTan(c));
+    }
+    if (p.allFinite() && medianOf(depth) > 0) {
+      f.center = p;
+      f.radius = medianOf(radius);
+      f.axes_meet = true;
+      return f;
+    }
+  }
+  if (mean_d.norm() < 0.5) {  // cameras facing every way: around their centres
+    f.center = mean_c;
+    f.radius = spread > 0 ? 2 * spread : 1.0;
+    return f;
+  }
+  const double depth = spread > 0 ? ViewFocus::kFallbackDepth * spread : 1.0;
+  f.center = mean_c + depth * mean_d.normalized();
+  std::vector<double> half;
+  for (const Camera& c : cameras) half.push_back(halfTan(c));
+  f.radius = depth * medianOf(half) + spread;
+  return f;
+}
+
 void validateCamera(const Camera& cam, const std::string& file, const std::string& field) {
   if (!cam.K.valid()) {
     std::ostringstream s;
-    s << "expected positive finite focal lengths and image size, got fx=" << cam.K.fx
+    s << "expected positive finite focal lengths and an image size of 1.." << kMaxImageSide << " per side, got fx=" << cam.K.fx
       << " fy=" << cam.K.fy << " size=" << cam.K.width << "x" << cam.K.height;
     throw InputError(file, field, s.str());
   }

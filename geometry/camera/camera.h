@@ -11,6 +11,9 @@
 
 namespace saresgs {
 
+// The largest image side a dataset may declare (readers refuse more before allocating).
+inline constexpr int kMaxImageSide = 65536;
+
 struct Intrinsics {
   int width = 0;
   int height = 0;
@@ -22,6 +25,7 @@ struct Intrinsics {
   double fovY() const;
   // The same camera for an image resized by `factor` (e.g. 0.5 for half size).
   Intrinsics scaled(double factor) const;
+  // Positive finite focal lengths, finite principal point, size 1..kMaxImageSide.
   bool valid() const;
   bool operator==(const Intrinsics&) const = default;
 };
@@ -75,6 +79,23 @@ struct Camera {
 
 // The 3DGS scene scale: 1.1 x the largest distance of the camera centres from their mean.
 double sceneExtent(std::span<const Camera> cameras);
+
+// Where a set of cameras looks, for a dataset without points: `center` is the point
+// closest in least squares to the cameras' optical axes, `radius` the half-size of the
+// volume they see about it (the median over cameras of distance x tan(half the narrower
+// field of view): a view-filling object about the centre). When the axes are near-parallel
+// (forward-facing captures) or their closest point lies behind most cameras, the axes do
+// not meet (`axes_meet` false) and `center` is instead at a typical depth along the mean
+// view direction (kFallbackDepth x the cameras' spread, or 1 when they share one centre),
+// with the radius from that depth plus the spread; cameras facing every way (outward)
+// get their mean centre and twice their spread.
+struct ViewFocus {
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  double radius = 0;
+  bool axes_meet = false;
+  static constexpr double kFallbackDepth = 4.0;
+};
+ViewFocus viewFocus(std::span<const Camera> cameras);
 
 // Throws InputError(file, field, ...) when R is not a rotation, t is not finite or the
 // intrinsics are not positive and finite.

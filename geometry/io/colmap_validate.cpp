@@ -5,7 +5,9 @@
 #include <filesystem>
 #include <limits>
 #include <sstream>
+#include <utility>
 
+#include "geometry/camera/camera.h"
 #include "geometry/error.h"
 #include "geometry/io/colmap.h"
 #include "geometry/io/colmap_detail.h"
@@ -49,8 +51,11 @@ void checkCamera(const ColmapCamera& cam, const std::string& file, const std::st
     if (!(cam.params[static_cast<size_t>(i)] > 0))
       fail(file, where, "focal length",
            "expected a positive focal length, got " + str(cam.params[static_cast<size_t>(i)]));
-  if (cam.width == 0) fail(file, where, "width", "expected a positive image width, got 0");
-  if (cam.height == 0) fail(file, where, "height", "expected a positive image height, got 0");
+  // Checked as read (64-bit), before anything narrows them to int.
+  for (const auto& [name, v] : {std::pair<const char*, std::uint64_t>{"width", cam.width}, {"height", cam.height}})
+    if (v == 0 || v > static_cast<std::uint64_t>(kMaxImageSide))
+      fail(file, where, name,
+           "expected an image " + std::string(name) + " in 1.." + std::to_string(kMaxImageSide) + ", got " + std::to_string(v));
 }
 
 void checkPose(const Eigen::Quaterniond& q, const Eigen::Vector3d& t, const std::string& file,

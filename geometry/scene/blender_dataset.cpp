@@ -1,13 +1,17 @@
 // NeRF-synthetic / Blender folders: transforms_train.json and transforms_test.json.
 // Poses are camera-to-world in OpenGL axes (x right, y up, z backward); we flip y and
-// z to reach OpenCV axes. RGBA images are composited on the chosen background.
+// z to reach OpenCV axes. RGBA images are composited on the chosen background. Optional:
+// points3d.ply (3DGS's point cloud), depth/<stem>.pfm, manifest.json (`saresgs scene`).
 #include <cmath>
 #include <filesystem>
+#include <map>
 
 #include <nlohmann/json.hpp>
 
 #include "geometry/error.h"
 #include "geometry/io/json_file.h"
+#include "geometry/io/point_ply.h"
+#include "geometry/scene/manifest.h"
 #include "geometry/scene/scene.h"
 
 namespace saresgs {
@@ -15,55 +19,63 @@ namespace saresgs {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-namespace {
+// More frames than any capture holds; a larger array is refused before it is walked.
+constexpr std::size_t kMaxFrames = 1000000;
 
-double number(const json& j, const std::string& key, const std::string& file,
-              const std::string& where) {
-  if (!j.contains(key) || !j[key].is_number())
-    throw InputError(file, where + key, "expected a number");
-  const double v = j[key].get<double>();
-  if (!std::isfinite(v)) throw InputError(file, where + key, "expected a finite number");
-  return v;
-}
+namespace {
 
 std::string resolveImage(const fs::path& root, const std::string& file_path) {
   fs::path p = root / file_path;
   if (!p.has_extension() || !fs::exists(p)) {
     for (const char* ext : {".png", ".jpg", ".jpeg"})
-      if (fs::exists(p.string() + ext)) return p.string() + ext;
+      if (fs::exists(p.string() + ext)) return fs::path(p.string() + ext).lexically_normal().string();
   }
   return p.lexically_normal().string();
 }
 
-void readSplit(const fs::path& root, const std::string& name, const DatasetOptions& opts,
-               Scene& scene, std::vector<int>& split) {
+// Reads one transforms file's frames into scene.views (their indices into `split`);
+// `full_size` gets each camera before --downscale, `seen` the images of every split so
+// far (an image listed twice, in one split or in two, is an error).
+void readSplit(const fs::path& root, const std::string& name, const DatasetOptions& opts, Scene& scene,
+               std::vector<int>& split, std::vector<Intrinsics>& full_size, std::map<std::string, std::string>& seen) {
   const std::string file = (root / name).string();
   const json j = readJsonFile(file);
-  if (!j.contains("frames") || !j["frames"].is_array())
-    throw InputError(file, "frames", "expected an array of frames");
+  jsonObject(j, file, "json");
+  const json& frames = jsonArray(jsonMember(j, "frames", file, ""), file, "frames", kMaxFrames);
   const int f = std::max(1, opts.load.downscale);
-  for (size_t k = 0; k < j["frames"].size(); ++k) {
-    const json& fr = j["frames"][k];
-    const std::string where = "frames[" + std::to_string(k) + "].";
-    if (!fr.contains("file_path") || !fr["file_path"].is_string())
-      throw InputError(file, where + "file_path", "expected a string");
+  for (size_t k = 0; k < frames.size(); ++k) {
+    const json& fr = frames[k];
+    const std::string where = jsonPath("frames", k);
+    jsonObject(fr, file, where);
     SceneView v;
-    v.image_path = resolveImage(root, fr["file_path"].get<std::string>());
+    const std::string file_path = jsonString(jsonMember(fr, "file_path", file, where), file, jsonPath(where, "file_path"));
+    v.image_path = resolveImage(root, file_path);
     v.name = fs::path(v.image_path).filename().string();
     if (!fs::exists(v.image_path))
-      throw InputError(v.image_path, where + "file_path", "image file is missing");
+      throw InputError(v.image_path, jsonPath(where, "file_path"), "image file is missing");
+    const std::string here = name + " " + where;
+    if (const auto [it, fresh] = seen.emplace(v.image_path, here); !fresh)
+      throw InputError(file, jsonPath(where, "file_path"), "'" + file_path + "' is listed twice (also as " + it->second + ")");
 
     // Intrinsics: camera_angle_x (NeRF) or fl_x/fl_y/cx/cy/w/h (Instant-NGP style),
     // per frame or per file. Size comes from w/h or from the image itself.
-    auto pick = [&](const char* key) -> const json* {
-      if (fr.contains(key)) return &fr[key];
-      if (j.contains(key)) return &j[key];
-      return nullptr;
+    auto pick = [&](const char* key) -> std::pair<const json*, std::string> {
+      if (const json* x = jsonFind(fr, key, file, where)) return {x, jsonPath(where, key)};
+      if (const json* x = jsonFind(j, key, file, "")) return {x, key};
+      return {nullptr, key};
+    };
+    auto number = [&](const char* key) {
+      const auto [x, field] = pick(key);
+      return jsonNumber(*x, file, field);
+    };
+    auto side = [&](const char* key) {
+      const auto [x, field] = pick(key);
+      return static_cast<int>(jsonInteger(*x, file, field, 1, kMaxImageSide));
     };
     int w = 0, h = 0;
-    if (pick("w") && pick("h")) {
-      w = pick("w")->get<int>();
-      h = pick("h")->get<int>();
+    if (pick("w").first && pick("h").first) {
+      w = side("w");
+      h = side("h");
     } else {
       const Image8 probe = readImage(v.image_path, true);
       w = probe.width;
@@ -72,41 +84,40 @@ void readSplit(const fs::path& root, const std::string& name, const DatasetOptio
     Intrinsics K;
     K.width = w;
     K.height = h;
-    if (pick("fl_x")) {
-      K.fx = number(fr.contains("fl_x") ? fr : j, "fl_x", file, where);
-      K.fy = pick("fl_y") ? number(fr.contains("fl_y") ? fr : j, "fl_y", file, where) : K.fx;
+    if (pick("fl_x").first) {
+      K.fx = number("fl_x");
+      K.fy = pick("fl_y").first ? number("fl_y") : K.fx;
     } else {
-      const double ax = number(fr.contains("camera_angle_x") ? fr : j, "camera_angle_x", file, "");
-      if (!(ax > 0 && ax < M_PI))
-        throw InputError(file, "camera_angle_x", "expected an angle in (0, pi) radians");
+      const auto [ax_json, ax_field] = pick("camera_angle_x");
+      if (!ax_json) throw InputError(file, "camera_angle_x", "missing (or give fl_x per frame or file)");
+      const double ax = jsonNumber(*ax_json, file, ax_field);
+      if (!(ax > 0 && ax < M_PI)) throw InputError(file, ax_field, "expected an angle in (0, pi) radians");
       K.fx = K.fy = 0.5 * w / std::tan(0.5 * ax);
     }
-    K.cx = pick("cx") ? pick("cx")->get<double>() : 0.5 * w;
-    K.cy = pick("cy") ? pick("cy")->get<double>() : 0.5 * h;
-    if (!K.valid()) throw InputError(file, where + "intrinsics", "expected positive focal length");
+    K.cx = pick("cx").first ? number("cx") : 0.5 * w;
+    K.cy = pick("cy").first ? number("cy") : 0.5 * h;
+    if (!K.valid()) throw InputError(file, where + ".intrinsics", "expected positive focal length");
 
-    const json& m = fr.value("transform_matrix", json());
-    if (!m.is_array() || m.size() < 3)
-      throw InputError(file, where + "transform_matrix", "expected a 4x4 array");
+    const std::string mfield = jsonPath(where, "transform_matrix");
+    const json& m = jsonArray(jsonMember(fr, "transform_matrix", file, where), file, mfield, 4);
+    if (m.size() < 3) throw InputError(file, mfield, "expected a 4x4 array");
     Eigen::Matrix4d c2w = Eigen::Matrix4d::Identity();
     for (int r = 0; r < 3; ++r) {
-      if (!m[r].is_array() || m[r].size() != 4)
-        throw InputError(file, where + "transform_matrix", "expected rows of 4 numbers");
-      for (int c = 0; c < 4; ++c) {
-        if (!m[r][c].is_number())
-          throw InputError(file, where + "transform_matrix", "expected numbers");
-        c2w(r, c) = m[r][c].get<double>();
-      }
+      const std::string row = jsonPath(mfield, static_cast<std::size_t>(r));
+      if (jsonArray(m[r], file, row).size() != 4) throw InputError(file, row, "expected a row of 4 numbers");
+      for (int c = 0; c < 4; ++c) c2w(r, c) = jsonNumber(m[r][c], file, jsonPath(row, static_cast<std::size_t>(c)));
     }
-    if (!c2w.allFinite()) throw InputError(file, where + "transform_matrix", "NaN or Inf in pose");
     const Eigen::Matrix3d Rc2w = c2w.topLeftCorner<3, 3>() * Eigen::Vector3d(1, -1, -1).asDiagonal();
     Camera cam;
     cam.K = f > 1 ? K.scaled(1.0 / f) : K;
     cam.R = Rc2w.transpose();
     cam.t = -cam.R * c2w.topRightCorner<3, 1>();
-    validateCamera(cam, file, where + "transform_matrix");
+    validateCamera(cam, file, mfield);
     v.camera = cam;
+    const fs::path depth = root / "depth" / (fs::path(v.image_path).stem().string() + ".pfm");
+    if (fs::exists(depth)) v.depth_path = depth.string();
     split.push_back(static_cast<int>(scene.views.size()));
+    full_size.push_back(K);
     scene.views.push_back(std::move(v));
   }
 }
@@ -118,13 +129,27 @@ Scene loadBlenderDataset(const std::string& path, const DatasetOptions& opts) {
   Scene scene;
   scene.source = path;
   scene.load = opts.load;
-  readSplit(root, "transforms_train.json", opts, scene, scene.train);
+  std::vector<Intrinsics> full_size;
+  std::map<std::string, std::string> seen;
+  readSplit(root, "transforms_train.json", opts, scene, scene.train, full_size, seen);
   if (fs::exists(root / "transforms_test.json"))
-    readSplit(root, "transforms_test.json", opts, scene, scene.test);
+    readSplit(root, "transforms_test.json", opts, scene, scene.test, full_size, seen);
   if (scene.train.empty())
     throw InputError((root / "transforms_train.json").string(), "frames", "expected at least one frame");
   scene.background = opts.load.background;
-  scene.finalize();  // no sparse points: the AABB spans the train cameras
+  // A folder written by `saresgs scene --format blender`: its manifest's sizes must match,
+  // and a room's "background": null means the data has none (its split is the transforms').
+  if (fs::exists(root / "manifest.json")) {
+    const DatasetManifest m = readDatasetManifest((root / "manifest.json").string());
+    std::vector<std::string> names;
+    for (const SceneView& v : scene.views) names.push_back(v.name);
+    checkManifestAgainstViews(m, names, full_size);
+    if (m.background_given) scene.background = m.background;
+  }
+  // 3DGS's points3d.ply beside the transforms, when there is one.
+  if (fs::exists(root / "points3d.ply"))
+    for (const PlyPoint& p : readPointsPly((root / "points3d.ply").string())) scene.points.push_back({p.xyz, p.rgb});
+  scene.finalize();  // without points the AABB spans the train cameras
   return scene;
 }
 

@@ -3,12 +3,10 @@
 #include <filesystem>
 #include <map>
 
-#include <nlohmann/json.hpp>
-
 #include "geometry/error.h"
 #include "geometry/io/colmap.h"
-#include "geometry/io/json_file.h"
 #include "geometry/scene/colmap_convert.h"
+#include "geometry/scene/manifest.h"
 #include "geometry/scene/scene.h"
 
 namespace saresgs {
@@ -35,29 +33,26 @@ std::string modelFile(const std::string& dir, const char* stem) {
 }
 
 // A dataset written by `saresgs scene` names its split in manifest.json ("split":
-// {"train": [names], "test": [names]}); it wins over the every-N-th rule.
-bool readManifestSplit(const fs::path& manifest, Scene& scene) {
+// {"train": [names], "test": [names]}); it wins over the every-N-th rule. Its background
+// (null: none) and its size and view count, which the model's cameras must match, are
+// read too. Returns whether it named the split.
+bool applyManifest(const fs::path& manifest, const std::vector<Intrinsics>& full_size, Scene& scene) {
   if (!fs::exists(manifest)) return false;
-  const nlohmann::json j = readJsonFile(manifest.string());
-  // null: the data has no background (an enclosed scene).
-  if (j.contains("background") && !j["background"].is_null()) {
-    const auto& b = j["background"];
-    if (!b.is_array() || b.size() != 3 || !b[0].is_number() || !b[1].is_number() || !b[2].is_number())
-      throw InputError(manifest.string(), "background", "expected an array of 3 numbers, or null for none");
-    scene.background = std::array<float, 3>{b[0].get<float>(), b[1].get<float>(), b[2].get<float>()};
-  }
-  if (!j.contains("split")) return false;
+  const DatasetManifest m = readDatasetManifest(manifest.string());
+  std::vector<std::string> names;
+  for (const SceneView& v : scene.views) names.push_back(v.name);
+  checkManifestAgainstViews(m, names, full_size);
+  if (m.background) scene.background = m.background;
+  if (!m.train) return false;
   std::map<std::string, int> index;
   for (int i = 0; i < static_cast<int>(scene.views.size()); ++i) index[scene.views[i].name] = i;
-  for (const char* part : {"train", "test"}) {
-    const auto& names = j["split"].value(part, nlohmann::json::array());
-    if (!names.is_array()) throw InputError(manifest.string(), std::string("split.") + part, "expected an array of image names");
-    auto& out = std::string(part) == "train" ? scene.train : scene.test;
-    for (const auto& n : names) {
-      const auto it = n.is_string() ? index.find(n.get<std::string>()) : index.end();
+  for (const bool train : {true, false}) {
+    const std::vector<std::string>& list = train ? *m.train : *m.test;
+    auto& out = train ? scene.train : scene.test;
+    for (const std::string& n : list) {
+      const auto it = index.find(n);
       if (it == index.end())
-        throw InputError(manifest.string(), std::string("split.") + part,
-                         "names " + n.dump() + ", which is not an image of the model");
+        throw InputError(manifest.string(), train ? "split.train" : "split.test", "names '" + n + "', which is not an image of the model");
       out.push_back(it->second);
     }
   }
@@ -71,6 +66,9 @@ bool readManifestSplit(const fs::path& manifest, Scene& scene) {
 
 Intrinsics intrinsicsFromColmap(const ColmapCamera& c, const std::string& file) {
   const std::string field = "camera " + std::to_string(c.id);
+  if (c.width == 0 || c.height == 0 || c.width > kMaxImageSide || c.height > kMaxImageSide)
+    throw InputError(file, field, "expected an image size of 1.." + std::to_string(kMaxImageSide) + " per side, got " +
+                                      std::to_string(c.width) + "x" + std::to_string(c.height));
   Intrinsics K;
   K.width = static_cast<int>(c.width);
   K.height = static_cast<int>(c.height);
@@ -132,10 +130,14 @@ Scene loadColmapDataset(const std::string& path, const DatasetOptions& opts) {
   for (const auto& [id, im] : model.images) sorted.push_back(&im);
   std::sort(sorted.begin(), sorted.end(),
             [](const ColmapImage* a, const ColmapImage* b) { return a->name < b->name; });
+  std::vector<Intrinsics> full_size;
   for (const ColmapImage* im : sorted) {
+    if (!scene.views.empty() && scene.views.back().name == im->name)
+      throw InputError(img_file, "image " + std::to_string(im->id) + " (" + im->name + ")", "the image name appears twice");
     SceneView v;
     v.name = im->name;
     const Intrinsics K = intrinsicsFromColmap(model.cameras.at(im->camera_id), cam_file);
+    full_size.push_back(K);
     v.camera = Camera::fromQuaternion(f > 1 ? K.scaled(1.0 / f) : K, im->q, im->t);
     validateCamera(v.camera, img_file, "image " + std::to_string(im->id) + " (" + im->name + ")");
     v.image_path = (image_dir / im->name).string();
@@ -146,7 +148,7 @@ Scene loadColmapDataset(const std::string& path, const DatasetOptions& opts) {
     if (fs::exists(depth)) v.depth_path = depth.string();
     scene.views.push_back(std::move(v));
   }
-  if (!readManifestSplit(root / "manifest.json", scene)) {
+  if (!applyManifest(root / "manifest.json", full_size, scene)) {
     for (int i = 0; i < static_cast<int>(scene.views.size()); ++i)
       ((opts.test_every > 0 && i % opts.test_every == 0) ? scene.test : scene.train).push_back(i);
     if (scene.train.empty()) scene.train.swap(scene.test);  // a single view trains

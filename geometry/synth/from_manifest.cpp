@@ -2,10 +2,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <filesystem>
+#include <limits>
 
 #include "geometry/error.h"
 #include "geometry/io/json_file.h"
+#include "geometry/scene/manifest.h"
 
 namespace saresgs {
 
@@ -13,29 +16,38 @@ std::optional<SyntheticOptions> syntheticOptionsFromManifest(const std::string& 
   const std::string path = (std::filesystem::path(folder) / "manifest.json").string();
   if (!std::filesystem::exists(path)) return std::nullopt;
   const nlohmann::json m = readJsonFile(path);
-  if (!m.contains("layout") || !m.contains("objects") || !m["objects"].is_array()) return std::nullopt;
-  for (const auto& o : m["objects"]) {
-    const std::string mesh = o.value("mesh", ""), tex = o.value("texture", "");
-    if (mesh.rfind("procedural:", 0) != 0 || tex.rfind("procedural:", 0) != 0) return std::nullopt;
+  jsonObject(m, path, "json");
+  const nlohmann::json* objects = jsonFind(m, "objects", path, "");
+  if (!jsonFind(m, "layout", path, "") || !objects) return std::nullopt;
+  jsonArray(*objects, path, "objects");
+  for (std::size_t i = 0; i < objects->size(); ++i) {
+    const std::string where = jsonPath("objects", i);
+    const nlohmann::json& o = jsonObject((*objects)[i], path, where);
+    for (const char* key : {"mesh", "texture"}) {
+      const nlohmann::json* v = jsonFind(o, key, path, where);
+      // Files given to --mesh / --texture are not recorded well enough to rebuild.
+      if (!v || jsonString(*v, path, jsonPath(where, key)).rfind("procedural:", 0) != 0) return std::nullopt;
+    }
   }
-  try {
-    SyntheticOptions s;
-    s.layout = m.at("layout");
-    s.seed = m.at("seed");
-    s.width = m.at("width");
-    s.height = m.at("height");
-    s.num_views = m.at("num_views");
-    s.up_axis = m.value("up_axis", "y");
-    s.projection = m.value("projection", "triplanar");
-    return s;
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(path, "layout", std::string("incomplete synthetic-scene manifest: ") + e.what());
-  }
+  // Every value is checked before anything is built: a corrupt count must not become
+  // two billion cameras.
+  SyntheticOptions s;
+  s.layout = jsonString(jsonMember(m, "layout", path, ""), path, "layout");
+  s.seed = static_cast<std::uint64_t>(jsonInteger(jsonMember(m, "seed", path, ""), path, "seed", 0, std::numeric_limits<long long>::max()));
+  s.width = static_cast<int>(jsonInteger(jsonMember(m, "width", path, ""), path, "width", 1, kMaxImageSide));
+  s.height = static_cast<int>(jsonInteger(jsonMember(m, "height", path, ""), path, "height", 1, kMaxImageSide));
+  s.num_views = static_cast<int>(jsonInteger(jsonMember(m, "num_views", path, ""), path, "num_views", 1, kMaxSyntheticViews));
+  if (const auto* v = jsonFind(m, "up_axis", path, "")) s.up_axis = jsonString(*v, path, "up_axis");
+  if (const auto* v = jsonFind(m, "projection", path, "")) s.projection = jsonString(*v, path, "projection");
+  return s;
 }
 
 std::optional<SyntheticScene> rebuildSyntheticScene(const std::string& folder, const Scene& dataset) {
   const auto opts = syntheticOptionsFromManifest(folder);
   if (!opts) return std::nullopt;
+  if (static_cast<std::size_t>(opts->num_views) != dataset.views.size())
+    throw InputError((std::filesystem::path(folder) / "manifest.json").string(), "num_views",
+                     std::to_string(opts->num_views) + ", but the dataset has " + std::to_string(dataset.views.size()) + " views");
   SyntheticScene s = makeSyntheticScene(*opts);
   if (s.cameras.size() != dataset.views.size()) return std::nullopt;
   const double tol = 1e-6 * std::max(1.0, dataset.extent);

@@ -9,8 +9,11 @@ namespace saresgs::synth {
 // Renders with grid x grid samples per pixel. With `jitter`, each sample sits at a
 // deterministic pseudo-random position inside its cell (a hash of pixel and sample);
 // without, at the cell centre (grid 1 without jitter: one ray through the pixel centre).
+// With `alpha`, the image has a fourth channel, the fraction of samples that hit a
+// surface, and its colour is the mean of the hits alone (straight alpha; black where
+// nothing is hit): composited on the background it is the RGB render.
 ImageF renderGrid(const SyntheticScene& scene, const Camera& cam, int grid, bool jitter,
-                  bool specular);
+                  bool specular, bool alpha = false);
 
 // The grid size that the public render uses for a requested sample count.
 int gridForSamples(int samples_per_pixel);

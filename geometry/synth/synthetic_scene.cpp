@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "geometry/error.h"
+#include "geometry/scene/manifest.h"
 #include "geometry/synth/layouts.h"
 #include "geometry/synth/noise.h"
 #include "geometry/synth/procedural_meshes.h"
@@ -128,6 +129,11 @@ ImageF SyntheticScene::render(const Camera& cam, const RenderOptions& opts) cons
                            opts.specular);
 }
 
+ImageF SyntheticScene::renderRgba(const Camera& cam, const RenderOptions& opts) const {
+  return synth::renderGrid(*this, cam, synth::gridForSamples(opts.samples_per_pixel), true,
+                           opts.specular, true);
+}
+
 ImageF SyntheticScene::renderDepth(const Camera& cam) const {
   const int W = cam.K.width, H = cam.K.height;
   ImageF depth(W, H, 1, 0.0f);
@@ -195,16 +201,17 @@ int gridForSamples(int samples_per_pixel) {
 }
 
 ImageF renderGrid(const SyntheticScene& scene, const Camera& cam, int grid, bool jitter,
-                  bool specular) {
+                  bool specular, bool alpha) {
   grid = std::max(grid, 1);
   const int W = cam.K.width, H = cam.K.height;
-  ImageF img(W, H, 3, 0.0f);
+  ImageF img(W, H, alpha ? 4 : 3, 0.0f);
   const Vector3f eye = cam.center().cast<float>();
   const float inv = 1.0f / static_cast<float>(grid * grid);
   tbb::parallel_for(tbb::blocked_range<int>(0, H), [&](const tbb::blocked_range<int>& rows) {
     for (int j = rows.begin(); j != rows.end(); ++j)
       for (int i = 0; i < W; ++i) {
-        Vector3f sum = Vector3f::Zero();
+        Vector3f sum = Vector3f::Zero(), hits_sum = Vector3f::Zero();
+        int hits = 0;
         for (int sy = 0; sy < grid; ++sy)
           for (int sx = 0; sx < grid; ++sx) {
             float jx = 0.5f, jy = 0.5f;
@@ -216,9 +223,21 @@ ImageF renderGrid(const SyntheticScene& scene, const Camera& cam, int grid, bool
             const Eigen::Vector2d uv(i + (sx + jx) / grid, j + (sy + jy) / grid);
             const Vector3f d = cam.rayDirection(uv).cast<float>();
             const SurfaceHit hit = scene.intersect(eye, d);
-            sum += hit.hit ? scene.shade(hit, eye, specular) : scene.background;
+            if (alpha) {
+              if (hit.hit) {
+                hits_sum += scene.shade(hit, eye, specular);
+                ++hits;
+              }
+            } else {
+              sum += hit.hit ? scene.shade(hit, eye, specular) : scene.background;
+            }
           }
-        sum *= inv;
+        if (alpha) {
+          if (hits > 0) sum = hits_sum / static_cast<float>(hits);
+          img.at(i, j, 3) = static_cast<float>(hits) * inv;
+        } else {
+          sum *= inv;
+        }
         for (int ch = 0; ch < 3; ++ch) img.at(i, j, ch) = std::clamp(sum[ch], 0.0f, 1.0f);
       }
   });
@@ -247,6 +266,14 @@ SyntheticScene makeSyntheticScene(const SyntheticOptions& opts) {
     throw InputError("options", "width/height",
                      "expected a positive image size, got " + std::to_string(opts.width) + "x" +
                          std::to_string(opts.height));
+  if (opts.width > kMaxImageSide || opts.height > kMaxImageSide)
+    throw InputError("options", "width/height",
+                     "expected at most " + std::to_string(kMaxImageSide) + " per side, got " + std::to_string(opts.width) + "x" +
+                         std::to_string(opts.height));
+  if (opts.num_views < 0 || opts.num_views > kMaxSyntheticViews)
+    throw InputError("options", "num_views",
+                     "expected 0 (the layout's default) .. " + std::to_string(kMaxSyntheticViews) + ", got " +
+                         std::to_string(opts.num_views));
   if (opts.layout != "object" && opts.layout != "room360" && opts.layout != "unbalanced")
     throw InputError("options", "layout",
                      "expected object, room360 or unbalanced, got '" + opts.layout + "'");
@@ -285,6 +312,7 @@ SyntheticScene makeSyntheticScene(const SyntheticOptions& opts) {
   scene.train = std::move(layout.train);
   scene.test = std::move(layout.test);
   scene.background = Vector3f(1, 1, 1);
+  scene.enclosed = opts.layout != "object";
 
   synth::Lighting lighting;
   nlohmann::json& m = scene.manifest;
@@ -300,7 +328,7 @@ SyntheticScene makeSyntheticScene(const SyntheticOptions& opts) {
   // The data's background: an enclosed room has none (every pixel sees a wall), which
   // tells a trainer that no white-background handling applies; an object layout's misses
   // are white.
-  m["background"] = opts.layout == "object" ? toJson(scene.background) : nlohmann::json(nullptr);
+  m["background"] = scene.enclosed ? nlohmann::json(nullptr) : toJson(scene.background);
   m["light"] = {{"direction", toJson(lighting.to_light)},
                 {"ambient", lighting.ambient},
                 {"diffuse", lighting.diffuse},

@@ -73,6 +73,9 @@ class SyntheticScene {
   std::vector<std::string> names;  // image file names, e.g. "0000.png"
   std::vector<int> train, test;    // indices into cameras
   Eigen::Vector3f background{1, 1, 1};  // colour of rays that miss (object layout)
+  // Rooms: every ray meets a wall, so the data has no background (manifest null) and
+  // their images are opaque; the object layout's misses are background.
+  bool enclosed = false;
   nlohmann::json manifest;         // layout, seed, meshes, textures, sizes, light
 
   // First hit along origin + s * dir (dir need not be unit), s in (tmin, tmax).
@@ -87,6 +90,9 @@ class SyntheticScene {
                         bool specular = false) const;
   // Colour image (3 channels, [0,1]), supersampled. TBB-parallel over rows.
   ImageF render(const Camera& cam, const RenderOptions& opts = {}) const;
+  // RGBA: colour of the surfaces alone (straight alpha) and the fraction of samples that
+  // hit one, as NeRF-synthetic's images hold; composited on `background` it is render().
+  ImageF renderRgba(const Camera& cam, const RenderOptions& opts = {}) const;
   // Depth along the camera z axis through each pixel centre; 0 where the ray misses.
   ImageF renderDepth(const Camera& cam) const;
   // `count` points uniformly distributed by area over all surfaces.

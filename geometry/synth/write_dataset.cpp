@@ -8,6 +8,7 @@
 #include "geometry/image/contact_sheet.h"
 #include "geometry/io/atomic_file.h"
 #include "geometry/io/pfm.h"
+#include "geometry/io/point_ply.h"
 #include "geometry/scene/colmap_convert.h"
 #include "geometry/synth/colmap_sfm.h"
 
@@ -31,6 +32,43 @@ void replaceFolder(const fs::path& src, const fs::path& dst) {
   }
   fs::rename(src, dst);
   if (!old.empty()) fs::remove_all(old);
+}
+
+// Blender's camera-to-world matrix: OpenGL axes (y up, z backward) are OpenCV's with y and
+// z flipped.
+nlohmann::json openGlTransform(const Camera& cam) {
+  Eigen::Matrix4d c2w = Eigen::Matrix4d::Identity();
+  c2w.topLeftCorner<3, 3>() = cam.R.transpose() * Eigen::Vector3d(1, -1, -1).asDiagonal();
+  c2w.topRightCorner<3, 1>() = cam.center();
+  nlohmann::json rows = nlohmann::json::array();
+  for (int r = 0; r < 4; ++r) rows.push_back({c2w(r, 0), c2w(r, 1), c2w(r, 2), c2w(r, 3)});
+  return rows;
+}
+
+// transforms_<part>.json for the views `which`, NeRF-synthetic's keys; cameras that
+// camera_angle_x alone cannot describe (fx != fy, off-centre principal point) also get
+// Instant-NGP's fl_x, fl_y, cx, cy, w, h.
+std::string transformsJson(const SyntheticScene& scene, const std::vector<int>& which, const std::string& part) {
+  nlohmann::json j;
+  const Intrinsics& K = scene.cameras.front().K;
+  j["camera_angle_x"] = K.fovX();
+  const bool simple = K.fx == K.fy && K.cx == 0.5 * K.width && K.cy == 0.5 * K.height;
+  for (const Camera& c : scene.cameras)
+    if (!(c.K == K)) throw std::invalid_argument("blender format: every view must share one camera");
+  if (!simple) {
+    j["fl_x"] = K.fx;
+    j["fl_y"] = K.fy;
+    j["cx"] = K.cx;
+    j["cy"] = K.cy;
+    j["w"] = K.width;
+    j["h"] = K.height;
+  }
+  j["frames"] = nlohmann::json::array();
+  for (int i : which)
+    j["frames"].push_back({{"file_path", "./" + part + "/" + fs::path(scene.names[static_cast<std::size_t>(i)]).stem().string()},
+                           {"rotation", 0.0},
+                           {"transform_matrix", openGlTransform(scene.cameras[static_cast<std::size_t>(i)])}});
+  return j.dump(2) + "\n";
 }
 
 }  // namespace
@@ -63,27 +101,55 @@ ColmapModel colmapModelOf(const SyntheticScene& scene) {
 
 WriteDatasetReport writeSyntheticDataset(const SyntheticScene& scene, const std::string& out,
                                          const WriteDatasetOptions& opts) {
+  const bool blender = opts.format == "blender";
+  if (!blender && opts.format != "colmap")
+    throw std::invalid_argument("--format: expected colmap or blender, got '" + opts.format + "'");
+  if (blender && opts.sfm == "colmap")
+    throw std::invalid_argument("--sfm colmap needs --format colmap (COLMAP reads the images/ folder)");
+  if (scene.cameras.empty()) throw std::invalid_argument("the scene has no views");
   const fs::path dst(out);
   const fs::path tmp = dst.string() + ".partial-" + std::to_string(::getpid());
   fs::remove_all(tmp);
-  fs::create_directories(tmp / "images");
   fs::create_directories(tmp / "depth");
   WriteDatasetReport report;
   report.views = static_cast<int>(scene.cameras.size());
   auto progress = [&](const std::string& stage, int done, int total) {
     if (opts.progress) opts.progress(stage, done, total);
   };
+  std::vector<bool> is_test(scene.cameras.size(), false);
+  for (int i : scene.test) is_test[static_cast<std::size_t>(i)] = true;
 
   // Renders, one view at a time (each render is parallel inside); thumbnails kept for
   // the contact sheet.
   const auto t_render = std::chrono::steady_clock::now();
   std::vector<double> view_ms;
   std::vector<Image8> images(scene.cameras.size());
+  const float background[3] = {scene.background.x(), scene.background.y(), scene.background.z()};
   for (size_t i = 0; i < scene.cameras.size(); ++i) {
     const auto t0 = std::chrono::steady_clock::now();
-    images[i] = toByte(scene.render(scene.cameras[i], opts.render));
-    view_ms.push_back(1e3 * secondsSince(t0));
-    writeImage((tmp / "images" / scene.names[i]).string(), images[i]);
+    fs::path image_file = tmp / "images" / scene.names[i];
+    if (!blender) {
+      images[i] = toByte(scene.render(scene.cameras[i], opts.render));
+      view_ms.push_back(1e3 * secondsSince(t0));
+      fs::create_directories(image_file.parent_path());
+      writeImage(image_file.string(), images[i]);
+    } else {
+      // RGBA: the object's coverage as alpha; a room is opaque everywhere.
+      Image8 rgba;
+      if (scene.enclosed) {
+        const Image8 rgb = toByte(scene.render(scene.cameras[i], opts.render));
+        rgba = Image8(rgb.width, rgb.height, 4, 255);
+        for (std::size_t p = 0; p < static_cast<std::size_t>(rgb.width) * rgb.height; ++p)
+          for (int c = 0; c < 3; ++c) rgba.data[4 * p + c] = rgb.data[3 * p + c];
+      } else {
+        rgba = toByte(scene.renderRgba(scene.cameras[i], opts.render));
+      }
+      view_ms.push_back(1e3 * secondsSince(t0));
+      images[i] = compositeOnBackground(rgba, background);
+      image_file = tmp / (is_test[i] ? "test" : "train") / scene.names[i];
+      fs::create_directories(image_file.parent_path());
+      writeImage(image_file.string(), rgba);
+    }
     writePfm((tmp / "depth" / (fs::path(scene.names[i]).stem().string() + ".pfm")).string(),
              scene.renderDepth(scene.cameras[i]));
     progress("render", static_cast<int>(i + 1), report.views);
@@ -103,7 +169,17 @@ WriteDatasetReport writeSyntheticDataset(const SyntheticScene& scene, const std:
     throw std::invalid_argument("--sfm: expected simulated, colmap or none, got '" + opts.sfm + "'");
   }
   report.sfm_seconds = secondsSince(t_sfm);
-  writeColmapText((tmp / "sparse" / "0").string(), model);
+  if (!blender) {
+    writeColmapText((tmp / "sparse" / "0").string(), model);
+  } else {
+    writeFileAtomic((tmp / "transforms_train.json").string(), transformsJson(scene, scene.train, "train"));
+    writeFileAtomic((tmp / "transforms_test.json").string(), transformsJson(scene, scene.test, "test"));
+    if (opts.sfm != "none") {
+      std::vector<PlyPoint> points;
+      for (const auto& [id, p] : model.points) points.push_back({p.xyz, p.rgb});
+      writePointsPly((tmp / "points3d.ply").string(), points);
+    }
+  }
 
   report.points = model.points.size();
   double track = 0, err = 0;
@@ -121,11 +197,13 @@ WriteDatasetReport writeSyntheticDataset(const SyntheticScene& scene, const std:
   }
 
   nlohmann::json manifest = scene.manifest;
-  // The split by image name: the loader honours it instead of its every-8th rule.
+  // The split by image name: the COLMAP loader honours it instead of its every-8th rule
+  // (a Blender folder's transforms files are its split).
   nlohmann::json split = {{"train", nlohmann::json::array()}, {"test", nlohmann::json::array()}};
   for (int i : scene.train) split["train"].push_back(scene.names[i]);
   for (int i : scene.test) split["test"].push_back(scene.names[i]);
-  manifest["split"] = split;
+  if (!blender) manifest["split"] = split;
+  manifest["format"] = opts.format;
   manifest["depth"] = {{"format", "pfm"}, {"convention", "z along the camera axis; 0 where a ray misses"}};
   manifest["render"] = {{"samples_per_pixel", opts.render.samples_per_pixel},
                         {"specular", opts.render.specular}};
@@ -137,11 +215,6 @@ WriteDatasetReport writeSyntheticDataset(const SyntheticScene& scene, const std:
   writeFileAtomic((tmp / "manifest.json").string(), manifest.dump(2) + "\n");
 
   std::vector<ContactSheetItem> items;
-  const std::vector<bool> is_test = [&] {
-    std::vector<bool> t(scene.cameras.size(), false);
-    for (int i : scene.test) t[i] = true;
-    return t;
-  }();
   // At most 64 thumbnails, evenly spread over the views.
   const size_t n = images.size(), shown = std::min<size_t>(n, 64);
   for (size_t k = 0; k < shown; ++k) {

@@ -5,6 +5,15 @@
 //   OUT/sparse/0/*.txt         COLMAP text model: cameras, images with 2D points, points3D
 //   OUT/manifest.json          layout, seed, meshes, textures, split, SfM statistics
 //   OUT/contact_sheet.png      thumbnails of the views (test views framed)
+// or, with format "blender", as a NeRF-synthetic folder:
+//   OUT/transforms_train.json, transforms_test.json   camera_angle_x and, per frame,
+//                              file_path ("./train/0000", no extension) and the
+//                              camera-to-world transform_matrix in OpenGL axes
+//   OUT/train/NAME.png, test/NAME.png   RGBA: object layouts have true alpha (the fraction
+//                              of a pixel's samples that hit the object, colour
+//                              un-premultiplied); rooms are opaque
+//   OUT/points3d.ply           the sparse points (3DGS's file), unless sfm is "none"
+//   OUT/depth, manifest.json (no split: the transforms hold it), contact_sheet.png
 // The folder is assembled under a temporary name and renamed into place at the end.
 #include <functional>
 #include <string>
@@ -16,7 +25,8 @@ namespace saresgs {
 
 struct WriteDatasetOptions {
   RenderOptions render;
-  std::string sfm = "simulated";  // simulated | colmap (runs the COLMAP binary) | none
+  std::string format = "colmap";  // colmap | blender
+  std::string sfm = "simulated";  // simulated | colmap (runs the COLMAP binary; colmap format only) | none
   SimulatedSfmOptions simulated;
   std::function<void(const std::string& stage, int done, int total)> progress;
 };

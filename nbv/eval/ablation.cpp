@@ -4,12 +4,14 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <set>
 #include <sstream>
 #include <stdexcept>
 
 #include "geometry/error.h"
 #include "geometry/io/json_file.h"
+#include "geometry/scene/manifest.h"
 
 namespace saresgs {
 
@@ -36,18 +38,19 @@ auto parsedAs(F&& parse, const std::string& file, const std::string& field) {
   }
 }
 
-template <class T>
-T fieldAs(const nlohmann::json& j, const std::string& file, const std::string& field) {
-  try {
-    return j.get<T>();
-  } catch (const nlohmann::json::exception&) {
-    throw InputError(file, field, "unexpected type " + std::string(j.type_name()));
-  }
-}
+// The most threads a job may ask for (as `saresgs active --threads`).
+constexpr long long kMaxThreads = 1024;
 
-std::vector<std::string> stringList(const nlohmann::json& j, const std::string& file, const std::string& field) {
-  if (!j.is_array()) throw InputError(file, field, "expected an array of strings");
-  return fieldAs<std::vector<std::string>>(j, file, field);
+// A list whose items must differ (a repeat would run the same job twice).
+template <class T>
+void noRepeats(const std::vector<T>& items, const std::string& file, const std::string& field) {
+  for (std::size_t i = 0; i < items.size(); ++i)
+    for (std::size_t k = 0; k < i; ++k)
+      if (items[i] == items[k]) {
+        std::ostringstream s;
+        s << items[i];
+        throw InputError(file, jsonPath(field, i), s.str() + " appears twice");
+      }
 }
 
 // Folder-safe: letters, digits, '.', '-', '_' only.
@@ -96,7 +99,7 @@ void forEachNamedObject(const nlohmann::json& j, const std::string& path, const 
 
 // The item's folder-safe name, which no earlier item of the same array had.
 std::string uniqueName(const nlohmann::json& item, std::set<std::string>& seen, const std::string& path, const std::string& f) {
-  const std::string name = safeName(fieldAs<std::string>(item["name"], path, f + ".name"), path, f + ".name");
+  const std::string name = safeName(jsonString(item["name"], path, f + ".name"), path, f + ".name");
   if (!seen.insert(name).second) throw InputError(path, f + ".name", "'" + name + "' appears twice");
   return name;
 }
@@ -110,8 +113,8 @@ std::vector<AblationScene> readScenes(const nlohmann::json& j, const std::string
     if (!s.contains("dataset")) throw InputError(path, f, "expected {name, dataset[, layout]}");
     AblationScene sc;
     sc.name = uniqueName(s, names, path, f);
-    sc.dataset = fieldAs<std::string>(s["dataset"], path, f + ".dataset");
-    if (s.contains("layout")) sc.layout = fieldAs<std::string>(s["layout"], path, f + ".layout");
+    sc.dataset = jsonString(s["dataset"], path, f + ".dataset");
+    if (s.contains("layout")) sc.layout = jsonString(s["layout"], path, f + ".layout");
     scenes.push_back(sc);
   });
   return scenes;
@@ -123,9 +126,9 @@ std::vector<AblationVariant> readVariants(const nlohmann::json& j, const std::st
   forEachNamedObject(j, path, "variants", "{name, methods?, args?}", [&](const nlohmann::json& v, const std::string& f) {
     AblationVariant var;
     var.name = uniqueName(v, names, path, f);
-    if (v.contains("methods")) var.methods = stringList(v["methods"], path, f + ".methods");
+    if (v.contains("methods")) var.methods = jsonStrings(v["methods"], path, f + ".methods");
     for (const auto& m : var.methods) checkMethod(m, path, f + ".methods");
-    if (v.contains("args")) var.args = stringList(v["args"], path, f + ".args");
+    if (v.contains("args")) var.args = jsonStrings(v["args"], path, f + ".args");
     variants.push_back(var);
   });
   return variants;
@@ -137,9 +140,9 @@ std::vector<AblationTableSpec> readTables(const nlohmann::json& j, const std::st
   forEachNamedObject(j, path, "tables", "{name, title, methods?, variants?}", [&](const nlohmann::json& t, const std::string& f) {
     AblationTableSpec spec;
     spec.name = uniqueName(t, names, path, f);
-    spec.title = t.contains("title") ? fieldAs<std::string>(t["title"], path, f + ".title") : spec.name;
-    if (t.contains("methods")) spec.methods = stringList(t["methods"], path, f + ".methods");
-    if (t.contains("variants")) spec.variants = stringList(t["variants"], path, f + ".variants");
+    spec.title = t.contains("title") ? jsonString(t["title"], path, f + ".title") : spec.name;
+    if (t.contains("methods")) spec.methods = jsonStrings(t["methods"], path, f + ".methods");
+    if (t.contains("variants")) spec.variants = jsonStrings(t["variants"], path, f + ".variants");
     tables.push_back(spec);
   });
   return tables;
@@ -148,19 +151,20 @@ std::vector<AblationTableSpec> readTables(const nlohmann::json& j, const std::st
 SweepSpec readSweep(const nlohmann::json& s, const std::vector<AblationScene>& scenes, const std::string& path) {
   if (!s.is_object()) throw InputError(path, "sweep", "expected an object");
   SweepSpec sw;
-  sw.scenes = s.contains("scenes") ? stringList(s["scenes"], path, "sweep.scenes") : std::vector<std::string>{};
+  sw.scenes = s.contains("scenes") ? jsonStrings(s["scenes"], path, "sweep.scenes") : std::vector<std::string>{};
   if (sw.scenes.empty())
     for (const auto& sc : scenes) sw.scenes.push_back(sc.name);
   for (const auto& n : sw.scenes)
     if (std::none_of(scenes.begin(), scenes.end(), [&](const AblationScene& sc) { return sc.name == n; }))
       throw InputError(path, "sweep.scenes", "'" + n + "' is not one of the scenes");
-  if (s.contains("views")) sw.view_counts = fieldAs<std::vector<int>>(s["views"], path, "sweep.views");
-  for (int c : sw.view_counts)
-    if (c < 1) throw InputError(path, "sweep.views", "view counts must be >= 1");
+  if (s.contains("views")) {
+    sw.view_counts.clear();
+    for (long long c : jsonIntegers(s["views"], path, "sweep.views", 1, kMaxSyntheticViews)) sw.view_counts.push_back(static_cast<int>(c));
+  }
   if (sw.view_counts.empty()) throw InputError(path, "sweep.views", "expected at least one view count");
   if (s.contains("encodings")) {
     sw.encodings.clear();
-    for (const std::string& e : stringList(s["encodings"], path, "sweep.encodings"))
+    for (const std::string& e : jsonStrings(s["encodings"], path, "sweep.encodings"))
       sw.encodings.push_back(parsedAs(
           [&] {
             CoverageScoring c;
@@ -171,20 +175,23 @@ SweepSpec readSweep(const nlohmann::json& s, const std::vector<AblationScene>& s
   }
   if (s.contains("sets")) {
     sw.sets.clear();
-    for (const std::string& k : stringList(s["sets"], path, "sweep.sets"))
+    for (const std::string& k : jsonStrings(s["sets"], path, "sweep.sets"))
       sw.sets.push_back(parsedAs([&] { return parseCandidateSet(k); }, path, "sweep.sets"));
   }
   if (s.contains("scores")) {
     sw.scores.clear();
-    for (const std::string& k : stringList(s["scores"], path, "sweep.scores"))
+    for (const std::string& k : jsonStrings(s["scores"], path, "sweep.scores"))
       sw.scores.push_back(parsedAs([&] { return parseCoverageCriterion(k); }, path, "sweep.scores"));
   }
   if (s.contains("lifting")) {
-    const std::string l = fieldAs<std::string>(s["lifting"], path, "sweep.lifting");
+    const std::string l = jsonString(s["lifting"], path, "sweep.lifting");
     sw.lifting = parsedAs([&] { return parseLiftingSource(l); }, path, "sweep.lifting");
   }
-  if (s.contains("keep")) sw.keep_fraction = fieldAs<double>(s["keep"], path, "sweep.keep");
-  if (s.contains("timing_repeats")) sw.timing_repeats = fieldAs<int>(s["timing_repeats"], path, "sweep.timing_repeats");
+  if (s.contains("keep")) {
+    sw.keep_fraction = jsonNumberIn(s["keep"], path, "sweep.keep", 0, 1);
+    if (!(sw.keep_fraction > 0)) throw InputError(path, "sweep.keep", "expected a fraction in (0, 1]");
+  }
+  if (s.contains("timing_repeats")) sw.timing_repeats = static_cast<int>(jsonInteger(s["timing_repeats"], path, "sweep.timing_repeats", 1, 1000));
   return sw;
 }
 
@@ -199,23 +206,23 @@ AblationGrid readAblationGrid(const std::string& path) {
     if (!std::set<std::string>{"preset", "threads", "scenes", "methods", "seeds", "method_args", "variants", "tables", "sweep", "comment"}
              .count(key))
       throw InputError(path, key, "unknown field");
-  if (j.contains("preset")) g.preset = fieldAs<std::string>(j["preset"], path, "preset");
+  if (j.contains("preset")) g.preset = jsonString(j["preset"], path, "preset");
   if (g.preset != "quick" && g.preset != "paper") throw InputError(path, "preset", "expected quick or paper");
-  if (j.contains("threads")) g.threads = fieldAs<int>(j["threads"], path, "threads");
-  if (g.threads < 0) throw InputError(path, "threads", "expected >= 0");
+  if (j.contains("threads")) g.threads = static_cast<int>(jsonInteger(j["threads"], path, "threads", 0, kMaxThreads));
   g.scenes = readScenes(j, path);
-  if (j.contains("methods")) g.methods = stringList(j["methods"], path, "methods");
+  if (j.contains("methods")) g.methods = jsonStrings(j["methods"], path, "methods");
   for (const auto& m : g.methods) checkMethod(m, path, "methods");
-  if (j.contains("seeds")) {
-    if (!j["seeds"].is_array()) throw InputError(path, "seeds", "expected an array of integers");
-    g.seeds = fieldAs<std::vector<std::uint64_t>>(j["seeds"], path, "seeds");
-  }
+  noRepeats(g.methods, path, "methods");
+  if (j.contains("seeds"))
+    for (long long s : jsonIntegers(j["seeds"], path, "seeds", 0, std::numeric_limits<long long>::max()))
+      g.seeds.push_back(static_cast<std::uint64_t>(s));
+  noRepeats(g.seeds, path, "seeds");
   if (g.seeds.empty()) g.seeds = {0};
   if (j.contains("method_args")) {
     if (!j["method_args"].is_object()) throw InputError(path, "method_args", "expected {method: [args]}");
     for (const auto& [m, a] : j["method_args"].items()) {
       checkMethod(m, path, "method_args");
-      g.method_args[m] = stringList(a, path, "method_args." + m);
+      g.method_args[m] = jsonStrings(a, path, "method_args." + m);
     }
   }
   if (j.contains("variants")) g.variants = readVariants(j["variants"], path);

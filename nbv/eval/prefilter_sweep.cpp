@@ -10,6 +10,7 @@
 #include "geometry/occupancy/coverage_score.h"
 #include "geometry/occupancy/occupancy_grid.h"
 #include "geometry/error.h"
+#include "geometry/io/json_file.h"
 #include "nbv/initial_views.h"
 
 namespace saresgs {
@@ -59,30 +60,32 @@ nlohmann::json toJson(const SweepReport& r) {
   return res;
 }
 
+namespace {
+constexpr long long kMaxSweepCount = 2'000'000'000;
+}  // namespace
+
 SweepReport sweepReportFromJson(const nlohmann::json& j, const std::string& source) {
   SweepReport r;
-  std::string at = "json";
-  try {
-    at = "scene";
-    r.scene = j.at("scene").get<std::string>();
-    at = "dataset";
-    r.dataset = j.at("dataset").get<std::string>();
-    at = "lifting";
-    r.lifting = j.at("lifting").get<std::string>();
-    at = "reference";
-    r.reference = j.at("reference").get<std::string>();
-    at = "rows";
-    const auto& rows = j.at("rows");
-    for (std::size_t i = 0; i < rows.size(); ++i) {
-      at = "rows[" + std::to_string(i) + "]";
-      const auto& w = rows[i];
-      r.rows.push_back({w.at("set").get<std::string>(), w.at("encoding").get<std::string>(), w.at("score").get<std::string>(),
-                        w.at("views").get<int>(), w.at("candidates").get<int>(), w.at("overlap").get<double>(),
-                        w.at("kendall_tau").get<double>(), w.at("seconds_scoring").get<double>(),
-                        w.at("seconds_sets").get<double>()});
-    }
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(source, at, std::string("missing or mistyped: ") + e.what());
+  auto text = [&](const nlohmann::json& o, const char* key, const std::string& path) {
+    return jsonString(jsonMember(o, key, source, path), source, jsonPath(path, key));
+  };
+  auto number = [&](const nlohmann::json& o, const char* key, const std::string& path) {
+    return jsonNumber(jsonMember(o, key, source, path), source, jsonPath(path, key));
+  };
+  auto count = [&](const nlohmann::json& o, const char* key, const std::string& path) {
+    return static_cast<int>(jsonInteger(jsonMember(o, key, source, path), source, jsonPath(path, key), 0, kMaxSweepCount));
+  };
+  r.scene = text(j, "scene", "");
+  r.dataset = text(j, "dataset", "");
+  r.lifting = text(j, "lifting", "");
+  r.reference = text(j, "reference", "");
+  const auto& rows = jsonArray(jsonMember(j, "rows", source, ""), source, "rows");
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const std::string at = jsonPath("rows", i);
+    const auto& w = rows[i];
+    r.rows.push_back({text(w, "set", at), text(w, "encoding", at), text(w, "score", at), count(w, "views", at),
+                      count(w, "candidates", at), number(w, "overlap", at), number(w, "kendall_tau", at),
+                      number(w, "seconds_scoring", at), number(w, "seconds_sets", at)});
   }
   return r;
 }

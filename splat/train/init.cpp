@@ -128,13 +128,13 @@ Gaussians gaussiansFromPoints(const std::vector<ColoredPoint>& pts, int max_sh_d
   return g;
 }
 
-std::vector<ColoredPoint> randomPointsInBox(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int n,
-                                            std::mt19937_64& rng) {
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::vector<ColoredPoint> out(static_cast<std::size_t>(std::max(n, 0)));
-  for (auto& p : out) {
-    for (int k = 0; k < 3; ++k) p.xyz[k] = lo[k] + (hi[k] - lo[k]) * u(rng);
-    for (int k = 0; k < 3; ++k) p.rgb[k] = static_cast<float>(u(rng));
+std::vector<ColoredPoint> randomPointsInBall(const Eigen::Vector3d& center, double radius, int n, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<ColoredPoint> out;
+  out.reserve(static_cast<std::size_t>(std::max(n, 0)));
+  while (static_cast<int>(out.size()) < n) {
+    const Eigen::Vector3d q(u(rng), u(rng), u(rng));
+    if (q.squaredNorm() <= 1.0) out.push_back({center + radius * q, {0.5f, 0.5f, 0.5f}});
   }
   return out;
 }

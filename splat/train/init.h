@@ -2,7 +2,7 @@
 // Initial Gaussians, as 3DGS makes them: one isotropic Gaussian per point with scale
 // log(sqrt(mean squared distance to its 3 nearest neighbours)), identity rotation,
 // opacity 0.1 and the point's colour in the DC coefficient; or, for a dataset without
-// points, random points in a box with random colours.
+// points, grey random points in a ball.
 #include <array>
 #include <cstdint>
 #include <random>
@@ -27,8 +27,9 @@ std::vector<double> meanSquaredKnnDistance(const std::vector<Eigen::Vector3d>& p
 Gaussians gaussiansFromPoints(const std::vector<ColoredPoint>& pts, int max_sh_degree,
                               float initial_opacity = 0.1f);
 
-// n points uniform in [lo, hi] with uniform random colours (3DGS's synthetic-scene init).
-std::vector<ColoredPoint> randomPointsInBox(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int n,
-                                            std::mt19937_64& rng);
+// n points uniform in the ball of `radius` about `center` (rejection sampling from its
+// cube), grey (0.5): 3DGS's synthetic-scene init draws its colours as SH coefficients in
+// [0, 1/255), i.e. grey to within 0.1 %.
+std::vector<ColoredPoint> randomPointsInBall(const Eigen::Vector3d& center, double radius, int n, std::mt19937_64& rng);
 
 }  // namespace saresgs

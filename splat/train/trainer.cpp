@@ -27,14 +27,17 @@ Gaussians initialModel(const Scene& scene, const TrainerOptions& opt) {
     for (const auto& p : scene.points)
       pts.push_back({p.xyz, {p.rgb[0] / 255.0f, p.rgb[1] / 255.0f, p.rgb[2] / 255.0f}});
   } else {
-    // 3DGS's NeRF-synthetic init is uniform in [-1.3, 1.3]^3 with cameras ~4 from the
-    // origin (extent ~4.4): a cube of half-size 0.3 extent about the cameras' centre.
-    Eigen::Vector3d c = Eigen::Vector3d::Zero();
-    for (int v : scene.train) c += scene.views[static_cast<std::size_t>(v)].camera.center();
-    if (!scene.train.empty()) c /= static_cast<double>(scene.train.size());
-    const double h = 0.3 * std::max(scene.extent, 1e-6);
+    // No points: grey random points in the ball the cameras see (viewFocus: about the
+    // point nearest their optical axes, the radius a view-filling object's). On
+    // NeRF-synthetic (cameras 4 from the origin, 40 deg field of view) that is the sphere
+    // in 3DGS's own [-1.3, 1.3]^3; the mean of the camera centres, which an upper
+    // hemisphere puts well above the objects, is not used.
+    const ViewFocus focus = viewFocus(scene.cameras(scene.train));
     std::mt19937_64 init_rng(opt.seed ^ 0x5eed1417ULL);
-    pts = randomPointsInBox(c.array() - h, c.array() + h, opt.random_init_points, init_rng);
+    // A model cap bounds the initial model too.
+    int n = opt.random_init_points;
+    if (opt.densify.max_gaussians > 0) n = static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(n), opt.densify.max_gaussians));
+    pts = randomPointsInBall(focus.center, std::max(focus.radius, 1e-6), n, init_rng);
   }
   return gaussiansFromPoints(pts, opt.max_sh_degree, opt.initial_opacity);
 }

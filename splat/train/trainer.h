@@ -38,7 +38,7 @@ struct TrainerOptions {
   ResidualOptions residual;
   RasterSettings raster;           // sh_degree is set by the schedule
   double lambda_ssim = 0.2;
-  int random_init_points = 20000;  // used when the scene has no sparse points
+  int random_init_points = 100000;  // used when the scene has no sparse points (3DGS's count)
   float initial_opacity = 0.1f;
   std::uint64_t seed = 0;
 };
@@ -85,8 +85,9 @@ float meansLearningRate(const TrainerOptions& opt, int iteration, double extent)
 
 class Trainer {
  public:
-  // Builds the initial model from the scene's sparse points (or random points when it
-  // has none). The scene is copied (copies share its image cache).
+  // Builds the initial model from the scene's sparse points (or, when it has none,
+  // random_init_points grey random points in the ball the train cameras look at:
+  // viewFocus in geometry/camera/camera.h). The scene is copied (copies share its image cache).
   Trainer(const Scene& scene, const TrainerOptions& opt);
 
   // Trains `iterations` iterations on `views` (indices into scene.views); `progress` is

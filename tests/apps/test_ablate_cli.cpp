@@ -4,6 +4,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <tuple>
+#include <vector>
 
 #include "common/run_command.h"
 #include "common/test_support.h"
@@ -37,7 +39,7 @@ std::string writeGrid(const TempDir& d) {
     "methods": ["random", "fvs"],
     "seeds": [0, 1],
     "threads": 1,
-    "variants": [{"name": "default", "args": ["--max-views", "5", "--interval", "3", "--iterations", "30", "--final-iterations", "20"]}],
+    "variants": [{"name": "default", "args": ["--max-views", "5", "--interval", "3", "--min-iterations", "30", "--final-iterations", "20"]}],
     "tables": [{"name": "criteria", "title": "Prefilter criteria", "methods": ["random", "fvs"]}],
     "sweep": {"views": [4], "encodings": ["hash:11", "hash:16", "exact"], "lifting": "depth", "timing_repeats": 1}
   })");
@@ -143,4 +145,34 @@ TEST(AblateCli, GnuParallelShardsIntoOneFolderThenMerge) {
   EXPECT_EQ(results, 5);
   EXPECT_TRUE(fs::exists(out + "/tables/paired.csv"));
   EXPECT_EQ(readBytes(out + "/tables/paired.csv").rfind("scene,method,baseline,metric,mean_diff,ci_low,ci_high,n,win_rate\n", 0), 0u);
+}
+
+// Every job's `saresgs active` arguments are checked when the config is read: a bad value
+// in a variant's args or in method_args stops the grid before any job runs, naming the
+// config and the field.
+TEST(AblateCli, JobArgumentsAreCheckedWhenTheConfigIsRead) {
+  TempDir d;
+  const std::string grid = d.file("grid.json");
+  for (const auto& [extra, field, says] : std::vector<std::tuple<std::string, std::string, std::string>>{
+           {R"("variants": [{"name": "v", "args": ["--max-views", "-3"]}])", "variants[0].args", "--max-views"},
+           {R"("variants": [{"name": "v", "args": ["--nosuch"]}])", "variants[0].args", "--nosuch"},
+           {R"("variants": [{"name": "v", "args": ["--iterations", "300"]}])", "variants[0].args", "--min-iterations"},
+           {R"("method_args": {"fvs": ["--fisher-lambda", "-1"]})", "method_args.fvs", "--fisher-lambda"},
+           {R"("method_args": {"random": ["--prefilter-set", "sphere"]})", "method_args.random", "sphere"},
+           {R"("variants": [{"name": "v", "methods": ["fvs"], "args": ["--residual-ranking", "colour"]}])", "variants[0].args", "colour"},
+       }) {
+    writeBytes(grid, R"({"scenes": [{"name": "s", "dataset": ")" + d.file("s") + R"(", "layout": "object"}],
+                        "methods": ["random", "fvs"], )" + extra + "}");
+    for (const std::string& cmd : {" ablate --config " + grid + " --out " + d.file("o"),
+                                   " ablate --config " + grid + " --out " + d.file("o") + " --list",
+                                   " ablate merge --config " + grid + " --out " + d.file("o")}) {
+      const Result r = shell(cli() + cmd);
+      EXPECT_NE(r.code, 0) << extra;
+      EXPECT_NE(r.output.find(grid), std::string::npos) << extra << ": " << r.output;
+      EXPECT_NE(r.output.find(field), std::string::npos) << extra << ": " << r.output;
+      EXPECT_NE(r.output.find(says), std::string::npos) << extra << ": " << r.output;
+    }
+    EXPECT_FALSE(fs::exists(d.path() / "s")) << "no dataset generated";
+    EXPECT_FALSE(fs::exists(d.path() / "o" / "runs")) << "no job ran";
+  }
 }

@@ -111,7 +111,7 @@ TEST(Cli, TrainCoverageAndActiveOnASmallScene) {
           d.file("c2"));
   ASSERT_EQ(r.code, 0) << r.output;
 
-  r = run("active --dataset " + d.file("s") + " --method fvs --max-views 5 --interval 4 --iterations 40 --final-iterations 0 --out " +
+  r = run("active --dataset " + d.file("s") + " --method fvs --max-views 5 --interval 4 --min-iterations 40 --final-iterations 0 --out " +
           d.file("a"));
   ASSERT_EQ(r.code, 0) << r.output;
   const std::string ar = saresgs::test::readBytes(d.file("a/results.json"));
@@ -119,7 +119,7 @@ TEST(Cli, TrainCoverageAndActiveOnASmallScene) {
     EXPECT_NE(ar.find(key), std::string::npos) << key;
   EXPECT_TRUE(fs::exists(d.path() / "a" / "cameras.png"));
   // Running again into the same folder without --resume is refused (nothing overwritten).
-  r = run("active --dataset " + d.file("s") + " --method fvs --max-views 5 --interval 4 --iterations 40 --final-iterations 0 --out " +
+  r = run("active --dataset " + d.file("s") + " --method fvs --max-views 5 --interval 4 --min-iterations 40 --final-iterations 0 --out " +
           d.file("a"));
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.output.find("--resume"), std::string::npos) << r.output;
@@ -155,7 +155,7 @@ TEST(Cli, ActiveAcceptsEveryMethodOfTheList) {
 TEST(Cli, FinalFitEqualsTrainOnTheChosenViews) {
   TempDir d;
   ASSERT_EQ(run("scene --layout object --views 12 --width 64 --height 48 --out " + d.file("s")).code, 0);
-  Result r = run("active --dataset " + d.file("s") + " --method sa-resgs --max-views 5 --interval 4 --iterations 40 " +
+  Result r = run("active --dataset " + d.file("s") + " --method sa-resgs --max-views 5 --interval 4 --min-iterations 40 " +
                  "--final-iterations 150 --seed 3 --threads 2 --out " + d.file("a"));
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("final fit on these views (150 it)"), std::string::npos) << r.output;

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <functional>
@@ -64,6 +65,8 @@ TEST(ActiveRun, ProtocolCountsAndIterationBudget) {
     // 2*6 + 3*6 + 4*6 = 54 iterations over three selections, then the rest of 90.
     EXPECT_EQ(last_iteration, 90);
     EXPECT_EQ(calls, 90);  // one per training iteration
+    EXPECT_EQ(r.iterations, 90);
+    EXPECT_EQ(r.phase_iterations, (std::vector<int>{12, 18, 24, 36}));
     EXPECT_EQ(r.steps.size(), 4u);  // three selections and the final phase
     EXPECT_TRUE(std::isfinite(r.test.psnr));
     ASSERT_TRUE(r.ause.has_value());  // the synthetic dataset has depth
@@ -97,6 +100,17 @@ TEST(ActiveRun, OnlyWhatAMethodNeedsIsComputed) {
     EXPECT_EQ(l.seconds.prefilter, 0.0);
   }
   EXPECT_THROW(parseMethod("oracle"), std::invalid_argument);
+}
+
+// total_iterations is the loop's least total: when the phases' own k x interval add up to
+// more, more runs, and the result says so (what `--min-iterations 300` means).
+TEST(ActiveRun, TotalIterationsIsALeastTotalAndTheResultSaysWhatRan) {
+  const Scene& s = tinyDataset();
+  ActiveOptions o = tinyOptions(Method::kRandom);
+  o.total_iterations = 40;
+  const ActiveResult r = ActiveRun(s, o).run();
+  EXPECT_EQ(r.phase_iterations, (std::vector<int>{12, 18, 24, 30}));  // the last: 5 views x 6
+  EXPECT_EQ(r.iterations, 84);
 }
 
 TEST(ActiveRun, ResumedAfterAKillEqualsAnUninterruptedRun) {
@@ -169,10 +183,69 @@ TEST(ActiveRun, CorruptCheckpointFieldsAreRefusedByName) {
   ActiveOptions other_interval = tinyOptions(Method::kRandom);
   other_interval.interval = 7;
   EXPECT_TRUE(refused([](nlohmann::json&) {}, "iterations_done", other_interval));
+  // Wrong JSON types name the field, never with nlohmann's or the standard library's
+  // words ("type must be number", "vector::_M_range_check").
+  const auto named = [&](const std::function<void(nlohmann::json&)>& corrupt, const std::string& field) {
+    nlohmann::json j = good;
+    corrupt(j);
+    test::writeBytes(ckpt, j.dump());
+    ActiveRun run(s, tinyOptions(Method::kRandom), ckpt);
+    std::string msg;
+    try {
+      run.run();
+    } catch (const InputError& e) {
+      msg = e.what();
+    }
+    EXPECT_NE(msg.find(ckpt + ": " + field), std::string::npos) << field << ": " << msg;
+    EXPECT_EQ(msg.find("json.exception"), std::string::npos) << msg;
+    EXPECT_EQ(msg.find("_M_range_check"), std::string::npos) << msg;
+  };
+  named([](nlohmann::json& j) { j["initial"] = "0,1"; }, "initial: expected an array");
+  named([](nlohmann::json& j) { j["selected"][1] = "x"; }, "selected[1]: expected a whole number");
+  named([](nlohmann::json& j) { j["selected"][1] = -3; }, "selected[1]: expected a whole number in 0..");
+  named([](nlohmann::json& j) { j["selected"][1] = 1e12; }, "selected[1]");
+  named([](nlohmann::json& j) { j["iterations_done"] = "40"; }, "iterations_done: expected a whole number");
+  named([](nlohmann::json& j) { j["seed"] = -1; }, "seed: expected a whole number");
+  named([](nlohmann::json& j) { j["views"] = nullptr; }, "views: expected a whole number");
+  named([](nlohmann::json& j) { j["rng"] = 5; }, "rng: expected a string");
+  named([](nlohmann::json& j) { j["rng"] = "not a state"; }, "rng");
+  named([](nlohmann::json& j) { j["tag"] = 3; }, "tag: expected a string");
+  named([](nlohmann::json& j) { j["method"] = nlohmann::json::array(); }, "method: expected a string");
+  named([](nlohmann::json& j) { j["steps"][0]["seconds"]["fisher"] = "slow"; }, "steps[0].seconds.fisher: expected a number");
+  named([](nlohmann::json& j) { j["steps"][0]["views_before"] = 2.5; }, "steps[0].views_before: expected a whole number");
+  named([](nlohmann::json& j) { j["steps"][0]["candidates"][0] = 7; }, "steps[0].candidates[0]: expected a string");
+  named([](nlohmann::json& j) { j["steps"] = nlohmann::json::object(); }, "steps: expected an array");
   // The untouched checkpoint still resumes.
   test::writeBytes(ckpt, good.dump());
   ActiveRun ok(s, tinyOptions(Method::kRandom), ckpt);
   EXPECT_NO_THROW(ok.run());
+}
+
+// The prefilter's companion file holds raw points: a NaN among them is refused, naming
+// the file.
+TEST(ActiveRun, NonFinitePrefilterStateIsRefusedByFile) {
+  const Scene& s = tinyDataset();
+  TempDir d;
+  const std::string ckpt = d.file("c.json");
+  {
+    ActiveRun first(s, tinyOptions(Method::kSaHash), ckpt);
+    struct Killed {};
+    EXPECT_THROW(first.run([](const ActiveProgress& p) {
+      if (p.iteration == 40) throw Killed{};
+    }), Killed);
+  }
+  const nlohmann::json j = nlohmann::json::parse(test::readBytes(ckpt));
+  const std::string companion = ckpt + ".prefilter." + j["tag"].get<std::string>();
+  std::string bytes = test::readBytes(companion);
+  ASSERT_GE(bytes.size(), sizeof(double));
+  const double nan = std::nan("");
+  std::memcpy(bytes.data(), &nan, sizeof nan);
+  test::writeBytes(companion, bytes);
+  ActiveRun resumed(s, tinyOptions(Method::kSaHash), ckpt);
+  EXPECT_TRUE(test::throwsInputError([&] { resumed.run(); }, companion, "points"));
+  test::writeBytes(companion, bytes.substr(0, bytes.size() - 1));
+  ActiveRun truncated(s, tinyOptions(Method::kSaHash), ckpt);
+  EXPECT_TRUE(test::throwsInputError([&] { truncated.run(); }, companion, "points"));
 }
 
 TEST(CoveragePrefilter, PrefersTheViewOfTheUnobservedSide) {

@@ -163,3 +163,88 @@ TEST(Camera, ValidationNamesFileAndField) {
   c.R(0, 0) = 2;
   EXPECT_THROW(validateCamera(c, "f", "g"), InputError);
 }
+
+// viewFocus: where cameras without points look.
+namespace {
+
+std::vector<Camera> hemisphere(const Eigen::Vector3d& target, double radius, int n, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<Camera> cams;
+  for (int i = 0; i < n; ++i) {
+    const double phi = 2 * M_PI * u(rng), z = 0.1 + 0.85 * u(rng), r = std::sqrt(1 - z * z);
+    cams.push_back(Camera::lookAt(makeK(), target + radius * Eigen::Vector3d(r * std::cos(phi), r * std::sin(phi), z), target));
+  }
+  return cams;
+}
+
+}  // namespace
+
+TEST(ViewFocus, CamerasOnAHemisphereLookAtTheirTarget) {
+  // Object-centred capture away from the origin (the mean of the centres is well above it).
+  const Eigen::Vector3d target(1.5, -2.0, 0.75);
+  const std::vector<Camera> cams = hemisphere(target, 4.0, 40, 7);
+  const ViewFocus f = viewFocus(cams);
+  EXPECT_TRUE(f.axes_meet);
+  EXPECT_NEAR((f.center - target).norm(), 0.0, 1e-9);
+  // Every camera is 4 from the target: the radius is 4 tan(half the narrower fov).
+  EXPECT_NEAR(f.radius, 4.0 * std::tan(0.5 * std::min(makeK().fovX(), makeK().fovY())), 1e-9);
+  // The mean of the camera centres, the old init's centre, is far from the target.
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Camera& c : cams) mean += c.center();
+  mean /= static_cast<double>(cams.size());
+  EXPECT_GT((mean - target).norm(), f.radius);
+}
+
+TEST(ViewFocus, InwardFacingRingWithNoisyAxesFindsTheCentre) {
+  // A ring at varying heights looking at points scattered about the centre: the least-
+  // squares point stays near the centre and in front of every camera.
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> noise(0, 0.1);
+  std::vector<Camera> cams;
+  for (int i = 0; i < 36; ++i) {
+    const double a = 2 * M_PI * i / 36;
+    const Eigen::Vector3d eye(3 * std::cos(a), 3 * std::sin(a), 0.5 + 0.3 * std::sin(3 * a));
+    cams.push_back(Camera::lookAt(makeK(), eye, Eigen::Vector3d(noise(rng), noise(rng), noise(rng))));
+  }
+  const ViewFocus f = viewFocus(cams);
+  EXPECT_TRUE(f.axes_meet);
+  EXPECT_LT(f.center.norm(), 0.15);
+  for (const Camera& c : cams) EXPECT_GT(c.toCamera(f.center).z(), 0);
+  EXPECT_GT(f.radius, 0.5);
+  EXPECT_LT(f.radius, 3.0);
+}
+
+TEST(ViewFocus, ParallelAxesFallBackToADepthAlongTheViewDirection) {
+  // Forward-facing capture: a 3x3 grid of cameras, all looking along +y.
+  std::vector<Camera> cams;
+  for (int i = -1; i <= 1; ++i)
+    for (int j = -1; j <= 1; ++j) {
+      const Eigen::Vector3d eye(0.1 * i, 0, 0.1 * j);
+      cams.push_back(Camera::lookAt(makeK(), eye, eye + Eigen::Vector3d(0, 1, 0)));
+    }
+  const ViewFocus f = viewFocus(cams);
+  EXPECT_FALSE(f.axes_meet);
+  const double spread = 0.1 * std::sqrt(2.0);
+  EXPECT_NEAR(f.center.x(), 0.0, 1e-12);
+  EXPECT_NEAR(f.center.z(), 0.0, 1e-12);
+  EXPECT_NEAR(f.center.y(), ViewFocus::kFallbackDepth * spread, 1e-9);
+  for (const Camera& c : cams) EXPECT_TRUE(c.project(f.center).has_value());
+  EXPECT_GT(f.radius, spread);
+
+  // Outward-facing cameras (their axes meet behind them): the centres' mean.
+  std::vector<Camera> out;
+  for (int i = 0; i < 8; ++i) {
+    const double a = 2 * M_PI * i / 8;
+    const Eigen::Vector3d eye(0.2 * std::cos(a), 0.2 * std::sin(a), 0);
+    out.push_back(Camera::lookAt(makeK(), eye, 2 * eye));
+  }
+  const ViewFocus g = viewFocus(out);
+  EXPECT_FALSE(g.axes_meet);
+  EXPECT_LT(g.center.norm(), 1e-12);
+  EXPECT_NEAR(g.radius, 0.4, 1e-9);
+  // One camera: a point in front of it.
+  const ViewFocus one = viewFocus(std::span<const Camera>(cams.data(), 1));
+  EXPECT_FALSE(one.axes_meet);
+  EXPECT_GT(cams[0].toCamera(one.center).z(), 0);
+}

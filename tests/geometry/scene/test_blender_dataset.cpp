@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <functional>
+#include <memory>
 #include <nlohmann/json.hpp>
 
 #include "common/test_support.h"
@@ -122,4 +124,75 @@ TEST(BlenderDataset, ErrorsNameFileAndField) {
     std::ofstream(d.file("transforms_train.json")) << j.dump();
     expectError(d.str(), "transforms_train.json", "transform_matrix");
   }
+}
+
+// Wrong JSON types name the file and the field (not nlohmann's "type must be number");
+// sizes are bounded; an image listed twice, in one split or in both, is refused.
+TEST(BlenderDataset, MistypedFieldsRepeatsAndSizesAreRefusedByField) {
+  auto edited = [](const std::function<void(json&, json&)>& edit) {
+    auto d = std::make_unique<TempDir>();
+    writeSplit(*d, "transforms_train.json", "train", 3);
+    writeSplit(*d, "transforms_test.json", "test", 2);
+    json train = json::parse(std::ifstream(d->file("transforms_train.json")));
+    json test = json::parse(std::ifstream(d->file("transforms_test.json")));
+    edit(train, test);
+    std::ofstream(d->file("transforms_train.json")) << train.dump();
+    std::ofstream(d->file("transforms_test.json")) << test.dump();
+    return d;
+  };
+  struct Case {
+    std::function<void(json&, json&)> edit;
+    std::string file, field;
+  };
+  const std::vector<Case> cases{
+      {[](json& t, json&) { t["camera_angle_x"] = "wide"; }, "transforms_train.json", "camera_angle_x: expected a number"},
+      {[](json& t, json&) { t["frames"] = json::object(); }, "transforms_train.json", "frames: expected an array"},
+      {[](json& t, json&) { t["frames"][1] = json::array({1, 2}); }, "transforms_train.json", "frames[1]: expected an object"},
+      {[](json& t, json&) { t["frames"][1]["file_path"] = 7; }, "transforms_train.json", "frames[1].file_path: expected a string"},
+      {[](json& t, json&) { t["frames"][2]["transform_matrix"][1][2] = "x"; }, "transforms_train.json",
+       "frames[2].transform_matrix[1][2]: expected a number"},
+      {[](json& t, json&) { t["frames"][0]["transform_matrix"] = 3; }, "transforms_train.json", "frames[0].transform_matrix"},
+      {[](json&, json& s) { s["frames"][0]["cx"] = json::array(); }, "transforms_test.json", "frames[0].cx: expected a number"},
+      {[](json& t, json&) { t["w"] = "40"; t["h"] = 30; }, "transforms_train.json", "w: expected a whole number"},
+      {[](json& t, json&) { t["w"] = 4294967336.0; t["h"] = 30; }, "transforms_train.json", "w: expected a whole number in 1..65536"},
+      {[](json& t, json&) { t["frames"][2]["file_path"] = "./train/r_0"; }, "transforms_train.json", "frames[2].file_path"},
+      {[](json& t, json& s) { s["frames"][1]["file_path"] = t["frames"][0]["file_path"]; }, "transforms_test.json",
+       "frames[1].file_path"},
+  };
+  for (const Case& c : cases) {
+    const auto d = edited(c.edit);
+    std::string msg;
+    try {
+      loadDataset(d->str());
+    } catch (const InputError& e) {
+      msg = e.what();
+    }
+    EXPECT_NE(msg.find(c.file), std::string::npos) << c.field << ": " << msg;
+    EXPECT_NE(msg.find(c.field), std::string::npos) << msg;
+    EXPECT_EQ(msg.find("json.exception"), std::string::npos) << msg;
+  }
+  // The repeat names where the image was first listed.
+  const auto d = edited([](json& t, json& s) { s["frames"][1]["file_path"] = t["frames"][0]["file_path"]; });
+  EXPECT_TRUE(test::throwsInputError([&] { loadDataset(d->str()); }, "listed twice", "transforms_train.json frames[0]"));
+}
+
+// A manifest beside the transforms (`saresgs scene --format blender`) must agree with the
+// cameras; "background": null means the data has none.
+TEST(BlenderDataset, ManifestSizesMustMatchAndNullMeansNoBackground) {
+  TempDir d;
+  writeSplit(d, "transforms_train.json", "train", 3);
+  test::writeBytes(d.file("manifest.json"), R"({"width": 40, "height": 30, "num_views": 3, "background": null})");
+  const Scene s = loadDataset(d.str());
+  EXPECT_FALSE(s.background.has_value());
+  test::writeBytes(d.file("manifest.json"), R"({"width": 64, "height": 30, "num_views": 3})");
+  EXPECT_TRUE(test::throwsInputError([&] { loadDataset(d.str()); }, "manifest.json", "width"));
+  test::writeBytes(d.file("manifest.json"), R"({"num_views": 4})");
+  EXPECT_TRUE(test::throwsInputError([&] { loadDataset(d.str()); }, "manifest.json", "num_views"));
+  test::writeBytes(d.file("manifest.json"), R"({"num_views": 2e9})");
+  EXPECT_TRUE(test::throwsInputError([&] { loadDataset(d.str()); }, "manifest.json", "num_views: expected a whole number in 1..100000"));
+  // With --downscale the manifest is compared with the full-size cameras.
+  test::writeBytes(d.file("manifest.json"), R"({"width": 40, "height": 30})");
+  DatasetOptions half;
+  half.load.downscale = 2;
+  EXPECT_EQ(loadDataset(d.str(), half).views[0].camera.K.width, 20);
 }

@@ -161,3 +161,60 @@ TEST(ColmapDataset, ManifestSplitWinsOverTheEveryEighthRule) {
   test::writeBytes(d.file("manifest.json"), R"({"split": {"train": ["nope.png"], "test": []}})");
   EXPECT_TRUE(test::throwsInputError([&] { loadDataset(d.str()); }, "manifest.json", "split.train"));
 }
+
+// manifest.json: wrong types and sizes name the field; a name twice in the split or in
+// both parts, and sizes or counts that disagree with the model, are errors.
+TEST(ColmapDataset, ManifestFieldsAreTypedBoundedAndMatchTheModel) {
+  TempDir d;
+  writeDataset(d, 6);
+  const std::string train = R"("train": ["img_1000.png", "img_1002.png", "img_1003.png", "img_1004.png", "img_1005.png"])";
+  struct Case {
+    std::string manifest, field;
+  };
+  for (const Case& c : std::vector<Case>{
+           {R"({"split": [1, 2]})", "split: expected an object"},
+           {R"({"split": {"train": "img_1000.png"}})", "split.train: expected an array"},
+           {R"({"split": {"train": ["img_1000.png", 3]}})", "split.train[1]: expected a string"},
+           {R"({"split": {"train": ["img_1000.png", "img_1000.png"]}})", "split.train"},
+           {"{\"split\": {" + train + R"(, "test": ["img_1001.png", "img_1002.png"]}})", "split.test"},
+           {R"({"width": "abc"})", "width: expected a whole number"},
+           {R"({"width": 64})", "width"},
+           {R"({"height": 24.5})", "height: expected a whole number"},
+           {R"({"num_views": 2e9})", "num_views: expected a whole number in 1..100000"},
+           {R"({"num_views": 7})", "num_views"},
+           {R"({"background": [1, "white", 1]})", "background[1]"},
+           {R"({"background": 5})", "background"},
+           {R"([1, 2])", "json"},
+       }) {
+    test::writeBytes(d.file("manifest.json"), c.manifest);
+    std::string msg;
+    try {
+      loadDataset(d.str());
+    } catch (const InputError& e) {
+      msg = e.what();
+    }
+    EXPECT_NE(msg.find("manifest.json"), std::string::npos) << c.manifest << ": " << msg;
+    EXPECT_NE(msg.find(c.field), std::string::npos) << c.manifest << ": " << msg;
+    EXPECT_EQ(msg.find("json.exception"), std::string::npos) << msg;
+  }
+  // The sizes the model has are accepted.
+  test::writeBytes(d.file("manifest.json"), R"({"width": 32, "height": 24, "num_views": 6, "background": null})");
+  EXPECT_FALSE(loadDataset(d.str()).background.has_value());
+}
+
+TEST(ColmapDataset, AnImageNamedTwiceOrAWidthThatWrapsIsRefused) {
+  TempDir d;
+  ColmapModel m = writeDataset(d, 3);
+  m.images.begin()->second.name = std::next(m.images.begin())->second.name;
+  writeColmapText(d.file("sparse/0"), m);
+  EXPECT_TRUE(test::throwsInputError([&] { loadDataset(d.str()); }, "images.txt", "appears twice"));
+  // 2^32 + 64 must not wrap to 64 (which would match the images).
+  TempDir e;
+  writeDataset(e, 3);
+  std::string cams = test::readBytes(e.file("sparse/0/cameras.txt"));
+  const auto at = cams.find("PINHOLE 32 ");
+  ASSERT_NE(at, std::string::npos);
+  cams.replace(at, 11, "PINHOLE 4294967328 ");
+  test::writeBytes(e.file("sparse/0/cameras.txt"), cams);
+  EXPECT_TRUE(test::throwsInputError([&] { loadDataset(e.str()); }, "cameras.txt", "width"));
+}

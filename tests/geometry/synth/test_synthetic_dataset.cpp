@@ -212,3 +212,88 @@ TEST(SyntheticDatasetColmap, PointTriangulatorPointsLieOnTheSurface) {
   std::nth_element(rel.begin(), rel.begin() + rel.size() / 2, rel.end());
   EXPECT_LT(rel[rel.size() / 2], 0.01);
 }
+
+// `--format blender`: a NeRF-synthetic folder that saresgs reads back with the cameras,
+// split and points it was written from; object images carry true alpha, whose composite
+// on the white background is the COLMAP export's image; rooms are opaque and have no
+// background.
+TEST(SyntheticDatasetBlender, ReadsBackWithIdenticalCamerasAndTrueAlpha) {
+  TempDir d;
+  const SyntheticOptions o = smallOptions("object");
+  const SyntheticScene scene = makeSyntheticScene(o);
+  WriteDatasetOptions w;
+  w.simulated.seed = o.seed;
+  writeSyntheticDataset(scene, d.file("colmap"), w);
+  w.format = "blender";
+  writeSyntheticDataset(scene, d.file("blender"), w);
+  for (const char* f : {"transforms_train.json", "transforms_test.json", "points3d.ply", "manifest.json", "train/0000.png"})
+    EXPECT_TRUE(fs::exists(d.path() / "blender" / f)) << f;
+  EXPECT_FALSE(fs::exists(d.path() / "blender" / "sparse"));
+
+  const Scene b = loadDataset(d.file("blender"));
+  const Scene c = loadDataset(d.file("colmap"));
+  ASSERT_EQ(b.views.size(), scene.cameras.size());
+  std::vector<std::string> train, test;
+  for (int i : b.train) train.push_back(b.views[i].name);
+  for (int i : b.test) test.push_back(b.views[i].name);
+  std::vector<std::string> want_train, want_test;
+  for (int i : scene.train) want_train.push_back(scene.names[i]);
+  for (int i : scene.test) want_test.push_back(scene.names[i]);
+  EXPECT_EQ(train, want_train);
+  EXPECT_EQ(test, want_test);
+  int partial = 0, empty = 0, full = 0;
+  for (const SceneView& v : b.views) {
+    const auto k = static_cast<std::size_t>(std::find(scene.names.begin(), scene.names.end(), v.name) - scene.names.begin());
+    ASSERT_LT(k, scene.names.size()) << v.name;
+    const Camera& truth = scene.cameras[k];
+    EXPECT_EQ(v.camera.K.width, truth.K.width);
+    EXPECT_EQ(v.camera.K.height, truth.K.height);
+    for (double x : {v.camera.K.fx - truth.K.fx, v.camera.K.fy - truth.K.fy, v.camera.K.cx - truth.K.cx, v.camera.K.cy - truth.K.cy})
+      EXPECT_NEAR(x, 0.0, 1e-9 * truth.K.fx);
+    EXPECT_NEAR((v.camera.R - truth.R).norm(), 0.0, 1e-12);
+    EXPECT_NEAR((v.camera.t - truth.t).norm(), 0.0, 1e-12);
+    EXPECT_TRUE(!v.depth_path.empty());
+    // True alpha: coverage of the object, un-premultiplied colour.
+    const Image8 rgba = readImage(v.image_path, true);
+    ASSERT_EQ(rgba.channels, 4);
+    for (std::size_t p = 3; p < rgba.data.size(); p += 4) {
+      empty += rgba.data[p] == 0;
+      full += rgba.data[p] == 255;
+      partial += rgba.data[p] > 0 && rgba.data[p] < 255;
+    }
+    // On the white background it is the COLMAP image (8-bit rounding twice).
+    const Image8& composite = b.image(static_cast<int>(&v - b.views.data()));
+    const auto ci = std::find_if(c.views.begin(), c.views.end(), [&](const SceneView& x) { return x.name == v.name; });
+    const Image8& reference = c.image(static_cast<int>(ci - c.views.begin()));
+    int worst = 0;
+    for (std::size_t p = 0; p < composite.data.size(); ++p) worst = std::max(worst, std::abs(composite.data[p] - reference.data[p]));
+    EXPECT_LE(worst, 2) << v.name;
+  }
+  EXPECT_GT(empty, 0);
+  EXPECT_GT(full, 0);
+  EXPECT_GT(partial, 0);  // anti-aliased silhouettes
+  ASSERT_TRUE(b.background.has_value());
+  EXPECT_EQ(*b.background, (std::array<float, 3>{1, 1, 1}));
+  // The simulated points, in float.
+  ASSERT_EQ(b.points.size(), c.points.size());
+  for (std::size_t i = 0; i < b.points.size(); ++i) {
+    EXPECT_NEAR((b.points[i].xyz - c.points[i].xyz).norm(), 0.0, 1e-6 * (1 + c.points[i].xyz.norm()));
+    EXPECT_EQ(b.points[i].rgb, c.points[i].rgb);
+  }
+
+  // A room: opaque, no background, and with --sfm none no point cloud.
+  const SyntheticScene room = makeSyntheticScene(smallOptions("room360"));
+  w.sfm = "none";
+  writeSyntheticDataset(room, d.file("room"), w);
+  EXPECT_FALSE(fs::exists(d.path() / "room" / "points3d.ply"));
+  const Scene r = loadDataset(d.file("room"));
+  EXPECT_TRUE(r.points.empty());
+  EXPECT_FALSE(r.background.has_value());
+  const Image8 rgba = readImage(r.views[0].image_path, true);
+  ASSERT_EQ(rgba.channels, 4);
+  for (std::size_t p = 3; p < rgba.data.size(); p += 4) ASSERT_EQ(rgba.data[p], 255);
+
+  // COLMAP's triangulator reads images/, which a Blender folder does not have.
+  w.sfm = "colmap";
+  EXPECT_THROW(writeSyntheticDataset(room, d.file("room2"), w), std::invalid_argument);
+}

@@ -96,6 +96,35 @@ TEST(Ablation, MalformedGridsNameTheFileAndField) {
   EXPECT_TRUE(bad(R"({"scenes": [{"name": "a", "dataset": "x"}], "methods": ["random"], "seeds": "0"})", "seeds"));
   EXPECT_TRUE(bad(R"({"scenes": [{"name": "a", "dataset": "x"}], "sweep": {"scenes": ["z"]}})", "sweep.scenes"));
   EXPECT_TRUE(bad(R"({"scenes": [{"name": "a", "dataset": "x"}]})", "methods"));
+  // Values are checked as read: a negative or fractional seed no longer wraps or truncates,
+  // threads are a count, repeats are refused, and the messages are ours.
+  const std::string scene = R"({"scenes": [{"name": "a", "dataset": "x"}], "methods": ["random"], )";
+  for (const auto& [text, field] : std::vector<std::pair<std::string, std::string>>{
+           {scene + R"("seeds": [0, -1]})", "seeds[1]: expected a whole number in 0.."},
+           {scene + R"("seeds": [0.5]})", "seeds[0]: expected a whole number"},
+           {scene + R"("seeds": ["1"]})", "seeds[0]: expected a whole number"},
+           {scene + R"("seeds": [1, 2, 1]})", "seeds[2]: 1 appears twice"},
+           {scene + R"("threads": -2})", "threads: expected a whole number in 0..1024"},
+           {scene + R"("threads": "two"})", "threads: expected a whole number"},
+           {scene + R"("threads": 1e12})", "threads"},
+           {scene + R"("preset": 3})", "preset"},
+           {R"({"scenes": [{"name": "a", "dataset": "x"}], "methods": ["random", "fvs", "random"]})", "methods[2]: random appears twice"},
+           {scene + R"("sweep": {"views": [4, -1]}})", "sweep.views[1]: expected a whole number in 1.."},
+           {scene + R"("sweep": {"views": "4"}})", "sweep.views: expected an array"},
+           {scene + R"("sweep": {"keep": 2}})", "sweep.keep: expected a number in 0..1"},
+           {scene + R"("sweep": {"keep": 0}})", "sweep.keep"},
+           {scene + R"("sweep": {"timing_repeats": 0}})", "sweep.timing_repeats"},
+       }) {
+    writeBytes(f, text);
+    std::string msg;
+    try {
+      readAblationGrid(f);
+    } catch (const InputError& e) {
+      msg = e.what();
+    }
+    EXPECT_NE(msg.find(f + ": " + field), std::string::npos) << text << ": " << msg;
+    EXPECT_EQ(msg.find("json.exception"), std::string::npos) << msg;
+  }
 }
 
 // tau-b from its textbook definition: sum of sign products over pairs, normalised by the

@@ -74,18 +74,24 @@ TEST(Trainer, InitialModelComesFromTheSparsePoints) {
   EXPECT_EQ(t.rasterSettings().background[0], 1.0f);
 }
 
-TEST(Trainer, WithoutPointsStartsFromRandomPointsAroundTheCameras) {
+TEST(Trainer, WithoutPointsStartsFromRandomPointsWhereTheCamerasLook) {
   Scene s = tinyDataset();
   s.points.clear();
   TrainerOptions o = quickOptions();
   o.random_init_points = 500;
   Trainer t(s, o);
   ASSERT_EQ(t.gaussians().size(), 500u);
-  Eigen::Vector3d c = Eigen::Vector3d::Zero();
-  for (int v : s.train) c += s.views[v].camera.center();
-  c /= static_cast<double>(s.train.size());
-  for (std::size_t i = 0; i < 500; ++i)
-    for (int k = 0; k < 3; ++k) EXPECT_LE(std::abs(t.gaussians().means[3 * i + k] - c[k]), 0.3 * s.extent + 1e-4);
+  const ViewFocus f = viewFocus(s.cameras(s.train));
+  ASSERT_GT(f.radius, 0);
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e30), hi = -lo;
+  for (std::size_t i = 0; i < 500; ++i) {
+    const Eigen::Vector3d p(t.gaussians().means[3 * i], t.gaussians().means[3 * i + 1], t.gaussians().means[3 * i + 2]);
+    EXPECT_LE((p - f.center).norm(), f.radius * (1 + 1e-6) + 1e-6);
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  // The points fill the ball, not a corner of it.
+  EXPECT_GT((hi - lo).minCoeff(), f.radius);
 }
 
 TEST(Trainer, TrainingRaisesTrainPsnr) {
