@@ -12,6 +12,7 @@
 #include "geometry/error.h"
 #include "geometry/io/atomic_file.h"
 #include "geometry/io/json_file.h"
+#include "geometry/io/json_number.h"
 #include "nbv/ause.h"
 #include "nbv/initial_views.h"
 #include "nbv/run_report.h"
@@ -276,6 +277,14 @@ bool ActiveRun::loadCheckpoint() {
   if (field("seed") != opt_.seed) throw InputError(checkpoint_, "seed", "written with seed " + j["seed"].dump());
   if (field("views") != scene_.views.size()) throw InputError(checkpoint_, "views", "written for another scene");
   try {
+    // View lists are checked item by item before conversion (get<int>() of 1e30 is
+    // undefined behaviour).
+    for (const char* name : {"initial", "selected"}) {
+      const nlohmann::json& a = field(name);
+      if (!a.is_array()) throw InputError(checkpoint_, name, "expected an array of view indices");
+      for (const auto& v : a)
+        if (!jsonIsExact<int>(v)) throw InputError(checkpoint_, name, "not a view index: " + v.dump());
+    }
     initial_ = field("initial").get<std::vector<int>>();
     selected_ = field("selected").get<std::vector<int>>();
     // Read as numbers first: a huge or fractional value must not be converted blindly.

@@ -3,6 +3,7 @@
 #include <map>
 
 #include "geometry/error.h"
+#include "geometry/io/json_number.h"
 #include "splat/train/residual.h"
 
 namespace saresgs {
@@ -16,6 +17,8 @@ template <class T>
 T field(const json& j, const char* key, const std::string& source, const std::string& path) {
   const std::string name = path.empty() ? key : path + "." + key;
   if (!j.is_object() || !j.contains(key)) throw InputError(source, name, "missing");
+  if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool>)
+    if (!jsonIsExact<T>(j[key])) throw InputError(source, name, "expected a whole number in range, got " + j[key].dump());
   try {
     return j[key].get<T>();
   } catch (const json::exception&) {

@@ -8,6 +8,7 @@
 
 #include "geometry/error.h"
 #include "geometry/io/json_file.h"
+#include "geometry/io/json_number.h"
 #include "geometry/scene/scene.h"
 
 namespace saresgs {
@@ -60,10 +61,18 @@ void readSplit(const fs::path& root, const std::string& name, const DatasetOptio
       if (j.contains(key)) return &j[key];
       return nullptr;
     };
+    // A size is a whole number of pixels, checked before conversion (get<int>() of a string
+    // throws nlohmann's message, of 1e30 is undefined behaviour).
+    auto pixels = [&](const char* key) {
+      const json& v = *pick(key);
+      if (!jsonIsExact<int>(v) || v.get<int>() < 1)
+        throw InputError(file, (fr.contains(key) ? where : std::string()) + key, "expected a positive whole number of pixels");
+      return v.get<int>();
+    };
     int w = 0, h = 0;
     if (pick("w") && pick("h")) {
-      w = pick("w")->get<int>();
-      h = pick("h")->get<int>();
+      w = pixels("w");
+      h = pixels("h");
     } else {
       const Image8 probe = readImage(v.image_path, true);
       w = probe.width;
@@ -81,8 +90,8 @@ void readSplit(const fs::path& root, const std::string& name, const DatasetOptio
         throw InputError(file, "camera_angle_x", "expected an angle in (0, pi) radians");
       K.fx = K.fy = 0.5 * w / std::tan(0.5 * ax);
     }
-    K.cx = pick("cx") ? pick("cx")->get<double>() : 0.5 * w;
-    K.cy = pick("cy") ? pick("cy")->get<double>() : 0.5 * h;
+    K.cx = pick("cx") ? number(fr.contains("cx") ? fr : j, "cx", file, fr.contains("cx") ? where : "") : 0.5 * w;
+    K.cy = pick("cy") ? number(fr.contains("cy") ? fr : j, "cy", file, fr.contains("cy") ? where : "") : 0.5 * h;
     if (!K.valid()) throw InputError(file, where + "intrinsics", "expected positive focal length");
 
     const json& m = fr.value("transform_matrix", json());

@@ -47,6 +47,7 @@ bool readManifestSplit(const fs::path& manifest, Scene& scene) {
     scene.background = std::array<float, 3>{b[0].get<float>(), b[1].get<float>(), b[2].get<float>()};
   }
   if (!j.contains("split")) return false;
+  if (!j["split"].is_object()) throw InputError(manifest.string(), "split", "expected {\"train\": [names], \"test\": [names]}");
   std::map<std::string, int> index;
   for (int i = 0; i < static_cast<int>(scene.views.size()); ++i) index[scene.views[i].name] = i;
   for (const char* part : {"train", "test"}) {

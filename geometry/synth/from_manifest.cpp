@@ -6,6 +6,7 @@
 
 #include "geometry/error.h"
 #include "geometry/io/json_file.h"
+#include "geometry/io/json_number.h"
 
 namespace saresgs {
 
@@ -15,9 +16,17 @@ std::optional<SyntheticOptions> syntheticOptionsFromManifest(const std::string& 
   const nlohmann::json m = readJsonFile(path);
   if (!m.contains("layout") || !m.contains("objects") || !m["objects"].is_array()) return std::nullopt;
   for (const auto& o : m["objects"]) {
+    if (!o.is_object() || (o.contains("mesh") && !o["mesh"].is_string()) || (o.contains("texture") && !o["texture"].is_string()))
+      throw InputError(path, "objects", "expected objects whose mesh and texture are strings");
     const std::string mesh = o.value("mesh", ""), tex = o.value("texture", "");
     if (mesh.rfind("procedural:", 0) != 0 || tex.rfind("procedural:", 0) != 0) return std::nullopt;
   }
+  // Whole numbers are checked before conversion (1e30 as an int is undefined behaviour).
+  for (const char* key : {"width", "height", "num_views"})
+    if (m.contains(key) && !(jsonIsExact<int>(m[key]) && m[key].get<int>() >= 0))
+      throw InputError(path, key, "expected a whole number >= 0, got " + m[key].dump());
+  if (m.contains("seed") && !jsonIsExact<std::uint64_t>(m["seed"]))
+    throw InputError(path, "seed", "expected a whole number >= 0, got " + m["seed"].dump());
   try {
     SyntheticOptions s;
     s.layout = m.at("layout");

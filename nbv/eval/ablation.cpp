@@ -10,6 +10,7 @@
 
 #include "geometry/error.h"
 #include "geometry/io/json_file.h"
+#include "geometry/io/json_number.h"
 
 namespace saresgs {
 
@@ -38,6 +39,17 @@ auto parsedAs(F&& parse, const std::string& file, const std::string& field) {
 
 template <class T>
 T fieldAs(const nlohmann::json& j, const std::string& file, const std::string& field) {
+  // Integers are checked before conversion: get<int>() of 1e30 is undefined behaviour and
+  // get<std::uint64_t>() of -1 wraps to 2^64-1.
+  const auto exact = [&](const nlohmann::json& v, const std::string& name, auto zero) {
+    if (!jsonIsExact<decltype(zero)>(v)) throw InputError(file, name, "expected a whole number in range, got " + v.dump());
+  };
+  if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool>) {
+    exact(j, field, T{});
+  } else if constexpr (std::is_same_v<T, std::vector<int>> || std::is_same_v<T, std::vector<std::uint64_t>>) {
+    if (j.is_array())
+      for (std::size_t i = 0; i < j.size(); ++i) exact(j[i], field + "[" + std::to_string(i) + "]", typename T::value_type{});
+  }
   try {
     return j.get<T>();
   } catch (const nlohmann::json::exception&) {

@@ -5,6 +5,7 @@
 
 #include "common/test_support.h"
 #include "geometry/error.h"
+#include "geometry/image/image.h"
 #include "geometry/scene/scene.h"
 
 using namespace saresgs;
@@ -121,5 +122,19 @@ TEST(BlenderDataset, ErrorsNameFileAndField) {
     j["frames"][0]["transform_matrix"][0][3] = std::nan("");  // json writes NaN as null
     std::ofstream(d.file("transforms_train.json")) << j.dump();
     expectError(d.str(), "transforms_train.json", "transform_matrix");
+  }
+}
+
+// Found with the Blender fuzz target (fuzz/fuzz_blender.cpp) on mutations of its
+// Instant-NGP seed: a size or principal point of the wrong type escaped as nlohmann's
+// "type must be number", and a size of 1e30 was converted to int (undefined behaviour).
+TEST(BlenderDataset, SizesAndCentresOfTheWrongTypeOrRangeNameTheirField) {
+  TempDir d;
+  for (int i = 0; i < 4; ++i) writeImage(d.file("r_" + std::to_string(i) + ".png"), Image8(8, 6, 4, 200));
+  const std::string file = d.file("transforms_train.json");
+  for (const auto& [input, field] : std::vector<std::pair<std::string, std::string>>{
+           {"w_string.json", "w"}, {"w_1e30.json", "w"}, {"cx_string.json", "cx"}}) {
+    test::writeBytes(file, test::readBytes(test::fuzzRegression("geometry/scene/fuzz_regressions/blender/" + input)));
+    EXPECT_TRUE(test::throwsInputError([&] { loadBlenderDataset(d.str()); }, file, field)) << input;
   }
 }

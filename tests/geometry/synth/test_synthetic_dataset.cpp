@@ -13,6 +13,7 @@
 #include "common/test_support.h"
 #include "geometry/io/colmap.h"
 #include "geometry/scene/scene.h"
+#include "geometry/synth/from_manifest.h"
 #include "geometry/synth/write_dataset.h"
 
 using namespace saresgs;
@@ -211,4 +212,16 @@ TEST(SyntheticDatasetColmap, PointTriangulatorPointsLieOnTheSurface) {
   EXPECT_GE(on_surface, 0.7 * m.points.size()) << on_surface << " of " << m.points.size();
   std::nth_element(rel.begin(), rel.begin() + rel.size() / 2, rel.end());
   EXPECT_LT(rel[rel.size() / 2], 0.01);
+}
+
+// Found with the manifest fuzz target (fuzz/fuzz_manifest.cpp): an object's mesh given
+// as a number escaped as nlohmann's "type must be string", and a width of 1e30 was
+// converted to int (undefined behaviour) before any check.
+TEST(SyntheticManifest, FieldsOfTheWrongTypeOrRangeNameTheField) {
+  for (const auto& [input, field] : std::vector<std::pair<std::string, std::string>>{
+           {"mesh_number.json", "objects"}, {"width_1e30.json", "width"}}) {
+    TempDir d;
+    test::writeBytes(d.file("manifest.json"), test::readBytes(test::fuzzRegression("geometry/synth/fuzz_regressions/manifest/" + input)));
+    EXPECT_TRUE(test::throwsInputError([&] { syntheticOptionsFromManifest(d.str()); }, d.file("manifest.json"), field)) << input;
+  }
 }
