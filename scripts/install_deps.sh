@@ -13,6 +13,9 @@ packages=(
   colmap libsqlite3-dev
   # GNU parallel: shards of an ablation grid on one machine (results/README.md)
   parallel
+  # the fuzz targets (fuzz/): clang 14 and its runtimes (libFuzzer, ASan, UBSan), which
+  # clang only recommends (third_party_notes/libfuzzer.md)
+  clang-14 libclang-rt-14-dev
   # CC0 meshes (/usr/share/doc/libcgal-dev/data.tar.gz) and photographs for textures
   libcgal-demo opencv-doc
 )

@@ -195,7 +195,10 @@ struct Source {
   std::string name;
   std::size_t offset = 0;
   bool is_double = false;
-  float* dst = nullptr;   // first Gaussian's slot
+  // The first Gaussian's slot is (*array)[first]: an index, not a pointer, as the arrays
+  // of an empty model have no storage to point into.
+  std::vector<float>* array = nullptr;
+  std::size_t first = 0;
   std::size_t step = 0;   // floats between consecutive Gaussians
 };
 
@@ -306,21 +309,21 @@ Gaussians readGaussiansPly(const std::string& path) {
   const int K = g.shCoeffs();
 
   std::vector<Source> sources;
-  auto want = [&](const std::string& name, float* dst, std::size_t step) {
+  auto want = [&](const std::string& name, std::vector<float>& array, std::size_t first, std::size_t step) {
     const Property* p = find(name);
     if (!p) throw InputError(path, name, "property missing from element vertex");
     if (p->type != Type::Float32 && p->type != Type::Float64)
       throw InputError(path, name, "type " + p->type_name + ", expected float or double");
-    sources.push_back({name, p->offset, p->type == Type::Float64, dst, step});
+    sources.push_back({name, p->offset, p->type == Type::Float64, &array, first, step});
   };
-  for (int a = 0; a < 3; ++a) want(std::string(1, "xyz"[a]), g.means.data() + a, 3);
-  for (int c = 0; c < 3; ++c) want("f_dc_" + std::to_string(c), g.sh.data() + c, 3 * K);
+  for (int a = 0; a < 3; ++a) want(std::string(1, "xyz"[a]), g.means, a, 3);
+  for (int c = 0; c < 3; ++c) want("f_dc_" + std::to_string(c), g.sh, c, 3 * K);
   for (int c = 0; c < 3; ++c)
     for (int k = 1; k < K; ++k)
-      want("f_rest_" + std::to_string(c * (K - 1) + (k - 1)), g.sh.data() + k * 3 + c, 3 * K);
-  want("opacity", g.opacities.data(), 1);
-  for (int a = 0; a < 3; ++a) want("scale_" + std::to_string(a), g.log_scales.data() + a, 3);
-  for (int a = 0; a < 4; ++a) want("rot_" + std::to_string(a), g.rotations.data() + a, 4);
+      want("f_rest_" + std::to_string(c * (K - 1) + (k - 1)), g.sh, k * 3 + c, 3 * K);
+  want("opacity", g.opacities, 0, 1);
+  for (int a = 0; a < 3; ++a) want("scale_" + std::to_string(a), g.log_scales, a, 3);
+  for (int a = 0; a < 4; ++a) want("rot_" + std::to_string(a), g.rotations, a, 4);
 
   in.clear();
   in.seekg(static_cast<std::streamoff>(offset));
@@ -352,7 +355,7 @@ Gaussians readGaussiansPly(const std::string& path) {
             throw InputError(path, s.name,
                              "vertex " + std::to_string(vi) + " is " + (std::isnan(v) ? "NaN" : "Inf"));
         }
-        s.dst[vi * s.step] = v;
+        (*s.array)[s.first + vi * s.step] = v;
       }
   }
   return g;

@@ -87,7 +87,8 @@ struct Reader {
       throw InputError(file, field, "expected " + std::to_string(expected) + " values, found " + std::to_string(n));
     if (n > (bytes.size() - pos) / sizeof(T)) throw InputError(file, field, "file is truncated");
     std::vector<T> v(n);
-    std::memcpy(v.data(), bytes.data() + pos, n * sizeof(T));
+    // An empty vector's data() may be null, which memcpy must never be given.
+    if (n) std::memcpy(v.data(), bytes.data() + pos, n * sizeof(T));
     pos += n * sizeof(T);
     return v;
   }

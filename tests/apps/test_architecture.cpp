@@ -47,7 +47,8 @@ std::string rel(const fs::path& p) { return fs::relative(p, kRoot).string(); }
 TEST(Architecture, RoomsIncludeOnlyWhatIsBelowThem) {
   int checked = 0;
   for (const auto& [room, forbidden] : std::vector<std::pair<std::string, std::vector<std::string>>>{
-           {"geometry", {"splat/", "nbv/", "apps/"}}, {"splat", {"nbv/", "apps/"}}, {"nbv", {"apps/"}}})
+           {"geometry", {"splat/", "nbv/", "apps/", "fuzz/"}}, {"splat", {"nbv/", "apps/", "fuzz/"}},
+           {"nbv", {"apps/", "fuzz/"}}})
     for (const fs::path& f : sources(room))
       for (const std::string& i : includes(f)) {
         ++checked;
@@ -126,7 +127,7 @@ std::string comments(const std::string& text) {
 TEST(Architecture, EveryDocumentTheCodeCitesExists) {
   static const std::regex doc(R"re(([A-Za-z0-9_./-]*(?:[A-Za-z0-9_]\.md\b|STACK_NOTES)))re");
   int cited = 0;
-  for (const std::string room : {"geometry", "splat", "nbv", "apps", "tests"})
+  for (const std::string room : {"geometry", "splat", "nbv", "apps", "tests", "fuzz"})
     for (const fs::path& f : sources(room)) {
       if (f.filename() == "test_architecture.cpp") continue;
       const std::string c = comments(read(f));

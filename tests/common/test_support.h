@@ -50,6 +50,12 @@ inline std::string readBytes(const std::string& path) {
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
+// A committed input that a fuzz target once failed on: tests/<room folder>/fuzz_regressions/
+// <target>/<name>, given from tests/ (README, "Fuzzing").
+inline std::string fuzzRegression(const std::string& path_in_tests) {
+  return std::string(SARESGS_SOURCE_DIR) + "/tests/" + path_in_tests;
+}
+
 // Success when `f` throws InputError whose message contains `file` and `field`.
 // Any other exception escapes and fails the test.
 template <typename F>

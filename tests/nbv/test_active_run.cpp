@@ -370,5 +370,46 @@ TEST(ActiveRun, ProgressNamesEveryPhaseWithItsCounts) {
     EXPECT_STRNE(toString(p), "?");
 }
 
+// Found with the active-checkpoint fuzz target (fuzz/fuzz_active_checkpoint.cpp): a view
+// index of 1e30 in "selected", or a step's views_before of 1e30, was converted to int
+// (undefined behaviour). The inputs are checkpoints of the fuzz fixture's run
+// (fuzz/fuzz_fixtures.h: 6 views named view0.png .. view5.png, view 0 the test view,
+// random selection from 2 views, seed 5); both are refused by field.
+TEST(ActiveRun, CheckpointNumbersOutOfRangeAreRefusedByField) {
+  Scene s;
+  Intrinsics K;
+  K.width = 16;
+  K.height = 12;
+  K.fx = K.fy = 14;
+  K.cx = 8;
+  K.cy = 6;
+  for (int i = 0; i < 6; ++i) {
+    SceneView v;
+    v.name = "view" + std::to_string(i) + ".png";
+    const double a = 2 * M_PI * i / 6;
+    v.camera = Camera::lookAt(K, Eigen::Vector3d(3 * std::cos(a), 3 * std::sin(a), 0.5), Eigen::Vector3d::Zero());
+    s.views.push_back(v);
+    (i == 0 ? s.test : s.train).push_back(i);
+  }
+  s.finalize();
+  ActiveOptions o;
+  o.method = Method::kRandom;
+  o.initial_views = 2;
+  o.max_views = 4;
+  o.interval = 1;
+  o.total_iterations = 8;
+  o.trainer.max_sh_degree = 1;
+  o.trainer.random_init_points = 8;
+  o.seed = 5;
+  for (const auto& [input, field] : std::vector<std::pair<std::string, std::string>>{
+           {"selected_1e30.json", "selected"}, {"views_before_1e30.json", "steps[0].views_before"}}) {
+    TempDir d;
+    const std::string ckpt = d.file("checkpoint.json");
+    test::writeBytes(ckpt, test::readBytes(test::fuzzRegression("nbv/fuzz_regressions/active_checkpoint/" + input)));
+    ActiveRun run(s, o, ckpt);
+    EXPECT_TRUE(test::throwsInputError([&] { run.run(); }, ckpt, field)) << input;
+  }
+}
+
 }  // namespace
 }  // namespace saresgs

@@ -340,3 +340,25 @@ TEST(GaussiansPly, MalformedFilesGiveInputErrorsNamingFileAndField) {
     EXPECT_TRUE(throwsInputError([&] { readGaussiansPly(p); }, p, "rot_2"));
   }
 }
+
+// Found by fuzz/fuzz_ply.cpp (UBSan: the reader pointed into the arrays of an empty model,
+// whose data() is null, before reading any vertex). The committed input is what
+// writeGaussiansPly writes for an empty model; the sanitizers check it in the test
+// command's fuzz run (fuzz/run_bounded.sh runs every tests/**/fuzz_regressions/<target>/ input).
+TEST(Ply, AFileWithoutVerticesReadsAsAnEmptyModel) {
+  const std::string p = std::string(SARESGS_SOURCE_DIR) + "/tests/splat/fuzz_regressions/ply/empty_model.ply";
+  const Gaussians g = readGaussiansPly(p);
+  EXPECT_EQ(g.size(), 0u);
+  EXPECT_EQ(g.max_sh_degree, 0);
+  g.forEachArray([](const std::vector<float>& a, std::size_t) { EXPECT_TRUE(a.empty()); });
+  TempDir d;
+  writeGaussiansPly(d.file("empty.ply"), Gaussians{});
+  EXPECT_EQ(saresgs::test::readBytes(d.file("empty.ply")), saresgs::test::readBytes(p));
+  // Without vertices a missing property is still refused by name.
+  std::string bytes = saresgs::test::readBytes(p);
+  const std::string line = "property float opacity\n";
+  ASSERT_NE(bytes.find(line), std::string::npos);
+  bytes.erase(bytes.find(line), line.size());
+  saresgs::test::writeBytes(d.file("no_opacity.ply"), bytes);
+  EXPECT_TRUE(throwsInputError([&] { readGaussiansPly(d.file("no_opacity.ply")); }, d.file("no_opacity.ply"), "opacity"));
+}

@@ -7,6 +7,7 @@
 
 #include "common/test_support.h"
 #include "geometry/error.h"
+#include "geometry/image/image.h"
 #include "geometry/scene/scene.h"
 
 using namespace saresgs;
@@ -195,4 +196,17 @@ TEST(BlenderDataset, ManifestSizesMustMatchAndNullMeansNoBackground) {
   DatasetOptions half;
   half.load.downscale = 2;
   EXPECT_EQ(loadDataset(d.str(), half).views[0].camera.K.width, 20);
+
+// Found with the Blender fuzz target (fuzz/fuzz_blender.cpp) on mutations of its
+// Instant-NGP seed: a size or principal point of the wrong type escaped as nlohmann's
+// "type must be number", and a size of 1e30 was converted to int (undefined behaviour).
+TEST(BlenderDataset, SizesAndCentresOfTheWrongTypeOrRangeNameTheirField) {
+  TempDir d;
+  for (int i = 0; i < 4; ++i) writeImage(d.file("r_" + std::to_string(i) + ".png"), Image8(8, 6, 4, 200));
+  const std::string file = d.file("transforms_train.json");
+  for (const auto& [input, field] : std::vector<std::pair<std::string, std::string>>{
+           {"w_string.json", "w"}, {"w_1e30.json", "w"}, {"cx_string.json", "cx"}}) {
+    test::writeBytes(file, test::readBytes(test::fuzzRegression("geometry/scene/fuzz_regressions/blender/" + input)));
+    EXPECT_TRUE(test::throwsInputError([&] { loadBlenderDataset(d.str()); }, file, field)) << input;
+  }
 }

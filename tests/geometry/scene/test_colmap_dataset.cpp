@@ -6,6 +6,8 @@
 #include "geometry/error.h"
 #include "geometry/io/colmap.h"
 #include "geometry/scene/scene.h"
+#include "geometry/synth/synthetic_scene.h"
+#include "geometry/synth/write_dataset.h"
 
 using namespace saresgs;
 using saresgs::test::TempDir;
@@ -217,4 +219,22 @@ TEST(ColmapDataset, AnImageNamedTwiceOrAWidthThatWrapsIsRefused) {
   cams.replace(at, 11, "PINHOLE 4294967328 ");
   test::writeBytes(e.file("sparse/0/cameras.txt"), cams);
   EXPECT_TRUE(test::throwsInputError([&] { loadDataset(e.str()); }, "cameras.txt", "width"));
+
+// Found with the manifest fuzz target (fuzz/fuzz_manifest.cpp): a manifest whose "split"
+// is an array, not {train, test}, escaped as nlohmann's "cannot use value() with array".
+TEST(ColmapDataset, AManifestSplitThatIsNotAnObjectNamesTheField) {
+  TempDir d;
+  SyntheticOptions o;
+  o.layout = "object";
+  o.width = 16;
+  o.height = 12;
+  o.num_views = 4;
+  WriteDatasetOptions w;
+  w.simulated.max_points = 6;
+  w.simulated.candidates = 400;
+  writeSyntheticDataset(makeSyntheticScene(o), d.file("ds"), w);
+  ASSERT_NO_THROW(loadDataset(d.file("ds")));
+  const std::string manifest = d.file("ds/manifest.json");
+  test::writeBytes(manifest, test::readBytes(test::fuzzRegression("geometry/scene/fuzz_regressions/manifest/split_array.json")));
+  EXPECT_TRUE(test::throwsInputError([&] { loadDataset(d.file("ds")); }, manifest, "split"));
 }

@@ -13,6 +13,7 @@
 #include "common/test_support.h"
 #include "geometry/io/colmap.h"
 #include "geometry/scene/scene.h"
+#include "geometry/synth/from_manifest.h"
 #include "geometry/synth/write_dataset.h"
 
 using namespace saresgs;
@@ -296,4 +297,15 @@ TEST(SyntheticDatasetBlender, ReadsBackWithIdenticalCamerasAndTrueAlpha) {
   // COLMAP's triangulator reads images/, which a Blender folder does not have.
   w.sfm = "colmap";
   EXPECT_THROW(writeSyntheticDataset(room, d.file("room2"), w), std::invalid_argument);
+
+// Found with the manifest fuzz target (fuzz/fuzz_manifest.cpp): an object's mesh given
+// as a number escaped as nlohmann's "type must be string", and a width of 1e30 was
+// converted to int (undefined behaviour) before any check.
+TEST(SyntheticManifest, FieldsOfTheWrongTypeOrRangeNameTheField) {
+  for (const auto& [input, field] : std::vector<std::pair<std::string, std::string>>{
+           {"mesh_number.json", "objects"}, {"width_1e30.json", "width"}}) {
+    TempDir d;
+    test::writeBytes(d.file("manifest.json"), test::readBytes(test::fuzzRegression("geometry/synth/fuzz_regressions/manifest/" + input)));
+    EXPECT_TRUE(test::throwsInputError([&] { syntheticOptionsFromManifest(d.str()); }, d.file("manifest.json"), field)) << input;
+  }
 }

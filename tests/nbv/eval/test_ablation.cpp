@@ -242,3 +242,17 @@ TEST(Ablation, PrefilterSweepReferenceIsExactAndACollisionFreeHashMatchesIt) {
   }
   EXPECT_TRUE(collision_free) << "pick a larger table for the test";
 }
+
+// Found with the ablation-config fuzz target (fuzz/fuzz_ablation_config.cpp): numbers of
+// 1e30 where a whole number belongs were converted to int or uint64 (undefined
+// behaviour); they are refused by field, as is a negative seed.
+TEST(AblationGrid, NumbersOutOfRangeAreRefusedByField) {
+  for (const auto& [input, field] : std::vector<std::pair<std::string, std::string>>{
+           {"threads_1e30.json", "threads"}, {"seed_1e30.json", "seeds[0]"}, {"sweep_views_1e30.json", "sweep.views[0]"}}) {
+    const std::string p = test::fuzzRegression("nbv/eval/fuzz_regressions/ablation_config/" + input);
+    EXPECT_TRUE(throwsInputError([&] { readAblationGrid(p); }, p, field)) << input;
+  }
+  TempDir d;
+  writeBytes(d.file("g.json"), R"({"scenes": [{"name": "a", "dataset": "x"}], "methods": ["random"], "seeds": [-1]})");
+  EXPECT_TRUE(throwsInputError([&] { readAblationGrid(d.file("g.json")); }, d.file("g.json"), "seeds[0]"));
+}

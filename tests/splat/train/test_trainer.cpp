@@ -224,6 +224,43 @@ TEST(Trainer, ExtremeModelsTrainWithoutNanOrInf) {
   for (float x : r.rgb.data) ASSERT_TRUE(std::isfinite(x));
 }
 
+// Found by fuzz/fuzz_trainer_checkpoint.cpp (UBSan: memcpy given the null data() of an
+// empty vector). The committed input is the checkpoint of a fresh trainer of the fuzz
+// fixture's scene (fuzz/fuzz_fixtures.h: 6 views, 8 points, SH degree 1): its view set
+// and view stack are empty. It loads, and saving it again gives the same bytes; the
+// sanitizers check the same input in the test command's fuzz run (fuzz/run_bounded.sh
+// runs every tests/**/fuzz_regressions/<target>/ input).
+TEST(Trainer, ACheckpointWithEmptyViewListsLoads) {
+  const std::string file =
+      std::string(SARESGS_SOURCE_DIR) + "/tests/splat/train/fuzz_regressions/trainer_checkpoint/fresh_empty_view_lists.bin";
+  Scene s;
+  Intrinsics K;
+  K.width = 16;
+  K.height = 12;
+  K.fx = K.fy = 14;
+  K.cx = 8;
+  K.cy = 6;
+  for (int i = 0; i < 6; ++i) {
+    SceneView v;
+    v.name = std::to_string(i);
+    const double a = 2 * M_PI * i / 6;
+    v.camera = Camera::lookAt(K, Eigen::Vector3d(3 * std::cos(a), 3 * std::sin(a), 0.5), Eigen::Vector3d::Zero());
+    s.views.push_back(v);
+    s.train.push_back(i);
+  }
+  s.finalize();
+  TrainerOptions o;
+  o.max_sh_degree = 1;
+  o.random_init_points = 4;
+  Trainer t(s, o);
+  t.loadCheckpoint(file);
+  EXPECT_EQ(t.gaussians().size(), 8u);
+  EXPECT_EQ(t.iteration(), 0);
+  TempDir d;
+  t.saveCheckpoint(d.file("again.bin"));
+  EXPECT_EQ(test::readBytes(d.file("again.bin")), test::readBytes(file));
+}
+
 }  // namespace
 }  // namespace saresgs
 

@@ -1,0 +1,93 @@
+#include "fuzz/fuzz_fixtures.h"
+
+#include <cmath>
+#include <filesystem>
+
+#include "fuzz/fuzz_support.h"
+#include "geometry/image/image.h"
+#include "geometry/synth/write_dataset.h"
+
+namespace saresgs::fuzz {
+
+namespace fs = std::filesystem;
+
+const Scene& tinyScene() {
+  static const Scene scene = [] {
+    Scene s;
+    const std::string dir = scratchPath("tiny_scene/images/x");
+    s.source = fs::path(dir).parent_path().parent_path().string();
+    Intrinsics K;
+    K.width = 16;
+    K.height = 12;
+    K.fx = K.fy = 14;
+    K.cx = 8;
+    K.cy = 6;
+    for (int i = 0; i < 6; ++i) {
+      const double a = 2 * M_PI * i / 6;
+      SceneView v;
+      v.name = "view" + std::to_string(i) + ".png";
+      v.camera = Camera::lookAt(K, Eigen::Vector3d(3 * std::cos(a), 3 * std::sin(a), 0.5), Eigen::Vector3d::Zero());
+      v.image_path = (fs::path(dir).parent_path() / v.name).string();
+      Image8 img(K.width, K.height, 3);
+      for (std::size_t p = 0; p < img.data.size(); ++p) img.data[p] = static_cast<std::uint8_t>((p * 37 + i * 11) % 251);
+      writeImage(v.image_path, img);
+      s.views.push_back(v);
+      (i == 0 ? s.test : s.train).push_back(i);
+    }
+    for (int p = 0; p < 8; ++p) {
+      SparsePoint sp;
+      sp.xyz = Eigen::Vector3d((p & 1) - 0.5, ((p >> 1) & 1) - 0.5, ((p >> 2) & 1) - 0.5);
+      sp.rgb = {static_cast<std::uint8_t>(40 * p), 128, static_cast<std::uint8_t>(255 - 30 * p)};
+      s.points.push_back(sp);
+    }
+    s.finalize();
+    return s;
+  }();
+  return scene;
+}
+
+TrainerOptions tinyTrainer() {
+  TrainerOptions o;
+  o.max_sh_degree = 1;
+  o.seed = 7;
+  return o;
+}
+
+ActiveOptions tinyActive() {
+  ActiveOptions o;
+  o.method = Method::kRandom;
+  o.initial_views = 2;
+  o.max_views = 4;
+  o.interval = 1;
+  o.total_iterations = 8;
+  o.progress_test_views = 0;
+  o.final_iterations = 0;
+  o.trainer = tinyTrainer();
+  o.seed = 5;
+  return o;
+}
+
+SyntheticOptions tinySyntheticOptions() {
+  SyntheticOptions o;
+  o.layout = "object";
+  o.width = 16;
+  o.height = 12;
+  o.num_views = 4;
+  o.seed = 1;
+  return o;
+}
+
+const std::string& tinyDataset() {
+  static const std::string dir = [] {
+    const std::string d = scratchPath("tiny_dataset");
+    WriteDatasetOptions w;
+    w.simulated.max_points = 6;
+    w.simulated.candidates = 400;
+    w.simulated.seed = 1;
+    writeSyntheticDataset(makeSyntheticScene(tinySyntheticOptions()), d, w);
+    return d;
+  }();
+  return dir;
+}
+
+}  // namespace saresgs::fuzz
