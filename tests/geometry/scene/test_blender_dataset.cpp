@@ -196,6 +196,7 @@ TEST(BlenderDataset, ManifestSizesMustMatchAndNullMeansNoBackground) {
   DatasetOptions half;
   half.load.downscale = 2;
   EXPECT_EQ(loadDataset(d.str(), half).views[0].camera.K.width, 20);
+}
 
 // Found with the Blender fuzz target (fuzz/fuzz_blender.cpp) on mutations of its
 // Instant-NGP seed: a size or principal point of the wrong type escaped as nlohmann's

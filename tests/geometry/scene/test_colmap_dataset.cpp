@@ -219,6 +219,7 @@ TEST(ColmapDataset, AnImageNamedTwiceOrAWidthThatWrapsIsRefused) {
   cams.replace(at, 11, "PINHOLE 4294967328 ");
   test::writeBytes(e.file("sparse/0/cameras.txt"), cams);
   EXPECT_TRUE(test::throwsInputError([&] { loadDataset(e.str()); }, "cameras.txt", "width"));
+}
 
 // Found with the manifest fuzz target (fuzz/fuzz_manifest.cpp): a manifest whose "split"
 // is an array, not {train, test}, escaped as nlohmann's "cannot use value() with array".

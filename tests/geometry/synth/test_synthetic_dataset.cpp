@@ -297,6 +297,7 @@ TEST(SyntheticDatasetBlender, ReadsBackWithIdenticalCamerasAndTrueAlpha) {
   // COLMAP's triangulator reads images/, which a Blender folder does not have.
   w.sfm = "colmap";
   EXPECT_THROW(writeSyntheticDataset(room, d.file("room2"), w), std::invalid_argument);
+}
 
 // Found with the manifest fuzz target (fuzz/fuzz_manifest.cpp): an object's mesh given
 // as a number escaped as nlohmann's "type must be string", and a width of 1e30 was
