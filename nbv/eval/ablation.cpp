@@ -205,7 +205,8 @@ AblationGrid readAblationGrid(const std::string& path) {
   for (const auto& [key, value] : j.items())
     if (!std::set<std::string>{"preset", "threads", "scenes", "methods", "seeds", "method_args", "variants", "tables", "sweep", "comment"}
              .count(key))
-      throw InputError(path, key, "unknown field");
+      // Quoted, so that an empty key (found by the ablation-config fuzz target) still names a field.
+      throw InputError(path, "\"" + key + "\"", "unknown field");
   if (j.contains("preset")) g.preset = jsonString(j["preset"], path, "preset");
   if (g.preset != "quick" && g.preset != "paper") throw InputError(path, "preset", "expected quick or paper");
   if (j.contains("threads")) g.threads = static_cast<int>(jsonInteger(j["threads"], path, "threads", 0, kMaxThreads));

@@ -256,3 +256,13 @@ TEST(AblationGrid, NumbersOutOfRangeAreRefusedByField) {
   writeBytes(d.file("g.json"), R"({"scenes": [{"name": "a", "dataset": "x"}], "methods": ["random"], "seeds": [-1]})");
   EXPECT_TRUE(throwsInputError([&] { readAblationGrid(d.file("g.json")); }, d.file("g.json"), "seeds[0]"));
 }
+
+// Found by a 1M-input run of the ablation-config fuzz target: a key that is the empty
+// string was reported as an unknown field with an empty name. Unknown keys are quoted.
+TEST(AblationGrid, AnUnknownKeyIsNamedEvenWhenEmpty) {
+  const std::string p = test::fuzzRegression("nbv/eval/fuzz_regressions/ablation_config/empty_key.json");
+  EXPECT_TRUE(throwsInputError([&] { readAblationGrid(p); }, p, "\"\": unknown field"));
+  TempDir d;
+  writeBytes(d.file("g.json"), R"({"scenes": [{"name": "a", "dataset": "x"}], "methods": ["random"], "seedz": [1]})");
+  EXPECT_TRUE(throwsInputError([&] { readAblationGrid(d.file("g.json")); }, d.file("g.json"), "\"seedz\": unknown field"));
+}
