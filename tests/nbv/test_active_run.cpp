@@ -376,22 +376,7 @@ TEST(ActiveRun, ProgressNamesEveryPhaseWithItsCounts) {
 // (fuzz/fuzz_fixtures.h: 6 views named view0.png .. view5.png, view 0 the test view,
 // random selection from 2 views, seed 5); both are refused by field.
 TEST(ActiveRun, CheckpointNumbersOutOfRangeAreRefusedByField) {
-  Scene s;
-  Intrinsics K;
-  K.width = 16;
-  K.height = 12;
-  K.fx = K.fy = 14;
-  K.cx = 8;
-  K.cy = 6;
-  for (int i = 0; i < 6; ++i) {
-    SceneView v;
-    v.name = "view" + std::to_string(i) + ".png";
-    const double a = 2 * M_PI * i / 6;
-    v.camera = Camera::lookAt(K, Eigen::Vector3d(3 * std::cos(a), 3 * std::sin(a), 0.5), Eigen::Vector3d::Zero());
-    s.views.push_back(v);
-    (i == 0 ? s.test : s.train).push_back(i);
-  }
-  s.finalize();
+  Scene s = test::ringScene([](int i) { return "view" + std::to_string(i) + ".png"; }, true);
   ActiveOptions o;
   o.method = Method::kRandom;
   o.initial_views = 2;

@@ -233,22 +233,7 @@ TEST(Trainer, ExtremeModelsTrainWithoutNanOrInf) {
 TEST(Trainer, ACheckpointWithEmptyViewListsLoads) {
   const std::string file =
       std::string(SARESGS_SOURCE_DIR) + "/tests/splat/train/fuzz_regressions/trainer_checkpoint/fresh_empty_view_lists.bin";
-  Scene s;
-  Intrinsics K;
-  K.width = 16;
-  K.height = 12;
-  K.fx = K.fy = 14;
-  K.cx = 8;
-  K.cy = 6;
-  for (int i = 0; i < 6; ++i) {
-    SceneView v;
-    v.name = std::to_string(i);
-    const double a = 2 * M_PI * i / 6;
-    v.camera = Camera::lookAt(K, Eigen::Vector3d(3 * std::cos(a), 3 * std::sin(a), 0.5), Eigen::Vector3d::Zero());
-    s.views.push_back(v);
-    s.train.push_back(i);
-  }
-  s.finalize();
+  const Scene s = test::ringScene([](int i) { return std::to_string(i); }, false);
   TrainerOptions o;
   o.max_sh_degree = 1;
   o.random_init_points = 4;
