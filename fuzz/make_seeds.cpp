@@ -14,6 +14,7 @@
 #include "fuzz/fuzz_support.h"
 #include "geometry/io/colmap.h"
 #include "geometry/io/pfm.h"
+#include "geometry/io/point_ply.h"
 #include "geometry/lifting/correspondence.h"
 #include "geometry/synth/simulated_sfm.h"
 #include "geometry/synth/write_dataset.h"
@@ -115,6 +116,24 @@ int main(int argc, char** argv) {
     const std::string path = fuzz::scratchPath("seeds/degree" + std::to_string(degree) + ".ply");
     writeGaussiansPly(path, gaussiansFromPoints(pts, degree, 0.1f));
     seed(out, "ply", "sh_degree" + std::to_string(degree), fuzz::readBytes(path));
+  }
+
+  {
+    // 3DGS's points3d.ply as saresgs writes it (binary), and the ascii forms other tools
+    // write: double coordinates without colours, and extra properties between the ones read.
+    std::vector<PlyPoint> pts;
+    for (const SparsePoint& p : fuzz::tinyScene().points) pts.push_back({p.xyz, {p.rgb[0], p.rgb[1], p.rgb[2]}});
+    pts.resize(3);
+    const std::string path = fuzz::scratchPath("seeds/points3d.ply");
+    writePointsPly(path, pts);
+    seed(out, "points_ply", "binary_3dgs", fuzz::readBytes(path));
+    seed(out, "points_ply", "ascii_xyz_double",
+         "ply\nformat ascii 1.0\nelement vertex 2\nproperty double x\nproperty double y\nproperty double z\n"
+         "end_header\n0.5 -1.25 2\n1e-3 3.5 -0.75\n");
+    seed(out, "points_ply", "ascii_extra_properties",
+         "ply\nformat ascii 1.0\ncomment two faces follow\nelement vertex 2\nproperty float x\nproperty float y\n"
+         "property float z\nproperty float confidence\nproperty uchar red\nproperty uchar green\nproperty uchar blue\n"
+         "element face 0\nproperty list uchar int vertex_indices\nend_header\n0 0 1 0.9 255 0 10\n0.25 0.5 1 0.1 3 200 99\n");
   }
 
   for (int channels : {1, 3}) {

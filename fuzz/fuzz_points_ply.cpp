@@ -1,0 +1,15 @@
+// libFuzzer target: a coloured point cloud (the points3d.ply beside a NeRF-synthetic
+// folder's transforms), read with readPointsPly.
+#include <cstddef>
+#include <cstdint>
+
+#include "fuzz/fuzz_support.h"
+#include "geometry/io/point_ply.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  using namespace saresgs;
+  static const std::string path = fuzz::scratchPath("points_ply/points3d.ply");
+  fuzz::writeBytes(path, {reinterpret_cast<const char*>(data), size});
+  fuzz::check([&] { (void)readPointsPly(path); });
+  return 0;
+}
