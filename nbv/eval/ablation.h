@@ -111,12 +111,14 @@ struct Table {
 
 // The results tables (nbv/eval/ablation_tables.cpp), each left out when it would be
 // empty: PSNR/SSIM/AUSE per scene and method (mean +- std over seeds), the config's named
-// tables, PSNR against the number of views, the time breakdown, and the prefilter sweep.
+// tables, PSNR against the number of views, the time breakdown, the prefilter sweep, the
+// paired differences and the final fit's PSNR per test view.
 std::vector<Table> ablationTables(const AblationGrid& g, const std::vector<JobResult>& results);
 Table resultsTable(const AblationGrid& g, const std::vector<JobResult>& results);
 Table namedTable(const AblationGrid& g, const AblationTableSpec& spec, const std::vector<JobResult>& results);
 Table psnrVsViewsTable(const AblationGrid& g, const std::vector<JobResult>& results);
 Table timeTable(const AblationGrid& g, const std::vector<JobResult>& results);
+Table finalFitPerViewTable(const AblationGrid& g, const std::vector<JobResult>& results);
 Table sweepTable(const std::vector<JobResult>& results);
 // Paired differences (nbv/eval/paired_stats.h) of every method against random and against
 // fisher (those in the grid), per scene, for the final-fit PSNR and the in-loop PSNR:

@@ -30,6 +30,33 @@ double halfInterval95(const std::vector<double>& v) {
   return studentT975(static_cast<int>(v.size()) - 1) * meanStd(v).second / std::sqrt(static_cast<double>(v.size()));
 }
 
+// Final-fit PSNR per test view (mean over seeds), one line per method: where in a scene
+// a method's views fall short (a region none of them saw shows as a dip on its views).
+void addPerViewPlot(const AblationGrid& g, const std::vector<JobResult>& results, std::vector<NamedPlot>& plots) {
+  std::vector<PlotPanel> panels;
+  for (const AblationScene& sc : g.scenes) {
+    PlotPanel p{sc.name + ": final-fit PSNR per test view (mean, seeds)", "test view (split order)", "PSNR dB", false, {}, {}};
+    for (const std::string& l : labelsFor(results, sc.name)) {
+      std::vector<std::vector<double>> per_view;
+      for (const JobResult& r : results) {
+        if (r.job.kind != AblationJob::Kind::kActive || r.job.scene != sc.name || label(r.job) != l || !r.run.final_fit) continue;
+        const auto& views = r.run.final_fit->views;
+        if (per_view.size() < views.size()) per_view.resize(views.size());
+        for (std::size_t k = 0; k < views.size(); ++k) per_view[k].push_back(views[k].psnr);
+      }
+      if (per_view.empty()) continue;
+      PlotSeries s{l, {}, {}, {}, {}, true};
+      for (std::size_t k = 0; k < per_view.size(); ++k) {
+        s.x.push_back(static_cast<double>(k));
+        s.y.push_back(meanStd(per_view[k]).first);
+      }
+      p.series.push_back(s);
+    }
+    if (!p.series.empty()) panels.push_back(p);
+  }
+  if (!panels.empty()) plots.push_back({"final_fit_per_view", drawPlot(panels, 720, 420)});
+}
+
 // In-loop PSNR per method, final-fit PSNR per method, PSNR against views (bands over
 // seeds) and PSNR against selection time: one panel per scene in each.
 void addActivePlots(const AblationGrid& g, const std::vector<JobResult>& results, std::vector<NamedPlot>& plots) {
@@ -83,6 +110,7 @@ void addActivePlots(const AblationGrid& g, const std::vector<JobResult>& results
     time.push_back(t);
   }
   plots.push_back({"psnr", drawPlot(psnr)});
+  addPerViewPlot(g, results, plots);
   if (!final_fit.empty()) plots.push_back({"final_fit_psnr", drawPlot(final_fit)});
   plots.push_back({"psnr_vs_views", drawPlot(views)});
   plots.push_back({"psnr_vs_selection_time", drawPlot(time)});

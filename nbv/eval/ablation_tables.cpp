@@ -211,6 +211,37 @@ Table psnrVsViewsTable(const AblationGrid& g, const std::vector<JobResult>& resu
   return t;
 }
 
+// Final-fit PSNR per test view: where in a scene a method's views fall short. Columns are
+// the test views in split order (every method of a scene shares them; names are in each
+// run's results.json). A view's cell is the mean over the seeds whose final fit has it.
+Table finalFitPerViewTable(const AblationGrid& g, const std::vector<JobResult>& results) {
+  Table t{"final_fit_per_view",
+          "Final-fit PSNR per test view (mean over seeds; columns: the scene's test views in split order)",
+          {"scene", "method", "n"}, {}};
+  std::size_t max_views = 0;
+  for (const JobResult& r : results)
+    if (isActive(r) && r.run.final_fit) max_views = std::max(max_views, r.run.final_fit->views.size());
+  if (max_views == 0) return t;
+  for (std::size_t k = 0; k < max_views; ++k) t.header.push_back(std::to_string(k));
+  const auto by = runsByKey(results);
+  forEachCombo(g, [&](const std::string& s, const std::string& m, const std::string& v) {
+    auto it = by.find({s, m, v});
+    if (it == by.end()) return;
+    std::vector<std::vector<double>> per_view(max_views);
+    int n = 0;
+    for (const RunReport* r : it->second) {
+      if (!r->final_fit) continue;
+      ++n;
+      for (std::size_t k = 0; k < r->final_fit->views.size(); ++k) per_view[k].push_back(r->final_fit->views[k].psnr);
+    }
+    if (n == 0) return;
+    std::vector<std::string> row{s, runLabel(m, v), std::to_string(n)};
+    for (const auto& p : per_view) row.push_back(p.empty() ? "" : fmt(meanStd(p).first, 2));
+    t.rows.push_back(row);
+  });
+  return t;
+}
+
 // Time breakdown per method over all scenes and seeds (seconds per run unless named).
 Table timeTable(const AblationGrid& g, const std::vector<JobResult>& results) {
   Table t{"time",
@@ -339,6 +370,7 @@ std::vector<Table> ablationTables(const AblationGrid& g, const std::vector<JobRe
   if (Table t = timeTable(g, results); !t.rows.empty()) tables.push_back(std::move(t));
   if (Table t = sweepTable(results); !t.rows.empty()) tables.push_back(std::move(t));
   if (Table t = pairedTable(g, results); !t.rows.empty()) tables.push_back(std::move(t));
+  if (Table t = finalFitPerViewTable(g, results); !t.rows.empty()) tables.push_back(std::move(t));
   return tables;
 }
 

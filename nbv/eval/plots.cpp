@@ -43,8 +43,25 @@ std::vector<double> linearTicks(double lo, double hi) {
 
 void drawPanel(cv::Mat& img, const PlotPanel& p) {
   const int W = img.cols, H = img.rows;
-  const int left = 62, right = 14, top = 30, bottom = 78;
+  const int left = 62, right = 14, top = 30;
   const auto font = cv::FONT_HERSHEY_SIMPLEX;
+  // The legend: entries left to right under the axis label, wrapped into as many rows as
+  // the panel's width needs (the plot area gives up 16 px per extra row).
+  std::vector<cv::Point> legend_at;
+  {
+    int x = left, row = 0;
+    for (const PlotSeries& s : p.series) {
+      const int w = 34 + cv::getTextSize(s.label, font, 0.4, 1, nullptr).width;
+      if (x > left && x + w - 12 > W - right) {
+        x = left;
+        ++row;
+      }
+      legend_at.emplace_back(x, row);
+      x += w;
+    }
+  }
+  const int legend_rows = legend_at.empty() ? 1 : legend_at.back().y + 1;
+  const int bottom = 78 + 16 * (legend_rows - 1);
   const cv::Scalar black(0, 0, 0), grey(225, 225, 225);
   auto fx = [&](double x) { return p.log_x ? std::log10(x) : x; };
   double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
@@ -124,8 +141,6 @@ void drawPanel(cv::Mat& img, const PlotPanel& p) {
   cv::putText(img, p.xlabel, cv::Point(left + pw / 2 - 4 * static_cast<int>(p.xlabel.size()), top + ph + (stagger ? 46 : 36)), font, 0.42, black, 1,
               cv::LINE_AA);
   cv::putText(img, p.ylabel, cv::Point(4, top - 8 + 0), font, 0.38, black, 1, cv::LINE_AA);
-  // The legend goes in a row under the axis label, where it hides no data.
-  int legend_x = left;
 
   for (std::size_t si = 0; si < p.series.size(); ++si) {
     const PlotSeries& s = p.series[si];
@@ -162,10 +177,9 @@ void drawPanel(cv::Mat& img, const PlotPanel& p) {
       pts.push_back(q);
     }
     if (s.lines && pts.size() > 1) cv::polylines(img, pts, false, c, 2, cv::LINE_AA);
-    const int ly = H - 10;
+    const int legend_x = legend_at[si].x, ly = H - 10 - 16 * (legend_rows - 1 - legend_at[si].y);
     cv::line(img, cv::Point(legend_x, ly - 4), cv::Point(legend_x + 18, ly - 4), c, 2, cv::LINE_AA);
     cv::putText(img, s.label, cv::Point(legend_x + 22, ly), font, 0.4, black, 1, cv::LINE_AA);
-    legend_x += 34 + cv::getTextSize(s.label, font, 0.4, 1, nullptr).width;
   }
 }
 

@@ -203,6 +203,31 @@ TEST(Ablation, TablesAggregateSeedsAndSplitMeanStdInCsv) {
   EXPECT_FALSE(ablationPlots(g, results).empty());
 }
 
+TEST(Ablation, FinalFitPerViewTableAveragesEachTestViewOverSeeds) {
+  TempDir d;
+  writeBytes(d.file("g.json"), kGrid);
+  const AblationGrid g = readAblationGrid(d.file("g.json"));
+  std::vector<JobResult> results;
+  for (const AblationJob& j : expandGrid(g)) {
+    if (j.kind != AblationJob::Kind::kActive || j.scene != "a" || j.variant != "default") continue;
+    RunReport r;
+    FinalFitReport f;
+    // random: views (20, 30) at seed 0 and (22, 31) at seed 1; sa-resgs has no final fit
+    // at seed 1, so its cells are seed 0's alone and n says so.
+    if (j.method == "random") f.views = {{"v0", j.seed == 0 ? 20.0 : 22.0, 0.5}, {"v1", j.seed == 0 ? 30.0 : 31.0, 0.5}};
+    else if (j.seed == 0) f.views = {{"v0", 25.0, 0.5}, {"v1", 26.5, 0.5}};
+    if (!f.views.empty()) r.final_fit = f;
+    results.push_back({j, r, {}});
+  }
+  const Table t = finalFitPerViewTable(g, results);
+  EXPECT_EQ(t.header, (std::vector<std::string>{"scene", "method", "n", "0", "1"}));
+  ASSERT_EQ(t.rows.size(), 2u);
+  EXPECT_EQ(t.rows[0], (std::vector<std::string>{"a", "random", "2", "21.00", "30.50"}));
+  EXPECT_EQ(t.rows[1], (std::vector<std::string>{"a", "sa-resgs", "1", "25.00", "26.50"}));
+  const std::vector<NamedPlot> plots = ablationPlots(g, results);
+  EXPECT_TRUE(std::any_of(plots.begin(), plots.end(), [](const NamedPlot& p) { return p.name == "final_fit_per_view"; }));
+}
+
 TEST(Ablation, PrefilterSweepReferenceIsExactAndACollisionFreeHashMatchesIt) {
   const Scene& scene = test::tinyDataset();
   const auto truth = rebuildSyntheticScene(scene.source, scene);
