@@ -87,7 +87,8 @@ void drawPanel(cv::Mat& img, const PlotPanel& p) {
   if (y1 - y0 < 1e-12) y0 -= 0.5, y1 += 0.5;
   const double pad_x = p.x_categories.empty() ? 0.05 * (x1 - x0) : 0, pad_y = 0.08 * (y1 - y0);
   x0 -= pad_x, x1 += pad_x, y0 -= pad_y, y1 += pad_y;
-  const int pw = W - left - right, ph = H - top - bottom;
+  // A legend of very many rows squeezes the plot area, never below 40 px.
+  const int pw = W - left - right, ph = std::max(40, H - top - bottom);
   auto P = [&](double x, double y) {
     return cv::Point(left + static_cast<int>(std::lround((fx(x) - x0) / (x1 - x0) * pw)),
                      top + ph - static_cast<int>(std::lround((y - y0) / (y1 - y0) * ph)));
