@@ -6,6 +6,7 @@
 #include "fuzz/fuzz_support.h"
 #include "geometry/image/image.h"
 #include "geometry/synth/write_dataset.h"
+#include "tests/common/ring_scene.h"
 
 namespace saresgs::fuzz {
 
@@ -13,26 +14,16 @@ namespace fs = std::filesystem;
 
 const Scene& tinyScene() {
   static const Scene scene = [] {
-    Scene s;
+    // The tests' ring scene, whose checkpoints seed the fuzz targets, with images on disk.
+    Scene s = test::ringScene([](int i) { return "view" + std::to_string(i) + ".png"; }, true);
     const std::string dir = scratchPath("tiny_scene/images/x");
     s.source = fs::path(dir).parent_path().parent_path().string();
-    Intrinsics K;
-    K.width = 16;
-    K.height = 12;
-    K.fx = K.fy = 14;
-    K.cx = 8;
-    K.cy = 6;
-    for (int i = 0; i < 6; ++i) {
-      const double a = 2 * M_PI * i / 6;
-      SceneView v;
-      v.name = "view" + std::to_string(i) + ".png";
-      v.camera = Camera::lookAt(K, Eigen::Vector3d(3 * std::cos(a), 3 * std::sin(a), 0.5), Eigen::Vector3d::Zero());
+    for (std::size_t i = 0; i < s.views.size(); ++i) {
+      SceneView& v = s.views[i];
       v.image_path = (fs::path(dir).parent_path() / v.name).string();
-      Image8 img(K.width, K.height, 3);
+      Image8 img(v.camera.K.width, v.camera.K.height, 3);
       for (std::size_t p = 0; p < img.data.size(); ++p) img.data[p] = static_cast<std::uint8_t>((p * 37 + i * 11) % 251);
       writeImage(v.image_path, img);
-      s.views.push_back(v);
-      (i == 0 ? s.test : s.train).push_back(i);
     }
     for (int p = 0; p < 8; ++p) {
       SparsePoint sp;
