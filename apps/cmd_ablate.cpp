@@ -5,7 +5,10 @@
 #include <unistd.h>
 #include <fcntl.h>
 
+#include <chrono>
 #include <cstdio>
+#include <set>
+#include <thread>
 #include <filesystem>
 #include <iostream>
 #include <sstream>
@@ -38,6 +41,7 @@ std::string commandLine(const std::vector<std::string>& args) {
 std::vector<std::string> activeArgs(const AblationJob& j, const std::string& out) {
   std::vector<std::string> a{"active"};
   a.insert(a.end(), j.args.begin(), j.args.end());
+  if (!j.replay_of.empty()) a.insert(a.end(), {"--replay", replaySource(out, j)});
   a.insert(a.end(), {"--out", jobFolder(out, j)});
   return a;
 }
@@ -156,8 +160,32 @@ int runAblate(const AblateArgs& a) {
   }
   fs::create_directories(a.out + "/runs");
   int failed = 0, done = 0;
-  for (std::size_t k = 0; k < jobs.size(); ++k) {
+  // A replay job whose source run is not finished goes to the back of the queue; when only
+  // such jobs are left, the runner waits for another shard to finish their sources.
+  std::vector<std::size_t> queue(jobs.size());
+  for (std::size_t k = 0; k < jobs.size(); ++k) queue[k] = k;
+  std::size_t deferred_in_a_row = 0;
+  std::set<std::string> failed_ids;
+  while (!queue.empty()) {
+    const std::size_t k = queue.front();
+    queue.erase(queue.begin());
     const AblationJob& j = jobs[k];
+    if (!j.replay_of.empty() && !jobFinished(a.out, j) && !fs::exists(replaySource(a.out, j))) {
+      if (failed_ids.count(j.replay_of)) {
+        std::cerr << "[ablate] " << j.id << " failed: the run it replays, " << j.replay_of << ", failed\n";
+        ++failed;
+        continue;
+      }
+      queue.push_back(k);
+      if (++deferred_in_a_row >= queue.size()) {
+        std::cerr << "[ablate] " << queue.size() << " replay jobs wait for their source runs (" << replaySource(a.out, j)
+                  << ", ...): checking again in 30 s\n";
+        std::this_thread::sleep_for(std::chrono::seconds(30));
+        deferred_in_a_row = 0;
+      }
+      continue;
+    }
+    deferred_in_a_row = 0;
     if (jobFinished(a.out, j)) {
       std::cerr << "[ablate] " << k + 1 << "/" << jobs.size() << " " << j.id << ": finished before, skipped\n";
       ++done;
@@ -177,6 +205,7 @@ int runAblate(const AblateArgs& a) {
       ++done;
     } catch (const std::exception& e) {
       std::cerr << "[ablate] " << j.id << " failed: " << e.what() << "\n";
+      failed_ids.insert(j.id);
       ++failed;
     }
   }

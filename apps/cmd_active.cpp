@@ -10,6 +10,7 @@
 #include "apps/prefilter_flags.h"
 #include "apps/progress.h"
 #include "geometry/io/atomic_file.h"
+#include "geometry/io/json_file.h"
 #include "nbv/active_run.h"
 #include "nbv/eval/camera_plot.h"
 #include "nbv/preset.h"
@@ -26,14 +27,15 @@ namespace fs = std::filesystem;
 
 // Options as typed; the preset's values apply where an override is not given.
 struct ActiveArgs {
-  std::string dataset, out, method = "sa-resgs", preset = "quick", fvs_metric = "euclidean", ranking;
+  std::string dataset, out, method = "sa-resgs", preset = "quick", fvs_metric = "euclidean", ranking, replay;
   int downscale = 1, threads = 0;
   bool resume = false, continue_training = false, sub_only = false, time_exhaustive_fisher = false;
   std::uint64_t seed = 0;
   double fisher_lambda = 1e-6;
   std::optional<int> max_views, interval, total, final_iterations, renamed_iterations;
   std::optional<long long> max_gaussians;
-  std::optional<double> beta, prefilter_keep;
+  std::optional<double> beta, prefilter_keep, hybrid_weight;
+  std::string hybrid_fisher = "logdet";
   PrefilterFlags prefilter;
 };
 
@@ -65,6 +67,8 @@ ActiveOptions activeOptions(const ActiveArgs& a) {
   if (a.sub_only) o.trainer.residual.sub_only = true;
   o.prefilter = parsePrefilterFlags(a.prefilter, o.prefilter, "--prefilter-");
   if (a.prefilter_keep) o.prefilter.keep_fraction = *a.prefilter_keep;
+  if (a.hybrid_weight) o.hybrid_weight = *a.hybrid_weight;
+  o.hybrid_criterion = a.hybrid_fisher == "trace" ? FisherCriterion::kTrace : FisherCriterion::kLogDet;
   return o;
 }
 
@@ -75,24 +79,36 @@ void printSummary(const RunReport& r, const std::string& out) {
   std::printf("\n%s run, preset %s, seed %llu, %d iterations in the loop (%s; at least %d asked), %zu views\n", r.method.c_str(),
               r.preset.c_str(), static_cast<unsigned long long>(r.seed), r.iterations, phases.c_str(), r.options.total_iterations,
               r.selected_view_indices.size());
-  std::printf("%-34s %8s %8s %8s %10s %10s %10s\n", "model", "PSNR", "SSIM", "AUSE", "select s", "train s", "total s");
-  std::printf("%-34s %8.2f %8.4f %8s %10.1f %10.1f %10.1f\n", "in the loop (paper's protocol)", r.psnr, r.ssim,
+  std::printf("%-44s %8s %8s %8s %10s %10s %10s\n", "model", "PSNR", "SSIM", "AUSE", "select s", "train s", "total s");
+  std::printf("%-44s %8.2f %8.4f %8s %10.1f %10.1f %10.1f\n", "in the loop (paper's protocol)", r.psnr, r.ssim,
               r.ause ? std::to_string(*r.ause).substr(0, 6).c_str() : "n/a", r.seconds.selection(), r.seconds.training,
               r.end_to_end_seconds);
   if (r.final_fit) {
     char label[64];
-    std::snprintf(label, sizeof label, "final fit on these views (%d it)", r.final_fit->iterations);
-    std::printf("%-34s %8.2f %8.4f\n", label, r.final_fit->psnr, r.final_fit->ssim);
+    std::snprintf(label, sizeof label, "final fit on these views (%d it%s)", r.final_fit->iterations,
+                  r.final_fit->residual ? ", residual" : "");
+    std::printf("%-44s %8.2f %8.4f\n", label, r.final_fit->psnr, r.final_fit->ssim);
+    if (r.final_fit_views && r.final_fit->residual) {
+      std::snprintf(label, sizeof label, "plain refit of these views (%d it)", r.final_fit_views->iterations);
+      std::printf("%-44s %8.2f %8.4f\n", label, r.final_fit_views->psnr, r.final_fit_views->ssim);
+    }
   }
-  std::printf("wrote %s/results.json, cameras.png, test_renders/, point_cloud.ply%s\n", out.c_str(),
-              r.final_fit ? ", final_fit.ply" : "");
+  const bool plain_file = r.final_fit && r.final_fit->residual;
+  std::printf("wrote %s/results.json, cameras.png, test_renders/, point_cloud.ply%s%s\n", out.c_str(),
+              r.final_fit ? ", final_fit.ply" : "", plain_file ? ", final_fit_views.ply" : "");
 }
 
 int runActive(const ActiveArgs& a) {
-  const ActiveOptions opt = activeOptions(a);
+  ActiveOptions opt = activeOptions(a);
   DatasetOptions dopt;
   dopt.load.downscale = a.downscale;
   const Scene scene = loadDataset(a.dataset, dopt);
+  if (!a.replay.empty()) {
+    const RunReport replayed = runReportFromJson(readJsonFile(a.replay), a.replay);
+    opt.replay = replaySequence(scene, replayed, a.replay);
+    std::cerr << "replaying the " << opt.replay.size() << " views of " << a.replay << " (" << replayed.method << ", seed "
+              << replayed.seed << ") in their order\n";
+  }
   fs::create_directories(a.out);
   if (const int n = removeStaleTemporaries(a.out)) std::cerr << "removed " << n << " temporaries left by a killed run\n";
   const std::string ckpt = a.out + "/checkpoint.json";
@@ -113,7 +129,9 @@ int runActive(const ActiveArgs& a) {
   writeGaussiansPly(a.out + "/point_cloud.ply", t.gaussians());
   writeImage(a.out + "/cameras.png", plotCameras(scene, r.initial_views, r.selected_views));
   if (const Trainer* f = run.finalFitTrainer()) writeGaussiansPly(a.out + "/final_fit.ply", f->gaussians());
-  const RunReport report = makeRunReport(scene, opt, r, {a.dataset, a.preset, t.gaussians().size(), rasterThreadCount(opt.trainer.raster.execution)});
+  if (const Trainer* f = run.finalFitViewsTrainer()) writeGaussiansPly(a.out + "/final_fit_views.ply", f->gaussians());
+  const RunReport report =
+      makeRunReport(scene, opt, r, {a.dataset, a.preset, a.replay, t.gaussians().size(), rasterThreadCount(opt.trainer.raster.execution)});
   writeFileAtomic(a.out + "/results.json", toJson(report).dump(2) + "\n");
   printSummary(report, a.out);
   return 0;
@@ -158,7 +176,15 @@ CLI::App* addActiveOptions(CLI::App& app, const std::shared_ptr<ActiveArgs>& a) 
   sub->add_option("--prefilter-lifting", a->prefilter.lifting, "SA-Point lifting: flow (DIS + epipolar refinement) | depth (the trainer's rendered depth) | oracle (the dataset's ground-truth depth maps)")
       ->capture_default_str();
   sub->add_option("--prefilter-keep", a->prefilter_keep, "Fraction kept for Fisher (default 0.2)")->check(CLI::Range(0.0, 1.0));
+  sub->add_option("--hybrid-weight", a->hybrid_weight,
+                  "hybrid: share of the new-surface evidence against Fisher's, in [0, 1] (default 0.5)")
+      ->check(CLI::Range(0.0, 1.0));
+  sub->add_option("--hybrid-fisher", a->hybrid_fisher, "hybrid: Fisher criterion combined, trace | logdet")
+      ->check(CLI::IsMember({"trace", "logdet"}))->capture_default_str();
   sub->add_flag("--time-exhaustive-fisher", a->time_exhaustive_fisher, "Also time Fisher over all candidates");
+  sub->add_option("--replay", a->replay,
+                  "Fixed order: train with this method's training on the views of another run's results.json, in their "
+                  "order, instead of selecting (the paper's ablation)");
   sub->add_option("--downscale", a->downscale, "Image downscale factor")->check(CLI::Range(1, 64))->capture_default_str();
   sub->add_option("--threads", a->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
   sub->add_flag("--resume", a->resume, "Continue the run in OUT from its checkpoint");

@@ -39,14 +39,42 @@ ActiveRun::ActiveRun(const Scene& scene, const ActiveOptions& opt, std::string c
   TrainerOptions to = opt_.trainer;
   to.seed = opt_.seed;
   to.residual.enabled = needs.residual;
+  if (!opt_.replay.empty()) checkReplay();
   trainer_ = std::make_unique<Trainer>(scene_, to);
-  if (needs.coverage) prefilter_ = makeCoveragePrefilter(scene_, opt_.prefilter);
+  // A replay selects nothing, so it needs no prefilter.
+  if (needs.coverage && opt_.replay.empty()) prefilter_ = makeCoveragePrefilter(scene_, opt_.prefilter);
+  if (needs.surface && opt_.replay.empty()) {
+    SurfaceCoverageOptions so;
+    so.grid.resolution = opt_.prefilter.resolution;
+    so.grid.min_points = opt_.prefilter.min_points;
+    so.grid.upsample = opt_.prefilter.upsample;
+    so.stride = opt_.hybrid_stride;
+    surface_ = std::make_unique<SurfaceCoverage>(scene_, so);
+  }
 }
 
-TrainerOptions finalFitOptions(const ActiveOptions& o) {
+// The replayed sequence must be one this run could have held: distinct train views, at
+// least the initial ones and as many as the run will hold.
+void ActiveRun::checkReplay() const {
+  const std::vector<int>& r = opt_.replay;
+  const int n_initial = std::min<int>(opt_.initial_views, static_cast<int>(scene_.train.size()));
+  const int held = std::min<int>(std::max(opt_.max_views, n_initial), static_cast<int>(scene_.train.size()));
+  if (static_cast<int>(r.size()) < held)
+    throw std::invalid_argument("replay: the replayed sequence holds " + std::to_string(r.size()) + " views, this run holds " +
+                                std::to_string(held) + " (--max-views " + std::to_string(opt_.max_views) + ")");
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    if (std::find(scene_.train.begin(), scene_.train.end(), r[i]) == scene_.train.end())
+      throw std::invalid_argument("replay: view index " + std::to_string(r[i]) + " is not a train view of this dataset");
+    if (std::find(r.begin(), r.begin() + static_cast<long>(i), r[i]) != r.begin() + static_cast<long>(i))
+      throw std::invalid_argument("replay: view index " + std::to_string(r[i]) + " appears twice");
+  }
+}
+
+TrainerOptions finalFitOptions(const ActiveOptions& o, bool method_training) {
   TrainerOptions t = o.final_trainer;
   t.seed = o.seed;
-  t.residual.enabled = false;
+  t.residual = o.trainer.residual;
+  t.residual.enabled = method_training && needsOf(o.method).residual;
   return t;
 }
 
@@ -59,6 +87,7 @@ const char* toString(ActivePhase p) {
     case ActivePhase::kExhaustiveFisher: return "exhaustive Fisher";
     case ActivePhase::kFinalEvaluation: return "final evaluation";
     case ActivePhase::kFinalFit: return "final fit";
+    case ActivePhase::kFinalFitViews: return "plain refit";
   }
   return "?";
 }
@@ -76,6 +105,12 @@ int ActiveRun::selectNext(SelectionLog& log) {
   for (int v : scene_.train)
     if (std::find(selected_.begin(), selected_.end(), v) == selected_.end()) candidates.push_back(v);
   log.views_before = static_cast<int>(selected_.size());
+  if (!opt_.replay.empty()) {
+    // Fixed order: the next view of the replayed sequence (checkReplay made it a candidate).
+    const int next = opt_.replay.at(selected_.size());
+    log.candidates = {next};
+    return next;
+  }
   const MethodNeeds needs = needsOf(opt_.method);
   std::vector<int> pool = candidates;
   if (needs.coverage) {
@@ -119,9 +154,22 @@ int ActiveRun::selectNext(SelectionLog& log) {
   const RasterSettings s = trainer_->rasterSettings();
   auto t0 = Clock::now();
   log.candidates = pool;
+  const FisherCriterion criterion = opt_.method == Method::kFisherLogDet ? FisherCriterion::kLogDet
+                                    : opt_.method == Method::kHybrid     ? opt_.hybrid_criterion
+                                                                         : FisherCriterion::kTrace;
   log.scores = fisherScores(trainer_->gaussians(), s, scene_, selected_, pool, opt_.fisher_lambda,
-                            [this](int done, int total) { report(ActivePhase::kFisher, done, total); });
+                            [this](int done, int total) { report(ActivePhase::kFisher, done, total); }, criterion);
   log.seconds.fisher += since(t0);
+  if (needs.surface) {
+    // What the held views see is known from the poses: observing all of them again is a
+    // union (cached sets), so a resumed run needs no saved state.
+    t0 = Clock::now();
+    surface_->observe(selected_);
+    log.fisher_scores = log.scores;
+    log.new_surface = surface_->newSurface(pool);
+    log.scores = hybridScores(log.fisher_scores, log.new_surface, opt_.hybrid_weight);
+    log.seconds.coverage += since(t0);
+  }
   if (needs.coverage && opt_.time_exhaustive_fisher) {
     t0 = Clock::now();
     (void)fisherScores(trainer_->gaussians(), s, scene_, selected_, candidates, opt_.fisher_lambda,
@@ -140,6 +188,7 @@ ActiveResult ActiveRun::run(const std::function<void(const ActiveProgress&)>& pr
     std::vector<Eigen::Vector3d> centers;
     for (int v : scene_.train) centers.push_back(scene_.views[static_cast<std::size_t>(v)].camera.center());
     for (int i : farthestPointSampling(centers, opt_.initial_views, 0)) initial_.push_back(scene_.train[static_cast<std::size_t>(i)]);
+    if (!opt_.replay.empty()) initial_.assign(opt_.replay.begin(), opt_.replay.begin() + static_cast<long>(initial_.size()));
     selected_ = initial_;
   }
   std::vector<int> progress_views;
@@ -202,13 +251,29 @@ ActiveResult ActiveRun::run(const std::function<void(const ActiveProgress&)>& pr
   r.ause = depthAuse(*trainer_, selected_, scene_.test.empty() ? scene_.train : scene_.test, opt_.fisher_lambda);
   report(ActivePhase::kFinalEvaluation, 1, 1);
   if (opt_.final_iterations > 0) {
-    final_fit_ = std::make_unique<Trainer>(scene_, finalFitOptions(opt_));
+    // The method's own training first, then (for methods that train otherwise than plain
+    // 3DGS) the plain refit of the same views.
     last_.views = static_cast<int>(selected_.size());
-    final_fit_->train(selected_, opt_.final_iterations, [&](const TrainProgress& p) {
-      last_.loss = p.loss_ema;
-      report(ActivePhase::kFinalFit, p.done, opt_.final_iterations);
-    });
-    r.final_fit = FinalFit{opt_.final_iterations, final_fit_->evaluate(scene_.test.empty() ? scene_.train : scene_.test)};
+    auto fit = [&](bool method_training, ActivePhase phase) {
+      const TrainerOptions to = finalFitOptions(opt_, method_training);
+      auto t = std::make_unique<Trainer>(scene_, to);
+      t->train(selected_, opt_.final_iterations, [&](const TrainProgress& p) {
+        last_.loss = p.loss_ema;
+        report(phase, p.done, opt_.final_iterations);
+      });
+      FinalFit f{opt_.final_iterations, to.residual.enabled, t->evaluate(scene_.test.empty() ? scene_.train : scene_.test)};
+      return std::make_pair(std::move(t), f);
+    };
+    auto [model, f] = fit(true, ActivePhase::kFinalFit);
+    final_fit_ = std::move(model);
+    r.final_fit = f;
+    if (f.residual) {
+      auto [plain, g] = fit(false, ActivePhase::kFinalFitViews);
+      final_fit_views_ = std::move(plain);
+      r.final_fit_views = g;
+    } else {
+      r.final_fit_views = f;
+    }
   }
   r.seconds = since(start);
   progress_ = {};

@@ -18,6 +18,7 @@
 #include "nbv/method.h"
 #include "nbv/selection_seconds.h"
 #include "nbv/selectors.h"
+#include "nbv/surface_coverage.h"
 #include "splat/train/trainer.h"
 
 namespace saresgs {
@@ -38,16 +39,29 @@ struct ActiveOptions {
   double fisher_lambda = 1e-6;
   ViewDistance fvs_metric = ViewDistance::kEuclidean;
   PrefilterConfig prefilter;
+  // hybrid: the share w of the new-surface evidence against Fisher's (hybridScores), the
+  // Fisher criterion it combines, and the surface grid (its resolution and points per
+  // voxel are the prefilter's).
+  double hybrid_weight = 0.5;
+  FisherCriterion hybrid_criterion = FisherCriterion::kLogDet;
+  int hybrid_stride = 4;
   bool time_exhaustive_fisher = false;  // prefiltered methods: also time Fisher on all
   int progress_test_views = 3;
   // After the last view: a fresh model from the initial state trained on exactly the
   // chosen views for this many iterations (0: none), so that the views can be judged
-  // apart from the loop's schedule. Plain 3DGS for every method (finalFitOptions).
+  // apart from the loop's schedule. It trains with the method's own training (residual
+  // supervision for the methods that have it, finalFitOptions); for those methods a
+  // second, plain 3DGS fit of the same views (ActiveResult::final_fit_views) judges the
+  // selection apart from the training.
   int final_iterations = 0;
   // Its trainer options: 3DGS's own schedule (a fit of a few thousand iterations on 20
   // views is 3DGS's first iterations, not a quarter-speed loop phase), with the preset's
   // model cap and SH degree; residual supervision and the seed are set by finalFitOptions.
   TrainerOptions final_trainer;
+  // Fixed-order replay (the paper's ablation ‡): when not empty, the views to hold, in
+  // order (the initial ones first, as many as initial_views): the run trains with its own
+  // method's training on this sequence instead of selecting (replaySequence, nbv/run_report.h).
+  std::vector<int> replay;
   TrainerOptions trainer;
   std::uint64_t seed = 0;
 };
@@ -60,10 +74,11 @@ struct SelectionLog {
   std::vector<int> prefiltered;     // coverage methods: the kept top N %
   SelectionSeconds seconds;
   double progress_psnr = 0;         // on the progress test views, before selection
+  std::vector<double> fisher_scores, new_surface;  // hybrid: its two kinds of evidence
 };
 
 // What an active run is doing; selection stages report per view or candidate handled.
-enum class ActivePhase { kTraining, kLifting, kPrefilter, kFisher, kExhaustiveFisher, kFinalEvaluation, kFinalFit };
+enum class ActivePhase { kTraining, kLifting, kPrefilter, kFisher, kExhaustiveFisher, kFinalEvaluation, kFinalFit, kFinalFitViews };
 const char* toString(ActivePhase p);  // "training", "lifting", ...
 
 struct ActiveProgress {
@@ -78,6 +93,7 @@ struct ActiveProgress {
 // The final fit's outcome (ActiveOptions::final_iterations).
 struct FinalFit {
   int iterations = 0;
+  bool residual = false;  // trained with residual supervision
   Evaluation test;
 };
 
@@ -86,17 +102,20 @@ struct ActiveResult {
   std::vector<SelectionLog> steps;
   Evaluation test;
   std::optional<double> ause;
-  std::optional<FinalFit> final_fit;
+  std::optional<FinalFit> final_fit;         // the method's own training on the chosen views
+  std::optional<FinalFit> final_fit_views;   // plain 3DGS on the same views (a copy of
+                                             // final_fit when the method trains plainly)
   SelectionSeconds total_seconds;
   int iterations = 0;  // training iterations over the whole run
   std::vector<int> phase_iterations;  // per phase: k x interval for k views held, then the last
   double seconds = 0;  // end to end, this process
 };
 
-// The trainer options of the final fit: final_trainer with the run's seed and without
-// residual supervision, the same for every method; `saresgs train` with these options on
-// the chosen views trains the same model.
-TrainerOptions finalFitOptions(const ActiveOptions& o);
+// The trainer options of the final fit: final_trainer with the run's seed and, when
+// `method_training` and the method trains with residual supervision, the loop's residual
+// options (otherwise none). `saresgs train` with these options on the chosen views
+// (`--residual` and its options for the method's training) trains the same model.
+TrainerOptions finalFitOptions(const ActiveOptions& o, bool method_training = true);
 
 class ActiveRun {
  public:
@@ -106,9 +125,12 @@ class ActiveRun {
   const Trainer& trainer() const { return *trainer_; }
   // The final fit's model (null before run() or without a final fit).
   const Trainer* finalFitTrainer() const { return final_fit_.get(); }
+  // The plain refit's model, when it differs from the final fit (residual methods).
+  const Trainer* finalFitViewsTrainer() const { return final_fit_views_.get(); }
 
  private:
   int selectNext(SelectionLog& log);
+  void checkReplay() const;
   // Passes the latest state, in `phase` at done/total, to the caller's progress callback.
   void report(ActivePhase phase, int done, int total);
   void saveCheckpoint() const;
@@ -120,7 +142,8 @@ class ActiveRun {
   std::string checkpoint_;
   std::unique_ptr<Trainer> trainer_;
   std::unique_ptr<CoveragePrefilter> prefilter_;
-  std::unique_ptr<Trainer> final_fit_;
+  std::unique_ptr<SurfaceCoverage> surface_;
+  std::unique_ptr<Trainer> final_fit_, final_fit_views_;
   std::mt19937_64 rng_;
   std::vector<int> initial_, selected_;
   std::vector<SelectionLog> steps_;

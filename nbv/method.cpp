@@ -9,7 +9,7 @@ namespace {
 struct MethodRow {
   Method method;
   const char* name;
-  MethodNeeds needs;  // fisher, coverage, residual
+  MethodNeeds needs;  // fisher, coverage, residual, surface
 };
 
 // The list of methods (see method.h).
@@ -21,6 +21,10 @@ constexpr MethodRow kMethodTable[] = {
     {Method::kSaHash, "sa-hash", {true, true, false}},
     {Method::kSaResgs, "sa-resgs", {true, true, true}},
     {Method::kResgs, "resgs", {true, false, true}},
+    // D-optimal Fisher: the log-det gain instead of the trace (selectors.h).
+    {Method::kFisherLogDet, "fisher-logdet", {true, false, false}},
+    // Fisher information and occlusion-aware coverage of unobserved surface (selectors.h).
+    {Method::kHybrid, "hybrid", {true, false, false, true}},
 };
 
 const MethodRow& rowOf(Method m) {

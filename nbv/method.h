@@ -8,13 +8,14 @@
 
 namespace saresgs {
 
-enum class Method { kRandom, kFvs, kFisher, kCoverage, kSaHash, kSaResgs, kResgs };
+enum class Method { kRandom, kFvs, kFisher, kCoverage, kSaHash, kSaResgs, kResgs, kFisherLogDet, kHybrid };
 
 // What a method computes; everything else is left out of its run.
 struct MethodNeeds {
   bool fisher = false;    // renders and squared gradients of candidates
   bool coverage = false;  // SA-Points, occupancy grids, prefilter
   bool residual = false;  // residual supervision in training
+  bool surface = false;   // Embree-visible coverage of SfM surface (nbv/surface_coverage.h)
 };
 
 // Every method, in the table's order.

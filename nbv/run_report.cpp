@@ -94,12 +94,14 @@ RunReport makeRunReport(const Scene& scene, const ActiveOptions& opt, const Acti
   for (const ViewMetrics& m : r.test.views)
     rep.views.push_back({scene.views.at(static_cast<std::size_t>(m.view)).name, m.psnr, m.ssim});
   for (const SelectionLog& s : r.steps) rep.steps.push_back(stepReport(scene, s));
-  if (r.final_fit) {
-    FinalFitReport f{r.final_fit->iterations, r.final_fit->test.psnr, r.final_fit->test.ssim, {}};
-    for (const ViewMetrics& m : r.final_fit->test.views)
-      f.views.push_back({scene.views.at(static_cast<std::size_t>(m.view)).name, m.psnr, m.ssim});
-    rep.final_fit = f;
-  }
+  auto fitReport = [&](const FinalFit& x) {
+    FinalFitReport f{x.iterations, x.residual, x.test.psnr, x.test.ssim, {}};
+    for (const ViewMetrics& m : x.test.views) f.views.push_back({scene.views.at(static_cast<std::size_t>(m.view)).name, m.psnr, m.ssim});
+    return f;
+  };
+  if (r.final_fit) rep.final_fit = fitReport(*r.final_fit);
+  if (r.final_fit_views) rep.final_fit_views = fitReport(*r.final_fit_views);
+  rep.replay_of = c.replay_of;
   return rep;
 }
 
@@ -110,6 +112,8 @@ json toJson(const StepReport& s) {
     e["candidates"] = s.candidates;
     e["scores"] = s.scores;
     if (!s.prefiltered.empty()) e["prefiltered"] = s.prefiltered;
+    if (!s.fisher_scores.empty()) e["fisher_scores"] = s.fisher_scores;
+    if (!s.new_surface.empty()) e["new_surface"] = s.new_surface;
   }
   return e;
 }
@@ -124,6 +128,8 @@ StepReport stepReportFromJson(const json& j, const std::string& source, const st
     s.candidates = field<std::vector<std::string>>(j, "candidates", source, path);
     s.scores = field<std::vector<double>>(j, "scores", source, path);
     if (j.contains("prefiltered")) s.prefiltered = field<std::vector<std::string>>(j, "prefiltered", source, path);
+    if (j.contains("fisher_scores")) s.fisher_scores = field<std::vector<double>>(j, "fisher_scores", source, path);
+    if (j.contains("new_surface")) s.new_surface = field<std::vector<double>>(j, "new_surface", source, path);
   }
   return s;
 }
@@ -163,11 +169,14 @@ json toJson(const RunReport& r) {
   j["threads"] = r.threads;
   for (const ViewReport& v : r.views) j["views"].push_back({{"name", v.name}, {"psnr", v.psnr}, {"ssim", v.ssim}});
   for (const StepReport& s : r.steps) j["steps"].push_back(toJson(s));
-  if (r.final_fit) {
-    json f = {{"iterations", r.final_fit->iterations}, {"psnr", r.final_fit->psnr}, {"ssim", r.final_fit->ssim}};
-    for (const ViewReport& v : r.final_fit->views) f["views"].push_back({{"name", v.name}, {"psnr", v.psnr}, {"ssim", v.ssim}});
-    j["final_fit"] = f;
-  }
+  auto fitJson = [](const FinalFitReport& x) {
+    json f = {{"iterations", x.iterations}, {"residual", x.residual}, {"psnr", x.psnr}, {"ssim", x.ssim}};
+    for (const ViewReport& v : x.views) f["views"].push_back({{"name", v.name}, {"psnr", v.psnr}, {"ssim", v.ssim}});
+    return f;
+  };
+  if (r.final_fit) j["final_fit"] = fitJson(*r.final_fit);
+  if (r.final_fit_views) j["final_fit_views"] = fitJson(*r.final_fit_views);
+  if (!r.replay_of.empty()) j["replay_of"] = r.replay_of;
   return j;
 }
 
@@ -210,15 +219,20 @@ RunReport runReportFromJson(const json& j, const std::string& src) {
   readViews(j, src, "views", r.views);
   const json& steps = jsonArray(jsonMember(j, "steps", src, ""), src, "steps");
   for (std::size_t i = 0; i < steps.size(); ++i) r.steps.push_back(stepReportFromJson(steps[i], src, jsonPath("steps", i)));
-  if (j.contains("final_fit")) {
-    const json& f = j["final_fit"];
+  auto readFit = [&](const char* name) {
+    const json& f = j[name];
     FinalFitReport ff;
-    ff.iterations = field<int>(f, "iterations", src, "final_fit");
-    ff.psnr = field<double>(f, "psnr", src, "final_fit");
-    ff.ssim = field<double>(f, "ssim", src, "final_fit");
-    r.final_fit = ff;
-    readViews(f, src, "final_fit.views", r.final_fit->views);
-  }
+    ff.iterations = field<int>(f, "iterations", src, name);
+    if (f.contains("residual")) ff.residual = field<bool>(f, "residual", src, name);
+    ff.psnr = field<double>(f, "psnr", src, name);
+    ff.ssim = field<double>(f, "ssim", src, name);
+    readViews(f, src, std::string(name) + ".views", ff.views);
+    return ff;
+  };
+  if (j.contains("final_fit")) r.final_fit = readFit("final_fit");
+  if (j.contains("final_fit_views")) r.final_fit_views = readFit("final_fit_views");
+  else if (r.final_fit && !r.final_fit->residual) r.final_fit_views = r.final_fit;  // written before it was recorded
+  if (j.contains("replay_of")) r.replay_of = field<std::string>(j, "replay_of", src, "");
   return r;
 }
 
@@ -232,6 +246,8 @@ StepReport stepReport(const Scene& scene, const SelectionLog& log) {
     s.candidates = names(scene, log.candidates);
     s.scores = log.scores;
     s.prefiltered = names(scene, log.prefiltered);
+    s.fisher_scores = log.fisher_scores;
+    s.new_surface = log.new_surface;
   }
   return s;
 }
@@ -257,7 +273,30 @@ SelectionLog selectionLog(const Scene& scene, const StepReport& step, const std:
   l.candidates = indices(step.candidates);
   l.scores = step.scores;
   l.prefiltered = indices(step.prefiltered);
+  l.fisher_scores = step.fisher_scores;
+  l.new_surface = step.new_surface;
   return l;
+}
+
+}  // namespace saresgs
+
+namespace saresgs {
+
+std::vector<int> replaySequence(const Scene& scene, const RunReport& r, const std::string& source) {
+  std::map<std::string, int> by_name;
+  for (int v : scene.train) by_name.emplace(scene.views.at(static_cast<std::size_t>(v)).name, v);
+  std::vector<int> seq;
+  auto add = [&](const std::vector<std::string>& names, const char* field) {
+    for (const std::string& n : names) {
+      auto it = by_name.find(n);
+      if (it == by_name.end())
+        throw InputError(source, field, "'" + n + "' is not a train view of this dataset (a run of another dataset?)");
+      seq.push_back(it->second);
+    }
+  };
+  add(r.initial_views, "initial_views");
+  add(r.selected_views, "selected_views");
+  return seq;
 }
 
 }  // namespace saresgs

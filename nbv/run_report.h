@@ -25,6 +25,7 @@ struct StepReport {
   std::vector<std::string> candidates;   // what the final scorer saw
   std::vector<double> scores;            // their scores
   std::vector<std::string> prefiltered;  // coverage methods: the kept top N %
+  std::vector<double> fisher_scores, new_surface;  // hybrid: its two kinds of evidence
 };
 
 // The options that shaped the run, as the tables name them.
@@ -46,9 +47,12 @@ struct ViewReport {
   double psnr = 0, ssim = 0;
 };
 
-// The final fit: a fresh plain-3DGS model trained on exactly the chosen views.
+// A final fit: a fresh model trained on exactly the chosen views, with residual
+// supervision or plain 3DGS (`residual`; absent in reports written before it was
+// recorded, when every final fit was plain).
 struct FinalFitReport {
   int iterations = 0;
+  bool residual = false;
   double psnr = 0, ssim = 0;
   std::vector<ViewReport> views;
 };
@@ -72,12 +76,19 @@ struct RunReport {
   int threads = 0;
   std::vector<ViewReport> views;  // per test view
   std::vector<StepReport> steps;
-  std::optional<FinalFitReport> final_fit;  // none when the run made no final fit
+  std::optional<FinalFitReport> final_fit;  // the method's own training; none without a final fit
+  // Plain 3DGS on the same views, so that selection is judged apart from training: for a
+  // method that trains plainly the same numbers as final_fit. A report written before it
+  // was recorded gets final_fit here when that fit was plain.
+  std::optional<FinalFitReport> final_fit_views;
+  // A fixed-order replay: the results file whose view sequence this run trained on.
+  std::string replay_of;
 };
 
 // Where and how the run was made, which the loop itself does not know.
 struct RunContext {
   std::string dataset, preset;
+  std::string replay_of;  // the replayed results file, if any
   std::size_t gaussians = 0;
   int threads = 0;
 };
@@ -94,6 +105,11 @@ StepReport stepReportFromJson(const nlohmann::json& j, const std::string& source
 // The loop's step record with views named, and back (names are looked up among the train
 // views; an unknown name throws InputError naming `source`).
 StepReport stepReport(const Scene& scene, const SelectionLog& log);
+
+// The views a run held, in order (initial first), as indices into `scene`: what a fixed-order
+// replay (ActiveOptions::replay) trains on. InputError names `source` and the field when a
+// view is not a train view of `scene`.
+std::vector<int> replaySequence(const Scene& scene, const RunReport& r, const std::string& source);
 SelectionLog selectionLog(const Scene& scene, const StepReport& step, const std::string& source);
 
 }  // namespace saresgs

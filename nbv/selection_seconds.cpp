@@ -13,12 +13,14 @@ SelectionSeconds& SelectionSeconds::operator+=(const SelectionSeconds& o) {
   fisher += o.fisher;
   training += o.training;
   exhaustive_fisher += o.exhaustive_fisher;
+  coverage += o.coverage;
   return *this;
 }
 
 nlohmann::json toJson(const SelectionSeconds& s) {
   return {{"lifting", s.lifting},   {"triangulation", s.triangulation}, {"prefilter", s.prefilter},
-          {"fisher", s.fisher},     {"training", s.training},           {"exhaustive_fisher", s.exhaustive_fisher}};
+          {"fisher", s.fisher},     {"training", s.training},           {"exhaustive_fisher", s.exhaustive_fisher},
+          {"coverage", s.coverage}};
 }
 
 SelectionSeconds secondsFrom(const nlohmann::json& j, const std::string& file, const std::string& field) {
@@ -32,6 +34,7 @@ SelectionSeconds secondsFrom(const nlohmann::json& j, const std::string& file, c
   s.fisher = stage("fisher");
   s.training = stage("training");
   s.exhaustive_fisher = stage("exhaustive_fisher");
+  if (j.is_object() && j.contains("coverage")) s.coverage = stage("coverage");
   return s;
 }
 

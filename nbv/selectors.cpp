@@ -5,6 +5,7 @@
 #include <limits>
 #include <numeric>
 #include <stdexcept>
+#include <string>
 
 #include "splat/fisher.h"
 
@@ -40,7 +41,7 @@ std::vector<double> farthestViewScores(const Scene& scene, const std::vector<int
 
 std::vector<double> fisherScores(const Gaussians& g, const RasterSettings& s, const Scene& scene,
                                  const std::vector<int>& chosen, const std::vector<int>& candidates,
-                                 double lambda, const std::function<void(int, int)>& tick) {
+                                 double lambda, const std::function<void(int, int)>& tick, FisherCriterion criterion) {
   Gaussians H = g.zerosLike();
   for (int v : chosen) addViewInformation(g, scene.views.at(v).camera, s, H);
   Gaussians Hv = g.zerosLike();
@@ -51,9 +52,28 @@ std::vector<double> fisherScores(const Gaussians& g, const RasterSettings& s, co
     if (tick) tick(static_cast<int>(out.size()), total);
     clearInformation(Hv);
     addViewInformation(g, scene.views.at(c).camera, s, Hv);
-    out.push_back(fisherScore(Hv, H, lambda));
+    out.push_back(criterion == FisherCriterion::kTrace ? fisherScore(Hv, H, lambda) : fisherLogDetScore(Hv, H, lambda));
   }
   if (tick) tick(total, total);
+  return out;
+}
+
+std::vector<double> hybridScores(const std::vector<double>& fisher, const std::vector<double>& new_surface, double w) {
+  if (fisher.size() != new_surface.size()) throw std::invalid_argument("hybridScores: the score lists differ in size");
+  if (!(w >= 0 && w <= 1)) throw std::invalid_argument("hybridScores: weight " + std::to_string(w) + " outside [0, 1]");
+  auto scale = [](const std::vector<double>& v) {
+    double m = 0;
+    for (double x : v)
+      if (std::isfinite(x)) m = std::max(m, x);
+    return m > 0 ? 1.0 / m : 0.0;
+  };
+  const double sf = scale(fisher), sn = scale(new_surface);
+  std::vector<double> out(fisher.size());
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const double f = std::isfinite(fisher[i]) ? fisher[i] * sf : 0.0;
+    const double n = std::isfinite(new_surface[i]) ? new_surface[i] * sn : 0.0;
+    out[i] = (1 - w) * f + w * n;
+  }
   return out;
 }
 

@@ -25,12 +25,25 @@ std::vector<double> farthestViewScores(const Scene& scene, const std::vector<int
                                        const std::vector<int>& candidates, ViewDistance metric,
                                        const Eigen::Vector3d& center);
 
-// FisherRF: H_train from `chosen`, then each candidate's sum H_v / (H_train + lambda).
+// How a candidate's information is scored against H_train (splat/fisher.h): FisherRF's
+// trace, sum H_v / (H_train + lambda), or the D-optimal log-det gain,
+// sum log(1 + H_v / (H_train + lambda)).
+enum class FisherCriterion { kTrace, kLogDet };
+
+// FisherRF: H_train from `chosen`, then each candidate's score by `criterion`.
 // Candidates are streamed through one information buffer: memory does not grow with
 // their number. `tick(done, total)` is called before each candidate (and at the end).
 std::vector<double> fisherScores(const Gaussians& g, const RasterSettings& s, const Scene& scene,
                                  const std::vector<int>& chosen, const std::vector<int>& candidates,
-                                 double lambda = 1e-6, const std::function<void(int, int)>& tick = {});
+                                 double lambda = 1e-6, const std::function<void(int, int)>& tick = {},
+                                 FisherCriterion criterion = FisherCriterion::kTrace);
+
+// The hybrid score of two kinds of evidence: (1 - w) F / max F + w N / max N over the
+// candidates, F the Fisher scores and N the new-surface counts (a term whose maximum is
+// not positive, or not finite, contributes 0). Scale-free in both, so w is the share of
+// the decision each kind of evidence gets. Throws std::invalid_argument on mismatched
+// sizes or w outside [0, 1].
+std::vector<double> hybridScores(const std::vector<double>& fisher, const std::vector<double>& new_surface, double w);
 
 // Index (into candidates) of the highest score; ties to the lowest view index.
 std::size_t argmaxScore(const std::vector<double>& scores, const std::vector<int>& candidates);

@@ -8,6 +8,7 @@
 // templated on the scalar (splat/fisher_detail.h), so that the tests can run the same
 // code in double against finite differences.
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <vector>
 
@@ -28,6 +29,26 @@ double fisherScore(const GaussiansT<T>& Hv, const GaussiansT<T>& Htrain, double 
   auto add = [&](const std::vector<T>& v, const std::vector<T>& t) {
     for (std::size_t k = 0; k < v.size(); ++k)
       if (v[k] != T(0)) score += static_cast<double>(v[k]) / (static_cast<double>(t[k]) + lambda);
+  };
+  add(Hv.means, Htrain.means);
+  add(Hv.log_scales, Htrain.log_scales);
+  add(Hv.opacities, Htrain.opacities);
+  add(Hv.sh, Htrain.sh);
+  return score;
+}
+
+// The D-optimal (log-det) gain of adding view v under the diagonal approximation:
+// log det(H_train + H_v + lambda) - log det(H_train + lambda) = sum_p log(1 + H_v[p] /
+// (H_train[p] + lambda)). Unlike the trace, a parameter's contribution grows only
+// logarithmically with the information a view adds to it, so a view that piles
+// information on a few parameters scores below one that adds some to many (views that
+// repeat what the chosen ones already tell score low in both). Double, fixed order.
+template <typename T>
+double fisherLogDetScore(const GaussiansT<T>& Hv, const GaussiansT<T>& Htrain, double lambda) {
+  double score = 0;
+  auto add = [&](const std::vector<T>& v, const std::vector<T>& t) {
+    for (std::size_t k = 0; k < v.size(); ++k)
+      if (v[k] != T(0)) score += std::log1p(static_cast<double>(v[k]) / (static_cast<double>(t[k]) + lambda));
   };
   add(Hv.means, Htrain.means);
   add(Hv.log_scales, Htrain.log_scales);

@@ -123,12 +123,17 @@ std::vector<AblationScene> readScenes(const nlohmann::json& j, const std::string
 std::vector<AblationVariant> readVariants(const nlohmann::json& j, const std::string& path) {
   std::vector<AblationVariant> variants;
   std::set<std::string> names;
-  forEachNamedObject(j, path, "variants", "{name, methods?, args?}", [&](const nlohmann::json& v, const std::string& f) {
+  forEachNamedObject(j, path, "variants", "{name, methods?, args?, replay?}", [&](const nlohmann::json& v, const std::string& f) {
     AblationVariant var;
     var.name = uniqueName(v, names, path, f);
     if (v.contains("methods")) var.methods = jsonStrings(v["methods"], path, f + ".methods");
     for (const auto& m : var.methods) checkMethod(m, path, f + ".methods");
     if (v.contains("args")) var.args = jsonStrings(v["args"], path, f + ".args");
+    if (v.contains("replay")) {
+      var.replay = jsonString(v["replay"], path, f + ".replay");
+      checkMethod(var.replay, path, f + ".replay");
+      if (var.name == "default") throw InputError(path, f + ".replay", "the default variant is what replays read: it cannot replay");
+    }
     variants.push_back(var);
   });
   return variants;
@@ -259,10 +264,21 @@ std::vector<AblationJob> expandGrid(const AblationGrid& g) {
           if (g.threads > 0) j.args.insert(j.args.end(), {"--threads", std::to_string(g.threads)});
           if (auto it = g.method_args.find(m); it != g.method_args.end()) j.args.insert(j.args.end(), it->second.begin(), it->second.end());
           j.args.insert(j.args.end(), v.args.begin(), v.args.end());
+          if (!v.replay.empty()) j.replay_of = sc.name + "__" + v.replay + "__default__s" + std::to_string(seed);
           jobs.push_back(j);
         }
       }
+  // A replay's source is a default-variant job of the same grid.
+  for (const AblationJob& j : jobs)
+    if (!j.replay_of.empty() &&
+        std::none_of(jobs.begin(), jobs.end(), [&](const AblationJob& s) { return s.id == j.replay_of; }))
+      throw InputError(g.source, "variants", "job " + j.id + " replays " + j.replay_of +
+                                                 ", which the grid does not run (the replayed method needs the default variant)");
   return jobs;
+}
+
+std::string replaySource(const std::string& out, const AblationJob& j) {
+  return j.replay_of.empty() ? std::string() : out + "/runs/" + j.replay_of + "/results.json";
 }
 
 std::pair<int, int> parseShard(const std::string& text) {

@@ -14,13 +14,17 @@
 //     "seeds": [0, 1],
 //     "method_args": {"sa-hash": ["--time-exhaustive-fisher"]},            (optional)
 //     "variants": [{"name": "beta0.05", "methods": ["sa-resgs"],             (optional)
-//                   "args": ["--residual-beta", "0.05"]}],
+//                   "args": ["--residual-beta", "0.05"]},
+//                  {"name": "replay-fisher", "methods": ["resgs"], "replay": "fisher"}],
 //     "tables": [{"name": "components", "title": "...", "methods": [...],  (optional)
 //                 "variants": [...]}],
 //     "sweep": {"scenes": ["room360"], "views": [4, 8, 12], "lifting": "flow"} (optional)
 //   }
 // A scene with a "layout" is generated with `saresgs scene` when its dataset is missing.
-// Without "variants" every method runs once as variant "default".
+// Without "variants" every method runs once as variant "default". A variant with "replay"
+// trains its methods on the view sequence of the replayed method's default run of the
+// same scene and seed (`saresgs active --replay`, the paper's fixed-order ablation); the
+// runner starts such a job once that run is finished.
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
@@ -43,6 +47,7 @@ struct AblationVariant {
   std::string name = "default";
   std::vector<std::string> methods;  // empty: every method
   std::vector<std::string> args;     // extra `saresgs active` arguments
+  std::string replay;                // a method whose default run's views are replayed
 };
 
 struct AblationTableSpec {
@@ -73,7 +78,8 @@ struct AblationJob {
   std::string id;  // folder name under OUT/runs
   std::string scene, method, variant;
   std::uint64_t seed = 0;
-  std::vector<std::string> args;  // `saresgs active` arguments, --out excluded
+  std::vector<std::string> args;  // `saresgs active` arguments, --out and --replay excluded
+  std::string replay_of;          // the id of the job whose views this one replays
 };
 
 // Every job of the grid in a fixed order (sweeps first, then scene, method, variant, seed).
@@ -91,6 +97,8 @@ std::string runLabel(const std::string& method, const std::string& variant);
 std::string jobFolder(const std::string& out, const AblationJob& j);          // OUT/runs/<id>
 std::string jobResultFile(const std::string& out, const AblationJob& j);      // results.json or sweep.json
 bool jobFinished(const std::string& out, const AblationJob& j);
+// The results file a replay job replays (empty for other jobs).
+std::string replaySource(const std::string& out, const AblationJob& j);
 
 // A finished job's result: the run report of an active job, the sweep report of a sweep.
 struct JobResult {
@@ -120,8 +128,9 @@ Table psnrVsViewsTable(const AblationGrid& g, const std::vector<JobResult>& resu
 Table timeTable(const AblationGrid& g, const std::vector<JobResult>& results);
 Table finalFitPerViewTable(const AblationGrid& g, const std::vector<JobResult>& results);
 Table sweepTable(const std::vector<JobResult>& results);
-// Paired differences (nbv/eval/paired_stats.h) of every method against random and against
-// fisher (those in the grid), per scene, for the final-fit PSNR and the in-loop PSNR:
+// Paired differences (nbv/eval/paired_stats.h) of every method against random, fisher and
+// fvs (those in the grid), per scene, for the final-fit PSNR (the method's training), the
+// plain refit's PSNR (selection alone) and the in-loop PSNR:
 // columns scene, method, baseline, metric, mean_diff, ci_low, ci_high, n, win_rate; an
 // interval over a single seed is "undefined".
 Table pairedTable(const AblationGrid& g, const std::vector<JobResult>& results);

@@ -148,31 +148,52 @@ TEST(Cli, ActiveAcceptsEveryMethodOfTheList) {
   EXPECT_NE(help.output.find(saresgs::methodChoices()), std::string::npos) << help.output;
 }
 
-// The final fit judges the chosen views apart from the loop's schedule: it is plain 3DGS
-// from the initial model on exactly those views, so `saresgs train` on the same views with
-// the final fit's options (quick preset: 3DGS's schedule, the cap, SH degree 0, the seed)
-// gives the same model, byte for byte, and the same test PSNR.
+// The final fit judges the chosen views apart from the loop's schedule: it is the method's
+// own training from the initial model on exactly those views (residual supervision for
+// sa-resgs), so `saresgs train --residual` on the same views with the final fit's options
+// (quick preset: 3DGS's schedule, the cap, SH degree 0, the seed) gives the same model,
+// byte for byte, and the same test PSNR; the plain refit of the same views is `saresgs
+// train` without --residual, byte for byte too.
 TEST(Cli, FinalFitEqualsTrainOnTheChosenViews) {
   TempDir d;
   ASSERT_EQ(run("scene --layout object --views 12 --width 64 --height 48 --out " + d.file("s")).code, 0);
   Result r = run("active --dataset " + d.file("s") + " --method sa-resgs --max-views 5 --interval 4 --min-iterations 40 " +
                  "--final-iterations 150 --seed 3 --threads 2 --out " + d.file("a"));
   ASSERT_EQ(r.code, 0) << r.output;
-  EXPECT_NE(r.output.find("final fit on these views (150 it)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("final fit on these views (150 it, residual)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("plain refit of these views (150 it)"), std::string::npos) << r.output;
   const nlohmann::json a = nlohmann::json::parse(saresgs::test::readBytes(d.file("a/results.json")));
-  ASSERT_TRUE(a.contains("final_fit")) << a.dump();
+  ASSERT_TRUE(a.contains("final_fit") && a.contains("final_fit_views")) << a.dump();
   EXPECT_EQ(a["final_fit"]["iterations"], 150);
+  EXPECT_EQ(a["final_fit"]["residual"], true);
+  EXPECT_EQ(a["final_fit_views"]["residual"], false);
   std::string views;
   for (const auto& v : a["initial_views"]) views += (views.empty() ? "" : ",") + v.get<std::string>();
   for (const auto& v : a["selected_views"]) views += "," + v.get<std::string>();
-  r = run("train --dataset " + d.file("s") + " --views " + views +
-          " --iterations 150 --max-gaussians 40000 --sh-degree 0 --seed 3 --threads 2 --out " +
-          d.file("t"));
+  const std::string train = "train --dataset " + d.file("s") + " --views " + views +
+                            " --iterations 150 --max-gaussians 40000 --sh-degree 0 --seed 3 --threads 2 ";
+  for (const bool residual : {true, false}) {
+    const std::string out = d.file(residual ? "tr" : "tp");
+    r = run(train + (residual ? "--residual " : "") + "--out " + out);
+    ASSERT_EQ(r.code, 0) << r.output;
+    const nlohmann::json t = nlohmann::json::parse(saresgs::test::readBytes(out + "/results.json"));
+    const nlohmann::json& fit = a[residual ? "final_fit" : "final_fit_views"];
+    EXPECT_EQ(t["psnr"].get<double>(), fit["psnr"].get<double>()) << residual;
+    EXPECT_EQ(t["ssim"].get<double>(), fit["ssim"].get<double>()) << residual;
+    EXPECT_EQ(saresgs::test::readBytes(out + "/point_cloud.ply"),
+              saresgs::test::readBytes(d.file(residual ? "a/final_fit.ply" : "a/final_fit_views.ply")))
+        << residual;
+  }
+  // The two trainings differ (otherwise the comparison above would not tell them apart).
+  EXPECT_NE(a["final_fit"]["psnr"].get<double>(), a["final_fit_views"]["psnr"].get<double>());
+  // A method that trains plainly makes one fit, reported as both.
+  r = run("active --dataset " + d.file("s") + " --method fisher --max-views 5 --interval 4 --min-iterations 40 " +
+          "--final-iterations 150 --seed 3 --threads 2 --out " + d.file("f"));
   ASSERT_EQ(r.code, 0) << r.output;
-  const nlohmann::json t = nlohmann::json::parse(saresgs::test::readBytes(d.file("t/results.json")));
-  EXPECT_EQ(t["psnr"].get<double>(), a["final_fit"]["psnr"].get<double>());
-  EXPECT_EQ(t["ssim"].get<double>(), a["final_fit"]["ssim"].get<double>());
-  EXPECT_EQ(saresgs::test::readBytes(d.file("t/point_cloud.ply")), saresgs::test::readBytes(d.file("a/final_fit.ply")));
+  const nlohmann::json f = nlohmann::json::parse(saresgs::test::readBytes(d.file("f/results.json")));
+  EXPECT_EQ(f["final_fit"]["residual"], false);
+  EXPECT_EQ(f["final_fit_views"], f["final_fit"]);
+  EXPECT_FALSE(std::filesystem::exists(d.file("f/final_fit_views.ply")));
   // A view listed twice, or not a train view, is refused by name.
   r = run("train --dataset " + d.file("s") + " --views 0,0 --iterations 5 --out " + d.file("t2"));
   EXPECT_NE(r.code, 0);

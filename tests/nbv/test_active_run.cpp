@@ -1,6 +1,7 @@
 // The active loop on a tiny synthetic scene: the protocol's view counts, a killed and
 // resumed run equals an uninterrupted one bit for bit, and the coverage prefilter prefers
 // the view of the unobserved side.
+#include <algorithm>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -394,6 +395,40 @@ TEST(ActiveRun, CheckpointNumbersOutOfRangeAreRefusedByField) {
     ActiveRun run(s, o, ckpt);
     EXPECT_TRUE(test::throwsInputError([&] { run.run(); }, ckpt, field)) << input;
   }
+}
+
+}  // namespace
+}  // namespace saresgs
+
+namespace saresgs {
+namespace {
+
+// Fixed-order replay: a run of another method on a replayed sequence holds exactly that
+// sequence, selects nothing (no Fisher pass, no prefilter) and refuses a sequence it could
+// not have held.
+TEST(ActiveRun, ReplayHoldsTheReplayedSequenceAndRefusesOnesItCouldNotHold) {
+  const Scene& s = tinyDataset();
+  const ActiveResult fisher = ActiveRun(s, tinyOptions(Method::kFisher)).run();
+  ActiveOptions o = tinyOptions(Method::kSaResgs);
+  o.replay = fisher.selected_views;
+  const ActiveResult replay = ActiveRun(s, o).run();
+  EXPECT_EQ(replay.selected_views, fisher.selected_views);
+  EXPECT_EQ(replay.initial_views, fisher.initial_views);
+  EXPECT_EQ(replay.total_seconds.selection(), 0.0);
+  // A sequence in another order is held in that order (the initial views included).
+  o.replay = fisher.selected_views;
+  std::reverse(o.replay.begin(), o.replay.end());
+  EXPECT_EQ(ActiveRun(s, o).run().selected_views, o.replay);
+  // Too short, a repeated view, a view that is not a train view.
+  o.replay.assign(fisher.selected_views.begin(), fisher.selected_views.begin() + 3);
+  EXPECT_THROW(ActiveRun(s, o), std::invalid_argument);
+  o.replay = fisher.selected_views;
+  o.replay[4] = o.replay[1];
+  EXPECT_THROW(ActiveRun(s, o), std::invalid_argument);
+  o.replay = fisher.selected_views;
+  ASSERT_FALSE(s.test.empty());
+  o.replay[3] = s.test[0];
+  EXPECT_THROW(ActiveRun(s, o), std::invalid_argument);
 }
 
 }  // namespace

@@ -58,7 +58,22 @@ TEST(RunReport, EveryCommittedResultFileReadsBackUnchanged) {
   for (const auto& e : std::filesystem::recursive_directory_iterator(std::string(SARESGS_SOURCE_DIR) + "/results")) {
     if (e.path().filename() != "results.json") continue;
     const nlohmann::json j = readJsonFile(e.path().string());
-    EXPECT_EQ(toJson(runReportFromJson(j, e.path().string())), j) << e.path();
+    nlohmann::json back = toJson(runReportFromJson(j, e.path().string()));
+    // Files written before these fields were recorded get them on reading (a plain final
+    // fit is its own plain refit; no hybrid, no coverage time); nothing else may change.
+    if (j.contains("final_fit") && !j["final_fit"].contains("residual")) {
+      EXPECT_EQ(back["final_fit"]["residual"], false) << e.path();
+      EXPECT_EQ(back["final_fit_views"], back["final_fit"]) << e.path();
+      back["final_fit"].erase("residual");
+      if (!j.contains("final_fit_views")) back.erase("final_fit_views");
+    }
+    auto dropNewStage = [](const nlohmann::json& old, nlohmann::json& now) {
+      if (!old.contains("coverage") && now.value("coverage", -1.0) == 0.0) now.erase("coverage");
+    };
+    dropNewStage(j["seconds"], back["seconds"]);
+    for (std::size_t i = 0; i < j["steps"].size() && i < back["steps"].size(); ++i)
+      dropNewStage(j["steps"][i]["seconds"], back["steps"][i]["seconds"]);
+    EXPECT_EQ(back, j) << e.path();
     ++files;
   }
   EXPECT_GT(files, 0);

@@ -68,7 +68,7 @@ TEST(PairedStats, TableRowsPerSceneMethodBaselineAndMetric) {
     r.job.seed = seed;
     r.run.psnr = psnr;
     r.run.views = {{"t0", psnr, 0.5}};
-    r.run.final_fit = FinalFitReport{100, final_psnr, 0.8, {{"t0", final_psnr, 0.8}}};
+    r.run.final_fit = FinalFitReport{100, false, final_psnr, 0.8, {{"t0", final_psnr, 0.8}}};
     return r;
   };
   // fisher - random, final fit: seed 0: 27 - 26 = 1, seed 1: 26 - 26 = 0 (a tie).
