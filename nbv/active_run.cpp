@@ -43,14 +43,7 @@ ActiveRun::ActiveRun(const Scene& scene, const ActiveOptions& opt, std::string c
   trainer_ = std::make_unique<Trainer>(scene_, to);
   // A replay selects nothing, so it needs no prefilter.
   if (needs.coverage && opt_.replay.empty()) prefilter_ = makeCoveragePrefilter(scene_, opt_.prefilter);
-  if (needs.surface && opt_.replay.empty()) {
-    SurfaceCoverageOptions so;
-    so.grid.resolution = opt_.prefilter.resolution;
-    so.grid.min_points = opt_.prefilter.min_points;
-    so.grid.upsample = opt_.prefilter.upsample;
-    so.stride = opt_.hybrid_stride;
-    surface_ = std::make_unique<SurfaceCoverage>(scene_, so);
-  }
+  if (needs.surface && opt_.replay.empty()) surface_ = std::make_unique<SurfaceCoverage>(scene_, opt_.hybrid_surface);
 }
 
 // The replayed sequence must be one this run could have held: distinct train views, at

@@ -40,11 +40,11 @@ struct ActiveOptions {
   ViewDistance fvs_metric = ViewDistance::kEuclidean;
   PrefilterConfig prefilter;
   // hybrid: the share w of the new-surface evidence against Fisher's (hybridScores), the
-  // Fisher criterion it combines, and the surface grid (its resolution and points per
-  // voxel are the prefilter's).
+  // Fisher criterion it combines, and its surface grid and rays (its own, so that the
+  // prefilter's paper settings do not move it).
   double hybrid_weight = 0.5;
   FisherCriterion hybrid_criterion = FisherCriterion::kLogDet;
-  int hybrid_stride = 4;
+  SurfaceCoverageOptions hybrid_surface{.grid = {.resolution = 64, .min_points = 2, .upsample = 2}, .stride = 4, .tolerance = 1};
   bool time_exhaustive_fisher = false;  // prefiltered methods: also time Fisher on all
   int progress_test_views = 3;
   // After the last view: a fresh model from the initial state trained on exactly the
