@@ -208,7 +208,7 @@ AblationGrid readAblationGrid(const std::string& path) {
   AblationGrid g;
   g.source = path;
   for (const auto& [key, value] : j.items())
-    if (!std::set<std::string>{"preset", "threads", "scenes", "methods", "seeds", "method_args", "variants", "tables", "sweep", "comment"}
+    if (!std::set<std::string>{"preset", "threads", "scenes", "methods", "seeds", "method_seeds", "method_args", "variants", "tables", "sweep", "comment"}
              .count(key))
       // Quoted, so that an empty key (found by the ablation-config fuzz target) still names a field.
       throw InputError(path, "\"" + key + "\"", "unknown field");
@@ -224,6 +224,21 @@ AblationGrid readAblationGrid(const std::string& path) {
       g.seeds.push_back(static_cast<std::uint64_t>(s));
   noRepeats(g.seeds, path, "seeds");
   if (g.seeds.empty()) g.seeds = {0};
+  if (j.contains("method_seeds")) {
+    if (!j["method_seeds"].is_object()) throw InputError(path, "method_seeds", "expected {method: [seeds]}");
+    for (const auto& [m, a] : j["method_seeds"].items()) {
+      const std::string f = "method_seeds." + m;
+      checkMethod(m, path, "method_seeds");
+      std::vector<std::uint64_t> seeds;
+      for (long long s : jsonIntegers(a, path, f, 0, std::numeric_limits<long long>::max())) {
+        if (std::find(g.seeds.begin(), g.seeds.end(), static_cast<std::uint64_t>(s)) == g.seeds.end())
+          throw InputError(path, f, "seed " + std::to_string(s) + " is not among \"seeds\" (the tables pair seeds from there)");
+        seeds.push_back(static_cast<std::uint64_t>(s));
+      }
+      noRepeats(seeds, path, f);
+      g.method_seeds[m] = seeds;
+    }
+  }
   if (j.contains("method_args")) {
     if (!j["method_args"].is_object()) throw InputError(path, "method_args", "expected {method: [args]}");
     for (const auto& [m, a] : j["method_args"].items()) {
@@ -253,7 +268,8 @@ std::vector<AblationJob> expandGrid(const AblationGrid& g) {
     for (const std::string& m : g.methods)
       for (const AblationVariant& v : g.variants) {
         if (!variantApplies(v, m)) continue;
-        for (std::uint64_t seed : g.seeds) {
+        const auto own = g.method_seeds.find(m);
+        for (std::uint64_t seed : own != g.method_seeds.end() ? own->second : g.seeds) {
           AblationJob j;
           j.scene = sc.name;
           j.method = m;

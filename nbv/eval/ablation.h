@@ -12,6 +12,7 @@
 //     "scenes": [{"name": "room360", "dataset": "out/builtin", "layout": "room360"}, ...],
 //     "methods": ["random", "fisher", "sa-hash", "sa-resgs"],
 //     "seeds": [0, 1],
+//     "method_seeds": {"sa-hash": [0]},   (optional: fewer seeds for a method, among "seeds")
 //     "method_args": {"sa-hash": ["--time-exhaustive-fisher"]},            (optional)
 //     "variants": [{"name": "beta0.05", "methods": ["sa-resgs"],             (optional)
 //                   "args": ["--residual-beta", "0.05"]},
@@ -62,6 +63,7 @@ struct AblationGrid {
   std::vector<AblationScene> scenes;
   std::vector<std::string> methods;
   std::vector<std::uint64_t> seeds;
+  std::map<std::string, std::vector<std::uint64_t>> method_seeds;  // overrides `seeds` per method
   std::map<std::string, std::vector<std::string>> method_args;
   std::vector<AblationVariant> variants;
   std::vector<AblationTableSpec> tables;

@@ -252,14 +252,15 @@ Table finalFitPerViewTable(const AblationGrid& g, const std::vector<JobResult>& 
 Table timeTable(const AblationGrid& g, const std::vector<JobResult>& results) {
   Table t{"time",
           "Time per run (mean over scenes and seeds, seconds): selection stages, training per iteration, end to "
-          "end; exhaustive Fisher = Fisher over all candidates timed in the same run",
-          {"method", "runs", "lifting", "triangulation", "prefilter", "Fisher", "selection", "exhaustive Fisher",
+          "end; coverage = the hybrid's visible-surface sets and counts; exhaustive Fisher = Fisher over all "
+          "candidates timed in the same run",
+          {"method", "runs", "lifting", "triangulation", "prefilter", "Fisher", "coverage", "selection", "exhaustive Fisher",
            "selection saved", "train ms/it", "end to end"},
           {}};
   for (const auto& m : g.methods)
     for (const auto& v : g.variants) {
       if (!variantApplies(v, m)) continue;
-      std::vector<double> li, tr, pf, fi, sel, ex, saved, it_ms, e2e;
+      std::vector<double> li, tr, pf, fi, cv, sel, ex, saved, it_ms, e2e;
       for (const JobResult& r : results) {
         if (!isActive(r) || r.job.method != m || r.job.variant != v.name) continue;
         const SelectionSeconds& st = r.run.seconds;
@@ -267,6 +268,7 @@ Table timeTable(const AblationGrid& g, const std::vector<JobResult>& results) {
         tr.push_back(st.triangulation);
         pf.push_back(st.prefilter);
         fi.push_back(st.fisher);
+        cv.push_back(st.coverage);
         sel.push_back(st.selection());
         if (st.exhaustive_fisher > 0) {
           ex.push_back(st.exhaustive_fisher);
@@ -278,7 +280,7 @@ Table timeTable(const AblationGrid& g, const std::vector<JobResult>& results) {
       if (li.empty()) continue;
       auto mean = [](const std::vector<double>& x, int d) { return x.empty() ? std::string("") : fmt(meanStd(x).first, d); };
       t.rows.push_back({runLabel(m, v.name), std::to_string(li.size()), mean(li, 2), mean(tr, 3), mean(pf, 3), mean(fi, 1),
-                        mean(sel, 1), mean(ex, 1), saved.empty() ? "" : mean(saved, 0) + " %", mean(it_ms, 1), mean(e2e, 0)});
+                        mean(cv, 2), mean(sel, 1), mean(ex, 1), saved.empty() ? "" : mean(saved, 0) + " %", mean(it_ms, 1), mean(e2e, 0)});
     }
   return t;
 }

@@ -65,6 +65,27 @@ TEST(Ablation, GridExpandsIntoEveryCombinationOnce) {
   EXPECT_THROW(parseShard("1/2x"), std::invalid_argument);
 }
 
+// A method may run on fewer seeds than the grid's (method_seeds, among "seeds"); the
+// others keep the grid's seeds, and a seed outside "seeds" is refused by field.
+TEST(Ablation, MethodSeedsNarrowOneMethodsSeeds) {
+  TempDir d;
+  nlohmann::json j = {{"scenes", {{{"name", "a"}, {"dataset", "x"}}}},
+                      {"methods", {"random", "fisher"}},
+                      {"seeds", {0, 1, 2, 3}},
+                      {"method_seeds", {{"fisher", {1, 3}}}}};
+  writeBytes(d.file("g.json"), j.dump());
+  std::vector<std::string> ids;
+  for (const AblationJob& job : expandGrid(readAblationGrid(d.file("g.json")))) ids.push_back(job.id);
+  EXPECT_EQ(ids, (std::vector<std::string>{"a__random__default__s0", "a__random__default__s1", "a__random__default__s2",
+                                           "a__random__default__s3", "a__fisher__default__s1", "a__fisher__default__s3"}));
+  j["method_seeds"]["fisher"] = {1, 7};
+  writeBytes(d.file("g.json"), j.dump());
+  EXPECT_TRUE(throwsInputError([&] { readAblationGrid(d.file("g.json")); }, d.file("g.json"), "method_seeds.fisher"));
+  j["method_seeds"] = {{"oracle", {1}}};
+  writeBytes(d.file("g.json"), j.dump());
+  EXPECT_TRUE(throwsInputError([&] { readAblationGrid(d.file("g.json")); }, d.file("g.json"), "method_seeds"));
+}
+
 TEST(Ablation, GridTakesEveryMethodOfTheList) {
   TempDir d;
   nlohmann::json j = {{"scenes", {{{"name", "a"}, {"dataset", "x"}}}}, {"methods", methodNames()}};
@@ -195,7 +216,7 @@ TEST(Ablation, TablesAggregateSeedsAndSplitMeanStdInCsv) {
   EXPECT_NE(csv.find("21.00,1.41"), std::string::npos) << csv;
   const Table time = find("time");
   ASSERT_EQ(time.rows.size(), 1u);
-  EXPECT_EQ(time.rows[0][9], "20.0");  // 2 s / 100 iterations
+  EXPECT_EQ(time.rows[0][10], "20.0");  // 2 s / 100 iterations
   const Table views = find("psnr_vs_views");
   ASSERT_EQ(views.rows.size(), 1u);
   EXPECT_EQ(views.rows[0][2], "15.00");
