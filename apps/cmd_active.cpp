@@ -35,7 +35,7 @@ struct ActiveArgs {
   std::optional<int> max_views, interval, total, final_iterations, renamed_iterations;
   std::optional<long long> max_gaussians;
   std::optional<double> beta, prefilter_keep, hybrid_weight;
-  std::string hybrid_fisher = "logdet";
+  std::string hybrid_fisher = "logdet", hybrid_coverage = "surface";
   PrefilterFlags prefilter;
 };
 
@@ -69,6 +69,7 @@ ActiveOptions activeOptions(const ActiveArgs& a) {
   if (a.prefilter_keep) o.prefilter.keep_fraction = *a.prefilter_keep;
   if (a.hybrid_weight) o.hybrid_weight = *a.hybrid_weight;
   o.hybrid_criterion = a.hybrid_fisher == "trace" ? FisherCriterion::kTrace : FisherCriterion::kLogDet;
+  o.hybrid_coverage = a.hybrid_coverage == "views" ? HybridCoverage::kViewDistance : HybridCoverage::kSurface;
   return o;
 }
 
@@ -177,10 +178,14 @@ CLI::App* addActiveOptions(CLI::App& app, const std::shared_ptr<ActiveArgs>& a) 
       ->capture_default_str();
   sub->add_option("--prefilter-keep", a->prefilter_keep, "Fraction kept for Fisher (default 0.2)")->check(CLI::Range(0.0, 1.0));
   sub->add_option("--hybrid-weight", a->hybrid_weight,
-                  "hybrid: share of the new-surface evidence against Fisher's, in [0, 1] (default 0.5)")
+                  "hybrid: share of the coverage evidence against Fisher's, in [0, 1] (default 0.5)")
       ->check(CLI::Range(0.0, 1.0));
   sub->add_option("--hybrid-fisher", a->hybrid_fisher, "hybrid: Fisher criterion combined, trace | logdet")
       ->check(CLI::IsMember({"trace", "logdet"}))->capture_default_str();
+  sub->add_option("--hybrid-coverage", a->hybrid_coverage,
+                  "hybrid: second evidence, surface (Embree-visible SfM surface no held view saw) | views (distance to the "
+                  "nearest held camera)")
+      ->check(CLI::IsMember({"surface", "views"}))->capture_default_str();
   sub->add_flag("--time-exhaustive-fisher", a->time_exhaustive_fisher, "Also time Fisher over all candidates");
   sub->add_option("--replay", a->replay,
                   "Fixed order: train with this method's training on the views of another run's results.json, in their "

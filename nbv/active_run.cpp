@@ -43,7 +43,7 @@ ActiveRun::ActiveRun(const Scene& scene, const ActiveOptions& opt, std::string c
   trainer_ = std::make_unique<Trainer>(scene_, to);
   // A replay selects nothing, so it needs no prefilter.
   if (needs.coverage && opt_.replay.empty()) prefilter_ = makeCoveragePrefilter(scene_, opt_.prefilter);
-  if (needs.surface && opt_.replay.empty()) surface_ = std::make_unique<SurfaceCoverage>(scene_, opt_.hybrid_surface);
+  if (needs.surface && opt_.replay.empty() && opt_.hybrid_coverage == HybridCoverage::kSurface) surface_ = std::make_unique<SurfaceCoverage>(scene_, opt_.hybrid_surface);
 }
 
 // The replayed sequence must be one this run could have held: distinct train views, at
@@ -157,10 +157,14 @@ int ActiveRun::selectNext(SelectionLog& log) {
     // What the held views see is known from the poses: observing all of them again is a
     // union (cached sets), so a resumed run needs no saved state.
     t0 = Clock::now();
-    surface_->observe(selected_);
     log.fisher_scores = log.scores;
-    log.new_surface = surface_->newSurface(pool);
-    log.scores = hybridScores(log.fisher_scores, log.new_surface, opt_.hybrid_weight);
+    if (surface_) {
+      surface_->observe(selected_);
+      log.new_surface = surface_->newSurface(pool);
+    } else {
+      log.view_distance = farthestViewScores(scene_, selected_, pool, ViewDistance::kEuclidean, Eigen::Vector3d::Zero());
+    }
+    log.scores = hybridScores(log.fisher_scores, surface_ ? log.new_surface : log.view_distance, opt_.hybrid_weight);
     log.seconds.coverage += since(t0);
   }
   if (needs.coverage && opt_.time_exhaustive_fisher) {

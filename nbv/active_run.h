@@ -44,6 +44,7 @@ struct ActiveOptions {
   // prefilter's paper settings do not move it).
   double hybrid_weight = 0.5;
   FisherCriterion hybrid_criterion = FisherCriterion::kLogDet;
+  HybridCoverage hybrid_coverage = HybridCoverage::kSurface;
   SurfaceCoverageOptions hybrid_surface{.grid = {.resolution = 64, .min_points = 2, .upsample = 2}, .stride = 4, .tolerance = 1};
   bool time_exhaustive_fisher = false;  // prefiltered methods: also time Fisher on all
   int progress_test_views = 3;
@@ -74,7 +75,8 @@ struct SelectionLog {
   std::vector<int> prefiltered;     // coverage methods: the kept top N %
   SelectionSeconds seconds;
   double progress_psnr = 0;         // on the progress test views, before selection
-  std::vector<double> fisher_scores, new_surface;  // hybrid: its two kinds of evidence
+  // hybrid: its two kinds of evidence (new_surface or view_distance, by hybrid_coverage)
+  std::vector<double> fisher_scores, new_surface, view_distance;
 };
 
 // What an active run is doing; selection stages report per view or candidate handled.

@@ -114,6 +114,7 @@ json toJson(const StepReport& s) {
     if (!s.prefiltered.empty()) e["prefiltered"] = s.prefiltered;
     if (!s.fisher_scores.empty()) e["fisher_scores"] = s.fisher_scores;
     if (!s.new_surface.empty()) e["new_surface"] = s.new_surface;
+    if (!s.view_distance.empty()) e["view_distance"] = s.view_distance;
   }
   return e;
 }
@@ -130,6 +131,7 @@ StepReport stepReportFromJson(const json& j, const std::string& source, const st
     if (j.contains("prefiltered")) s.prefiltered = field<std::vector<std::string>>(j, "prefiltered", source, path);
     if (j.contains("fisher_scores")) s.fisher_scores = field<std::vector<double>>(j, "fisher_scores", source, path);
     if (j.contains("new_surface")) s.new_surface = field<std::vector<double>>(j, "new_surface", source, path);
+    if (j.contains("view_distance")) s.view_distance = field<std::vector<double>>(j, "view_distance", source, path);
   }
   return s;
 }
@@ -248,6 +250,7 @@ StepReport stepReport(const Scene& scene, const SelectionLog& log) {
     s.prefiltered = names(scene, log.prefiltered);
     s.fisher_scores = log.fisher_scores;
     s.new_surface = log.new_surface;
+    s.view_distance = log.view_distance;
   }
   return s;
 }
@@ -275,6 +278,7 @@ SelectionLog selectionLog(const Scene& scene, const StepReport& step, const std:
   l.prefiltered = indices(step.prefiltered);
   l.fisher_scores = step.fisher_scores;
   l.new_surface = step.new_surface;
+  l.view_distance = step.view_distance;
   return l;
 }
 

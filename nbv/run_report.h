@@ -25,7 +25,7 @@ struct StepReport {
   std::vector<std::string> candidates;   // what the final scorer saw
   std::vector<double> scores;            // their scores
   std::vector<std::string> prefiltered;  // coverage methods: the kept top N %
-  std::vector<double> fisher_scores, new_surface;  // hybrid: its two kinds of evidence
+  std::vector<double> fisher_scores, new_surface, view_distance;  // hybrid: its evidence
 };
 
 // The options that shaped the run, as the tables name them.

@@ -38,6 +38,11 @@ std::vector<double> fisherScores(const Gaussians& g, const RasterSettings& s, co
                                  double lambda = 1e-6, const std::function<void(int, int)>& tick = {},
                                  FisherCriterion criterion = FisherCriterion::kTrace);
 
+// The second kind of evidence of the hybrid: Embree-visible SfM surface no held view has
+// seen (nbv/surface_coverage.h), or the distance of the candidate's camera to the nearest
+// held one (farthest view sampling's score).
+enum class HybridCoverage { kSurface, kViewDistance };
+
 // The hybrid score of two kinds of evidence: (1 - w) F / max F + w N / max N over the
 // candidates, F the Fisher scores and N the new-surface counts (a term whose maximum is
 // not positive, or not finite, contributes 0). Scale-free in both, so w is the share of

@@ -433,3 +433,34 @@ TEST(ActiveRun, ReplayHoldsTheReplayedSequenceAndRefusesOnesItCouldNotHold) {
 
 }  // namespace
 }  // namespace saresgs
+
+namespace saresgs {
+namespace {
+
+// The hybrid's ends are the selectors it mixes: at weight 0 it chooses what its Fisher
+// criterion chooses (log-det: fisher-logdet; trace: fisher), at weight 1 with the view
+// distance what farthest view sampling chooses; in between it logs both kinds of evidence.
+TEST(ActiveRun, HybridAtItsEndsChoosesWhatTheSelectorsItMixesChoose) {
+  const Scene& s = tinyDataset();
+  auto views = [&](Method m, double w, FisherCriterion c, HybridCoverage k) {
+    ActiveOptions o = tinyOptions(m);
+    o.hybrid_weight = w;
+    o.hybrid_criterion = c;
+    o.hybrid_coverage = k;
+    o.hybrid_surface.grid.resolution = 24;
+    return ActiveRun(s, o).run();
+  };
+  const auto d = HybridCoverage::kViewDistance, sf = HybridCoverage::kSurface;
+  const auto ld = FisherCriterion::kLogDet, tr = FisherCriterion::kTrace;
+  EXPECT_EQ(views(Method::kHybrid, 0, ld, sf).selected_views, views(Method::kFisherLogDet, 0, ld, sf).selected_views);
+  EXPECT_EQ(views(Method::kHybrid, 0, tr, d).selected_views, views(Method::kFisher, 0, ld, sf).selected_views);
+  EXPECT_EQ(views(Method::kHybrid, 1, ld, d).selected_views, views(Method::kFvs, 0, ld, sf).selected_views);
+  const ActiveResult mid = views(Method::kHybrid, 0.5, ld, sf);
+  ASSERT_FALSE(mid.steps.empty());
+  EXPECT_EQ(mid.steps[0].new_surface.size(), mid.steps[0].candidates.size());
+  EXPECT_EQ(mid.steps[0].fisher_scores.size(), mid.steps[0].candidates.size());
+  EXPECT_TRUE(mid.steps[0].view_distance.empty());
+}
+
+}  // namespace
+}  // namespace saresgs
