@@ -69,7 +69,9 @@ ActiveOptions activeOptions(const ActiveArgs& a) {
   if (a.prefilter_keep) o.prefilter.keep_fraction = *a.prefilter_keep;
   if (a.hybrid_weight) o.hybrid_weight = *a.hybrid_weight;
   o.hybrid_criterion = a.hybrid_fisher == "trace" ? FisherCriterion::kTrace : FisherCriterion::kLogDet;
-  o.hybrid_coverage = a.hybrid_coverage == "views" ? HybridCoverage::kViewDistance : HybridCoverage::kSurface;
+  o.hybrid_coverage = a.hybrid_coverage == "views"      ? HybridCoverage::kViewDistance
+                      : a.hybrid_coverage == "facility" ? HybridCoverage::kFacility
+                                                        : HybridCoverage::kSurface;
   return o;
 }
 
@@ -184,8 +186,9 @@ CLI::App* addActiveOptions(CLI::App& app, const std::shared_ptr<ActiveArgs>& a) 
       ->check(CLI::IsMember({"trace", "logdet"}))->capture_default_str();
   sub->add_option("--hybrid-coverage", a->hybrid_coverage,
                   "hybrid: second evidence, surface (Embree-visible SfM surface no held view saw) | views (distance to the "
-                  "nearest held camera)")
-      ->check(CLI::IsMember({"surface", "views"}))->capture_default_str();
+                  "nearest held camera) | facility (the facility-location gain over the train views, by the overlap of their visible "
+                  "surface)")
+      ->check(CLI::IsMember({"surface", "views", "facility"}))->capture_default_str();
   sub->add_flag("--time-exhaustive-fisher", a->time_exhaustive_fisher, "Also time Fisher over all candidates");
   sub->add_option("--replay", a->replay,
                   "Fixed order: train with this method's training on the views of another run's results.json, in their "

@@ -43,7 +43,7 @@ ActiveRun::ActiveRun(const Scene& scene, const ActiveOptions& opt, std::string c
   trainer_ = std::make_unique<Trainer>(scene_, to);
   // A replay selects nothing, so it needs no prefilter.
   if (needs.coverage && opt_.replay.empty()) prefilter_ = makeCoveragePrefilter(scene_, opt_.prefilter);
-  if (needs.surface && opt_.replay.empty() && opt_.hybrid_coverage == HybridCoverage::kSurface) surface_ = std::make_unique<SurfaceCoverage>(scene_, opt_.hybrid_surface);
+  if (needs.surface && opt_.replay.empty() && opt_.hybrid_coverage != HybridCoverage::kViewDistance) surface_ = std::make_unique<SurfaceCoverage>(scene_, opt_.hybrid_surface);
 }
 
 // The replayed sequence must be one this run could have held: distinct train views, at
@@ -160,7 +160,8 @@ int ActiveRun::selectNext(SelectionLog& log) {
     log.fisher_scores = log.scores;
     if (surface_) {
       surface_->observe(selected_);
-      log.new_surface = surface_->newSurface(pool);
+      log.new_surface = opt_.hybrid_coverage == HybridCoverage::kFacility ? surface_->facilityGain(pool, scene_.train)
+                                                                          : surface_->newSurface(pool);
     } else {
       log.view_distance = farthestViewScores(scene_, selected_, pool, ViewDistance::kEuclidean, Eigen::Vector3d::Zero());
     }

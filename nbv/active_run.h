@@ -75,7 +75,8 @@ struct SelectionLog {
   std::vector<int> prefiltered;     // coverage methods: the kept top N %
   SelectionSeconds seconds;
   double progress_psnr = 0;         // on the progress test views, before selection
-  // hybrid: its two kinds of evidence (new_surface or view_distance, by hybrid_coverage)
+  // hybrid: its two kinds of evidence (new_surface: the new surface or the facility gain;
+  // view_distance; by hybrid_coverage)
   std::vector<double> fisher_scores, new_surface, view_distance;
 };
 

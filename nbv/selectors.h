@@ -41,7 +41,8 @@ std::vector<double> fisherScores(const Gaussians& g, const RasterSettings& s, co
 // The second kind of evidence of the hybrid: Embree-visible SfM surface no held view has
 // seen (nbv/surface_coverage.h), or the distance of the candidate's camera to the nearest
 // held one (farthest view sampling's score).
-enum class HybridCoverage { kSurface, kViewDistance };
+// Or the facility-location gain over the train views (SurfaceCoverage::facilityGain).
+enum class HybridCoverage { kSurface, kViewDistance, kFacility };
 
 // The hybrid score of two kinds of evidence: (1 - w) F / max F + w N / max N over the
 // candidates, F the Fisher scores and N the new-surface counts (a term whose maximum is

@@ -1,5 +1,7 @@
 #include "nbv/surface_coverage.h"
 
+#include <algorithm>
+
 #include "geometry/error.h"
 #include "geometry/occupancy/candidate_sets.h"
 
@@ -36,7 +38,36 @@ const VoxelSet& SurfaceCoverage::visible(int view) const {
 }
 
 void SurfaceCoverage::observe(const std::vector<int>& views) {
-  for (int v : views) observed_ = setUnion(observed_, visible(v));
+  for (int v : views) {
+    observed_ = setUnion(observed_, visible(v));
+    if (std::find(held_.begin(), held_.end(), v) == held_.end()) held_.push_back(v);
+  }
+}
+
+double SurfaceCoverage::similarity(int a, int b) const {
+  if (a == b) return 1.0;
+  const std::pair<int, int> key(std::min(a, b), std::max(a, b));
+  auto it = similarity_.find(key);
+  if (it != similarity_.end()) return it->second;
+  const VoxelSet &va = visible(a), &vb = visible(b);
+  const std::size_t both = intersectionSize(va, vb), either = va.size() + vb.size() - both;
+  const double j = either > 0 ? static_cast<double>(both) / static_cast<double>(either) : 0.0;
+  similarity_.emplace(key, j);
+  return j;
+}
+
+std::vector<double> SurfaceCoverage::facilityGain(const std::vector<int>& candidates, const std::vector<int>& population) const {
+  std::vector<double> covered(population.size(), 0.0);
+  for (std::size_t i = 0; i < population.size(); ++i)
+    for (int s : held_) covered[i] = std::max(covered[i], similarity(population[i], s));
+  std::vector<double> out;
+  out.reserve(candidates.size());
+  for (int x : candidates) {
+    double gain = 0;  // summed in population order: deterministic
+    for (std::size_t i = 0; i < population.size(); ++i) gain += std::max(0.0, similarity(population[i], x) - covered[i]);
+    out.push_back(gain);
+  }
+  return out;
 }
 
 std::vector<double> SurfaceCoverage::newSurface(const std::vector<int>& candidates) const {

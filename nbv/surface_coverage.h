@@ -42,6 +42,14 @@ class SurfaceCoverage {
   // Per candidate, the number of surface voxels it sees that no observed view saw (none
   // within `tolerance` voxels).
   std::vector<double> newSurface(const std::vector<int>& candidates) const;
+  // Facility location over views (every train view stands for the test views near it):
+  // the similarity of two views is the Jaccard index of their visible sets, a view is as
+  // covered as its most similar held view, and a candidate's gain is how much adding it
+  // raises the sum of that coverage over `population` (the train views):
+  //   gain(x) = sum_c max(0, J(c, x) - max_{s held} J(c, s)).
+  // Observe the held views first; the similarities are cached.
+  std::vector<double> facilityGain(const std::vector<int>& candidates, const std::vector<int>& population) const;
+  double similarity(int a, int b) const;  // Jaccard index of the visible sets (1 for a == b)
   // The voxels a view sees (cached per view: cameras do not move).
   const VoxelSet& visible(int view) const;
   std::size_t observedCount() const { return observed_.size(); }
@@ -53,7 +61,9 @@ class SurfaceCoverage {
   std::unique_ptr<OccupancyGrids> grids_;
   std::unique_ptr<VisibilityTracer> tracer_;
   mutable std::map<int, VoxelSet> cache_;
+  mutable std::map<std::pair<int, int>, double> similarity_;
   VoxelSet observed_;
+  std::vector<int> held_;  // the observed views, in the order first observed
 };
 
 }  // namespace saresgs

@@ -133,6 +133,33 @@ TEST(HybridSelectors, HybridPrefersUnobservedSurfaceBehindAnOccluderThatFrustumS
   EXPECT_EQ(cov.newSurface({1})[0], 0.0);
 }
 
+// Facility location over views, against its definition computed from the pairwise
+// similarities: with A held, the view from behind (B) covers what nothing covers yet and
+// gains more than C, a second look at what A covers.
+TEST(HybridSelectors, FacilityGainIsTheRiseInCoverageOfTheTrainViews) {
+  const Scene s = occluderScene();
+  SurfaceCoverageOptions o;
+  o.grid.resolution = 64;
+  o.stride = 1;
+  SurfaceCoverage cov(s, o);
+  EXPECT_EQ(cov.similarity(1, 1), 1.0);
+  EXPECT_EQ(cov.similarity(0, 2), cov.similarity(2, 0));
+  EXPECT_GT(cov.similarity(0, 2), 0.5) << "A and C see the same wall";
+  EXPECT_LT(cov.similarity(0, 1), cov.similarity(0, 2));
+  cov.observe({0});
+  const std::vector<int> all = {0, 1, 2};
+  const std::vector<double> g = cov.facilityGain({1, 2}, all);
+  auto J = [&](int a, int b) { return cov.similarity(a, b); };
+  const double gain_b = 0 + (1 - J(1, 0)) + std::max(0.0, J(2, 1) - J(2, 0));
+  const double gain_c = 0 + std::max(0.0, J(1, 2) - J(1, 0)) + (1 - J(2, 0));
+  EXPECT_DOUBLE_EQ(g[0], gain_b);
+  EXPECT_DOUBLE_EQ(g[1], gain_c);
+  EXPECT_GT(g[0], g[1]);
+  // Holding every view leaves nothing to gain.
+  cov.observe({1, 2});
+  for (double x : cov.facilityGain({0, 1, 2}, all)) EXPECT_EQ(x, 0.0);
+}
+
 TEST(HybridSelectors, SurfaceCoverageNeedsSparsePoints) {
   Scene s = occluderScene();
   s.points.clear();
