@@ -27,7 +27,7 @@ namespace fs = std::filesystem;
 
 // Options as typed; the preset's values apply where an override is not given.
 struct ActiveArgs {
-  std::string dataset, out, method = "sa-resgs", preset = "quick", fvs_metric = "euclidean", ranking, replay;
+  std::string dataset, out, method = "hybrid", preset = "quick", fvs_metric = "euclidean", ranking, replay;
   int downscale = 1, threads = 0;
   bool resume = false, continue_training = false, sub_only = false, time_exhaustive_fisher = false;
   std::uint64_t seed = 0;
@@ -35,7 +35,7 @@ struct ActiveArgs {
   std::optional<int> max_views, interval, total, final_iterations, renamed_iterations;
   std::optional<long long> max_gaussians;
   std::optional<double> beta, prefilter_keep, hybrid_weight;
-  std::string hybrid_fisher = "logdet", hybrid_coverage = "surface";
+  std::string hybrid_fisher = "logdet", hybrid_coverage = "facility";
   PrefilterFlags prefilter;
 };
 
@@ -65,7 +65,7 @@ ActiveOptions activeOptions(const ActiveArgs& a) {
   if (a.beta) o.trainer.residual.beta = *a.beta;
   if (!a.ranking.empty()) o.trainer.residual.ranking = parseUncertaintyRanking(a.ranking);
   if (a.sub_only) o.trainer.residual.sub_only = true;
-  o.prefilter = parsePrefilterFlags(a.prefilter, o.prefilter, "--prefilter-");
+  o.prefilter = parsePrefilterFlags(a.prefilter, o.prefilter, "--prefilter-", a.dataset);
   if (a.prefilter_keep) o.prefilter.keep_fraction = *a.prefilter_keep;
   if (a.hybrid_weight) o.hybrid_weight = *a.hybrid_weight;
   o.hybrid_criterion = a.hybrid_fisher == "trace" ? FisherCriterion::kTrace : FisherCriterion::kLogDet;
@@ -174,7 +174,14 @@ CLI::App* addActiveOptions(CLI::App& app, const std::shared_ptr<ActiveArgs>& a) 
       ->check(CLI::IsMember({"euclidean", "great-circle"}))->capture_default_str();
   sub->add_option("--fisher-lambda", a->fisher_lambda, "Fisher damping lambda (> 0)")->check(positiveNumber())->capture_default_str();
   sub->add_option("--prefilter-set", a->prefilter.set, "frustum | visible")->capture_default_str();
-  sub->add_option("--prefilter-encoding", a->prefilter.encoding, "hash:K (11..19) | exact")->capture_default_str();
+  sub->add_option("--prefilter-encoding", a->prefilter.encoding,
+                  "hash:auto (the smallest 2^K, K in 11..19, with load <= 0.5) | hash:K (11..19) | exact")
+      ->capture_default_str();
+  sub->add_option("--prefilter-scene", a->prefilter.scene,
+                  "indoor (5 SfM points per occupied voxel, grid 32) | outdoor (2, grid 64) | auto (a built-in scene's "
+                  "layout says; outdoor otherwise)")
+      ->check(CLI::IsMember({"auto", "indoor", "outdoor"}))
+      ->capture_default_str();
   sub->add_option("--prefilter-score", a->prefilter.score, "xor | new")->capture_default_str();
   sub->add_option("--prefilter-lifting", a->prefilter.lifting, "SA-Point lifting: flow (DIS + epipolar refinement) | depth (the trainer's rendered depth) | oracle (the dataset's ground-truth depth maps)")
       ->capture_default_str();

@@ -65,6 +65,7 @@ int runCoverage(const CoverageArgs& a) {
   j["source"] = source;
   j["set"] = toString(config.set);
   j["encoding"] = encodingName(config.scoring);
+  j["prefilter_regime"] = toJson(c.prefilter->regime());
   j["score"] = toString(config.scoring.criterion);
   j["lifting"] = toString(config.lifting);
   auto name = [&](int v) { return scene.views[static_cast<std::size_t>(v)].name; };
@@ -112,7 +113,10 @@ void addCoverageCommand(CLI::App& app, Action& action) {
   sub->add_option("--out", a->out, "Output folder")->required();
   sub->add_option("--model", a->model, "Trained .ply to render extrapolated views (datasets without ground truth)");
   sub->add_option("--set", a->flags.set, "frustum | visible")->capture_default_str();
-  sub->add_option("--encoding", a->flags.encoding, "hash:K (K = 11..19) | exact")->capture_default_str();
+  a->flags.scene = "";  // --resolution and --min-points are this command's own flags
+  sub->add_option("--encoding", a->flags.encoding,
+                  "hash:auto (the smallest 2^K, K = 11..19, with load <= 0.5) | hash:K (K = 11..19) | exact")
+      ->capture_default_str();
   sub->add_option("--score", a->flags.score, "xor | new")->capture_default_str();
   sub->add_option("--lifting", a->flags.lifting, "flow | depth | oracle (the dataset's ground-truth depth maps)")->capture_default_str();
   sub->add_option("--keep", a->config.keep_fraction, "Fraction of candidates kept (top N %)")->check(CLI::Range(0.0, 1.0))->capture_default_str();

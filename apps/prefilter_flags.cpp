@@ -1,8 +1,13 @@
 #include "apps/prefilter_flags.h"
 
+#include <filesystem>
 #include <stdexcept>
 
+#include <nlohmann/json.hpp>
+
+
 #include "geometry/error.h"
+#include "geometry/io/json_file.h"
 
 namespace saresgs::apps {
 
@@ -19,7 +24,22 @@ void parseOption(const std::string& option, F&& parse) {
 
 }  // namespace
 
-PrefilterConfig parsePrefilterFlags(const PrefilterFlags& f, PrefilterConfig c, const std::string& prefix) {
+PrefilterConfig parsePrefilterFlags(const PrefilterFlags& f, PrefilterConfig c, const std::string& prefix,
+                                    const std::string& dataset) {
+  parseOption(prefix + "scene", [&] {
+    if (f.scene.empty()) return;  // the caller's numeric options stand
+    if (f.scene != "auto") {
+      applySceneType(c, parseSceneType(f.scene));
+      return;
+    }
+    std::optional<SceneType> t;
+    const std::string manifest = dataset + "/manifest.json";
+    if (!dataset.empty() && std::filesystem::exists(manifest)) {
+      const nlohmann::json j = readJsonFile(manifest);
+      if (j.is_object() && j.contains("layout") && j["layout"].is_string()) t = sceneTypeOfLayout(j["layout"].get<std::string>());
+    }
+    applySceneType(c, t.value_or(SceneType::kOutdoor));
+  });
   parseOption(prefix + "set", [&] { c.set = parseCandidateSet(f.set); });
   parseOption(prefix + "encoding", [&] { parseCoverageEncoding(f.encoding, c.scoring); });
   parseOption(prefix + "score", [&] { c.scoring.criterion = parseCoverageCriterion(f.score); });

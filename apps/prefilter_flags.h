@@ -8,11 +8,17 @@
 namespace saresgs::apps {
 
 struct PrefilterFlags {
-  std::string set = "frustum", encoding = "hash:13", score = "xor", lifting = "flow";
+  std::string set = "frustum", encoding = "hash:auto", score = "xor", lifting = "flow";
+  // indoor | outdoor | auto (the dataset's built-in layout says; outdoor otherwise); empty:
+  // leave the base's resolution and points per voxel
+  std::string scene = "auto";
 };
 
 // `base` with the flags parsed in; a bad value throws InputError naming the option
 // (`option_prefix` + "set", ...) and what was expected.
-PrefilterConfig parsePrefilterFlags(const PrefilterFlags& f, PrefilterConfig base, const std::string& option_prefix);
+// `dataset` is read only for `scene` auto (its manifest.json's layout; a dataset that is
+// missing or has none counts as outdoor).
+PrefilterConfig parsePrefilterFlags(const PrefilterFlags& f, PrefilterConfig base, const std::string& option_prefix,
+                                    const std::string& dataset = {});
 
 }  // namespace saresgs::apps

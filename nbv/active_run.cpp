@@ -236,6 +236,7 @@ ActiveResult ActiveRun::run(const std::function<void(const ActiveProgress&)>& pr
   r.steps = steps_;
   for (const auto& s : steps_) r.total_seconds += s.seconds;
   r.iterations = iterations_done_;
+  if (prefilter_) r.prefilter = prefilter_->regime();
   // The phases before the last trained k x interval for k views held (checkLoadedState
   // holds a resumed run to that); the last trained the rest.
   int before_last = 0;

@@ -37,6 +37,14 @@ class SaPointPrefilter : public CoveragePrefilter {
                                std::to_string(v) + " has none)");
     grids_ = std::make_unique<OccupancyGrids>(OccupancyGrids::fromSfm(pts, oo));
     sets_ = std::make_unique<CandidateSetBuilder>(*grids_);
+    if (config_.scoring.encoding == CoverageEncoding::Hashed && config_.scoring.table_size == 0)
+      config_.scoring.table_size = hashTableSizeFor(grids_->sceneCount());
+  }
+
+  PrefilterRegime regime() const override {
+    PrefilterRegime r{encodingName(config_.scoring), config_.resolution, config_.min_points, grids_->sceneCount(), {}};
+    if (config_.scoring.encoding == CoverageEncoding::Hashed) r.hash = hashLoad(grids_->sceneVoxels(), config_.scoring.table_size);
+    return r;
   }
 
   void observe(const std::vector<int>& views, const ViewRenderer& render, const DepthRenderer& depth,
@@ -162,20 +170,26 @@ void parseCoverageEncoding(std::string_view text, CoverageScoring& scoring, int 
     scoring.encoding = CoverageEncoding::Exact;
     return;
   }
-  if (t.rfind("hash:", 0) != 0) throw std::invalid_argument("prefilter encoding '" + t + "': expected hash:K or exact");
+  if (t == "hash:auto") {
+    scoring.encoding = CoverageEncoding::Hashed;
+    scoring.table_size = 0;
+    return;
+  }
+  if (t.rfind("hash:", 0) != 0) throw std::invalid_argument("prefilter encoding '" + t + "': expected hash:auto, hash:K or exact");
   int bits = 0;
   const std::string digits = t.substr(5);
   if (!digits.empty() && digits.size() <= 2 && std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
     bits = std::stoi(digits);
   if (bits < min_bits || bits > max_bits)
-    throw std::invalid_argument("prefilter encoding '" + t + "': expected hash:" + std::to_string(min_bits) + " .. hash:" +
-                                std::to_string(max_bits) + " or exact");
+    throw std::invalid_argument("prefilter encoding '" + t + "': expected hash:auto, hash:" + std::to_string(min_bits) +
+                                " .. hash:" + std::to_string(max_bits) + " or exact");
   scoring.encoding = CoverageEncoding::Hashed;
   scoring.table_size = std::size_t{1} << bits;
 }
 
 std::string encodingName(const CoverageScoring& s) {
   if (s.encoding == CoverageEncoding::Exact) return "exact";
+  if (s.table_size == 0) return "hash:auto";
   int bits = 0;
   while ((std::size_t{1} << bits) < s.table_size) ++bits;
   return "hash:" + std::to_string(bits);
@@ -195,6 +209,35 @@ std::vector<int> topFraction(const std::vector<double>& scores, const std::vecto
   for (std::size_t i = 0; i < std::min(k, order.size()); ++i) out.push_back(candidates[order[i]]);
   std::sort(out.begin(), out.end());
   return out;
+}
+
+nlohmann::json toJson(const PrefilterRegime& r) {
+  nlohmann::json j = {{"encoding", r.encoding}, {"resolution", r.resolution}, {"min_points", r.min_points}, {"scene_voxels", r.scene_voxels}};
+  if (r.hash) {
+    j["table_size"] = r.hash->table_size;
+    j["load_factor"] = r.hash->load;
+    j["bits_set"] = r.hash->bits_set;
+    j["colliding_voxels"] = r.hash->colliding;
+  }
+  return j;
+}
+
+SceneType parseSceneType(std::string_view text) {
+  if (text == "indoor") return SceneType::kIndoor;
+  if (text == "outdoor") return SceneType::kOutdoor;
+  throw std::invalid_argument("scene type '" + std::string(text) + "': expected indoor or outdoor");
+}
+const char* toString(SceneType t) { return t == SceneType::kIndoor ? "indoor" : "outdoor"; }
+
+void applySceneType(PrefilterConfig& c, SceneType t) {
+  c.min_points = t == SceneType::kIndoor ? 5 : 2;
+  c.resolution = t == SceneType::kIndoor ? 32 : 64;
+}
+
+std::optional<SceneType> sceneTypeOfLayout(std::string_view layout) {
+  if (layout == "room360" || layout == "unbalanced" || layout == "tworooms") return SceneType::kIndoor;
+  if (layout == "object") return SceneType::kOutdoor;
+  return std::nullopt;
 }
 
 std::unique_ptr<CoveragePrefilter> makeCoveragePrefilter(const Scene& scene, const PrefilterConfig& config) {

@@ -7,7 +7,10 @@
 //
 // Options arrive as text at the edges (CLI, ablation grid) and are parsed once, by the
 // parse* functions below, into PrefilterConfig; nothing further in is a string.
+#include <nlohmann/json.hpp>
+
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -31,16 +34,42 @@ enum class LiftingSource { kFlow, kDepth, kOracle };
 
 struct PrefilterConfig {
   CandidateSetKind set = CandidateSetKind::kFrustum;
-  CoverageScoring scoring{CoverageEncoding::Hashed, CoverageCriterion::Hamming, std::size_t{1} << 13};
+  // Table size 0: chosen when the scene grid is built, the smallest 2^K in the paper's
+  // 2^11..2^19 whose load factor (scene voxels / T) is at most 0.5 ("hash:auto"; the
+  // paper's robustness to hash size rests on a low load). Its regime is reported
+  // (CoveragePrefilter::regime).
+  CoverageScoring scoring{CoverageEncoding::Hashed, CoverageCriterion::Hamming, 0};
   double keep_fraction = 0.2;  // top N % kept for Fisher, as a fraction
   int visible_stride = 4;      // pixel stride of the visibility rays
   LiftingSource lifting = LiftingSource::kFlow;
   // Occupancy grid: resolution along the longest side and the SfM points per occupied
-  // voxel. The paper's m = 5 (indoor) at 128 leaves a 12k-point SfM cloud almost empty,
-  // so the default is sized for sparse clouds (see third_party_notes/openvdb.md).
+  // voxel; the defaults are the outdoor ones (applySceneType: the paper's m = 2 outdoor,
+  // m = 5 indoor; the paper gives no resolution).
   int resolution = 64;
   int min_points = 2;
   int upsample = 2;
+};
+
+// The paper's per-scene-type SfM point threshold: m = 5 indoors, 2 outdoors. The paper
+// gives no grid resolution; at m = 5 our 12k-point rooms leave 336 (room360) and 1840
+// (unbalanced) fine voxels occupied at resolution 64 and 8584 / 10304 at 32, so indoor
+// scenes use resolution 32 (coarse voxels of about 30 cm in a 10 m room); outdoor keeps
+// 64 at m = 2.
+enum class SceneType { kIndoor, kOutdoor };
+SceneType parseSceneType(std::string_view text);  // indoor | outdoor
+const char* toString(SceneType t);
+void applySceneType(PrefilterConfig& c, SceneType t);
+// The scene type of a built-in layout (`saresgs scene --layout`): the rooms are indoor,
+// the object outdoor; none for an unknown layout.
+std::optional<SceneType> sceneTypeOfLayout(std::string_view layout);
+
+// What the prefilter's grid and encoding are: scene-occupied voxels (what is hashed),
+// the encoding used ("hash:K" with K resolved, or "exact"), and for a hash its load.
+struct PrefilterRegime {
+  std::string encoding;
+  int resolution = 0, min_points = 0;
+  std::size_t scene_voxels = 0;
+  std::optional<HashLoad> hash;  // none for exact sets
 };
 
 // Parsers of the textual options; each throws std::invalid_argument naming the value and
@@ -89,11 +118,16 @@ class CoveragePrefilter {
   virtual std::vector<double> score(const std::vector<int>& candidates, SelectionSeconds& t) = 0;
   virtual const OccupancyGrids& grids() const = 0;
   virtual const LiftingReport& liftingReport() const = 0;  // summed over observed views
+  virtual PrefilterRegime regime() const = 0;
   // Serialised observed state, so a resumed run continues with the same grids.
   virtual std::string save() const = 0;
   // `source` names the file in errors (a truncated state, a non-finite point).
   virtual void load(const std::string& bytes, const std::string& source) = 0;
 };
+
+// As results.json and coverage.json write it: {encoding, resolution, min_points,
+// scene_voxels, and for a hash table_size, load_factor, bits_set, colliding_voxels}.
+nlohmann::json toJson(const PrefilterRegime& r);
 
 // Throws InputError when the scene has no sparse points (the occupancy grid needs them),
 // or for the oracle source when a train view has no ground-truth depth map.

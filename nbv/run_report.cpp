@@ -102,6 +102,7 @@ RunReport makeRunReport(const Scene& scene, const ActiveOptions& opt, const Acti
   if (r.final_fit) rep.final_fit = fitReport(*r.final_fit);
   if (r.final_fit_views) rep.final_fit_views = fitReport(*r.final_fit_views);
   rep.replay_of = c.replay_of;
+  if (r.prefilter) rep.prefilter_regime = toJson(*r.prefilter);
   return rep;
 }
 
@@ -179,6 +180,7 @@ json toJson(const RunReport& r) {
   if (r.final_fit) j["final_fit"] = fitJson(*r.final_fit);
   if (r.final_fit_views) j["final_fit_views"] = fitJson(*r.final_fit_views);
   if (!r.replay_of.empty()) j["replay_of"] = r.replay_of;
+  if (r.prefilter_regime) j["prefilter_regime"] = *r.prefilter_regime;
   return j;
 }
 
@@ -235,6 +237,7 @@ RunReport runReportFromJson(const json& j, const std::string& src) {
   if (j.contains("final_fit_views")) r.final_fit_views = readFit("final_fit_views");
   else if (r.final_fit && !r.final_fit->residual) r.final_fit_views = r.final_fit;  // written before it was recorded
   if (j.contains("replay_of")) r.replay_of = field<std::string>(j, "replay_of", src, "");
+  if (j.contains("prefilter_regime")) r.prefilter_regime = jsonObject(j["prefilter_regime"], src, "prefilter_regime");
   return r;
 }
 

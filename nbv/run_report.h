@@ -81,6 +81,9 @@ struct RunReport {
   // method that trains plainly the same numbers as final_fit. A report written before it
   // was recorded gets final_fit here when that fit was plain.
   std::optional<FinalFitReport> final_fit_views;
+  // Coverage methods: the prefilter's grid and hash regime, as toJson(PrefilterRegime)
+  // writes it (kept as JSON: the report reads it back as written).
+  std::optional<nlohmann::json> prefilter_regime;
   // A fixed-order replay: the results file whose view sequence this run trained on.
   std::string replay_of;
 };

@@ -11,7 +11,7 @@ namespace {
 
 OccupancyGrids sceneGrid(const Scene& scene, const OccupancyOptions& o) {
   if (scene.points.empty())
-    throw InputError(scene.source, "points", "the surface coverage of the hybrid selector needs sparse SfM points");
+    throw InputError(scene.source, "points", "the hybrid selector (the default --method) needs sparse SfM points for its surface coverage (points3D or points3d.ply); give the dataset points, or choose --method fisher or fvs");
   std::vector<Eigen::Vector3d> pts;
   pts.reserve(scene.points.size());
   for (const auto& p : scene.points) pts.push_back(p.xyz);

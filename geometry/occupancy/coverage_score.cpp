@@ -113,4 +113,21 @@ double criterionValue(const CoverageScore& s, CoverageCriterion c) {
   return c == CoverageCriterion::Hamming ? s.hamming : static_cast<double>(s.new_count);
 }
 
+HashLoad hashLoad(const VoxelSet& voxels, std::size_t table_size) {
+  const HashedBits bits = HashedBits::encode(voxels, table_size);
+  HashLoad h;
+  h.voxels = voxels.size();
+  h.table_size = table_size;
+  h.bits_set = bits.count();
+  h.colliding = h.voxels - h.bits_set;
+  h.load = static_cast<double>(h.voxels) / static_cast<double>(table_size);
+  return h;
+}
+
+std::size_t hashTableSizeFor(std::size_t voxels, double max_load, int min_bits, int max_bits) {
+  for (int k = min_bits; k < max_bits; ++k)
+    if (static_cast<double>(voxels) <= max_load * static_cast<double>(std::size_t{1} << k)) return std::size_t{1} << k;
+  return std::size_t{1} << max_bits;
+}
+
 }  // namespace saresgs

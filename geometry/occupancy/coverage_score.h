@@ -81,4 +81,18 @@ std::vector<CoverageScore> scoreCandidates(const VoxelSet& observed,
 // The value ranked by the prefilter: hamming or new_count.
 double criterionValue(const CoverageScore& s, CoverageCriterion c);
 
+// How full a hash table of T bits is when `voxels` are hashed into it (the paper hashes
+// only occupied voxels and relies on "the effective load factor of the hash table"
+// staying low): load = |voxels| / T; bits_set = distinct bits hit; colliding =
+// |voxels| - bits_set, the voxels that share a bit with an earlier one.
+struct HashLoad {
+  std::size_t voxels = 0, table_size = 0, bits_set = 0, colliding = 0;
+  double load = 0.0;
+};
+// Throws InputError("hash encoding", "table_size", ...) as HashedBits does.
+HashLoad hashLoad(const VoxelSet& voxels, std::size_t table_size);
+// The smallest power of two T = 2^K, K in [min_bits, max_bits], with voxels / T <=
+// max_load (2^max_bits when none is large enough).
+std::size_t hashTableSizeFor(std::size_t voxels, double max_load = 0.5, int min_bits = 11, int max_bits = 19);
+
 }  // namespace saresgs

@@ -6,6 +6,8 @@
 #include <numeric>
 #include <random>
 
+#include "common/tiny_dataset.h"
+#include "geometry/occupancy/occupancy_grid.h"
 #include "nbv/coverage_prefilter.h"
 
 namespace saresgs {
@@ -30,10 +32,15 @@ TEST(CoveragePrefilter, TextualOptionsParseAndNameRoundTrip) {
   parseCoverageEncoding("exact", s);
   EXPECT_EQ(s.encoding, CoverageEncoding::Exact);
   EXPECT_EQ(encodingName(s), "exact");
-  // The default configuration is the paper's: frustum sets, 2^13 hash, XOR, 20 %, flow.
+  parseCoverageEncoding("hash:auto", s);
+  EXPECT_EQ(s.encoding, CoverageEncoding::Hashed);
+  EXPECT_EQ(s.table_size, 0u);
+  EXPECT_EQ(encodingName(s), "hash:auto");
+  // The default configuration is the paper's: frustum sets, a hash sized for a load of at
+  // most 0.5 in 2^11..2^19, XOR, 20 %, flow.
   const PrefilterConfig d;
   EXPECT_EQ(toString(d.set), std::string("frustum"));
-  EXPECT_EQ(encodingName(d.scoring), "hash:13");
+  EXPECT_EQ(encodingName(d.scoring), "hash:auto");
   EXPECT_EQ(toString(d.scoring.criterion), std::string("xor"));
   EXPECT_EQ(d.keep_fraction, 0.2);
   EXPECT_EQ(d.lifting, LiftingSource::kFlow);
@@ -57,6 +64,46 @@ TEST(CoveragePrefilter, BadOptionsNameTheValue) {
   // The sweep's wider range.
   parseCoverageEncoding("hash:2", s, 2, 30);
   EXPECT_EQ(s.table_size, 4u);
+}
+
+// The paper's per-scene-type threshold (5 SfM points per voxel indoors, 2 outdoors), the
+// built-in layouts' types, and the regime a built prefilter reports: its auto-sized hash
+// holds the scene voxels at a load of at most 0.5, the bits it reports are those of the
+// scene voxels' own encoding.
+TEST(CoveragePrefilter, SceneTypesAndTheHashRegimeItReports) {
+  PrefilterConfig c;
+  applySceneType(c, parseSceneType("indoor"));
+  EXPECT_EQ(c.min_points, 5);
+  EXPECT_EQ(c.resolution, 32);
+  applySceneType(c, SceneType::kOutdoor);
+  EXPECT_EQ(c.min_points, 2);
+  EXPECT_EQ(c.resolution, 64);
+  EXPECT_THROW(parseSceneType("cave"), std::invalid_argument);
+  EXPECT_EQ(sceneTypeOfLayout("room360"), SceneType::kIndoor);
+  EXPECT_EQ(sceneTypeOfLayout("unbalanced"), SceneType::kIndoor);
+  EXPECT_EQ(sceneTypeOfLayout("object"), SceneType::kOutdoor);
+  EXPECT_FALSE(sceneTypeOfLayout("forest").has_value());
+
+  const Scene& scene = test::tinyDataset();
+  PrefilterConfig p;
+  p.resolution = 24;
+  const auto pre = makeCoveragePrefilter(scene, p);
+  const PrefilterRegime r = pre->regime();
+  ASSERT_TRUE(r.hash.has_value());
+  EXPECT_EQ(r.scene_voxels, pre->grids().sceneCount());
+  EXPECT_EQ(r.hash->voxels, r.scene_voxels);
+  EXPECT_EQ(r.hash->table_size, hashTableSizeFor(r.scene_voxels));
+  EXPECT_LE(r.hash->load, 0.5);
+  EXPECT_EQ(r.hash->bits_set, HashedBits::encode(pre->grids().sceneVoxels(), r.hash->table_size).count());
+  EXPECT_EQ(r.encoding, encodingName({CoverageEncoding::Hashed, CoverageCriterion::Hamming, r.hash->table_size}));
+  const nlohmann::json j = toJson(r);
+  EXPECT_EQ(j["load_factor"].get<double>(), r.hash->load);
+  EXPECT_EQ(j["table_size"].get<std::size_t>(), r.hash->table_size);
+  p.scoring.encoding = CoverageEncoding::Exact;
+  const PrefilterRegime e = makeCoveragePrefilter(scene, p)->regime();
+  EXPECT_EQ(e.encoding, "exact");
+  EXPECT_FALSE(e.hash.has_value());
+  EXPECT_FALSE(toJson(e).contains("load_factor"));
 }
 
 TEST(CoveragePrefilter, TopFractionCountsTiesAndNaN) {

@@ -274,3 +274,37 @@ TEST(Prefilter, HammingAndNewCountRankDifferently) {
     EXPECT_GT(criterionValue(sc[0], CoverageCriterion::NewCount), criterionValue(sc[1], CoverageCriterion::NewCount));
   }
 }
+
+namespace saresgs {
+namespace {
+
+// Voxels on the x axis hash to x mod T (the y and z products are 0), so the collisions of
+// a hand-made set are known: {0, 1, 2, 3, 9} in T = 8 bits sets bits 0-3, and 9 shares
+// bit 1 with voxel 1.
+TEST(HashLoad, HandMadeSetGivesItsLoadBitsAndCollisions) {
+  std::vector<Voxel> v;
+  for (int x : {0, 1, 2, 3, 9}) v.push_back({x, 0, 0});
+  const VoxelSet s = VoxelSet::fromVoxels(v);
+  const HashLoad h = hashLoad(s, 8);
+  EXPECT_EQ(h.voxels, 5u);
+  EXPECT_EQ(h.table_size, 8u);
+  EXPECT_EQ(h.bits_set, 4u);
+  EXPECT_EQ(h.colliding, 1u);
+  EXPECT_DOUBLE_EQ(h.load, 5.0 / 8.0);
+  // Without 9 there is no collision; in 16 bits 9 has a bit of its own.
+  EXPECT_EQ(hashLoad(VoxelSet::fromVoxels(std::vector<Voxel>(v.begin(), v.end() - 1)), 8).colliding, 0u);
+  EXPECT_EQ(hashLoad(s, 16).colliding, 0u);
+  EXPECT_EQ(hashLoad(VoxelSet{}, 8).load, 0.0);
+}
+
+TEST(HashLoad, TableSizeForALoadOfAtMostAHalf) {
+  EXPECT_EQ(hashTableSizeFor(0), std::size_t{1} << 11);
+  EXPECT_EQ(hashTableSizeFor(1024), std::size_t{1} << 11);  // exactly 0.5
+  EXPECT_EQ(hashTableSizeFor(1025), std::size_t{1} << 12);
+  EXPECT_EQ(hashTableSizeFor(24112), std::size_t{1} << 16);  // room360's scene voxels at grid 64, m = 2
+  EXPECT_EQ(hashTableSizeFor(10'000'000), std::size_t{1} << 19);  // beyond the paper's range: its largest
+  EXPECT_EQ(hashTableSizeFor(300, 0.1, 11, 19), std::size_t{1} << 12);
+}
+
+}  // namespace
+}  // namespace saresgs
