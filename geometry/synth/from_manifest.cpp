@@ -20,13 +20,18 @@ std::optional<SyntheticOptions> syntheticOptionsFromManifest(const std::string& 
   const nlohmann::json* objects = jsonFind(m, "objects", path, "");
   if (!jsonFind(m, "layout", path, "") || !objects) return std::nullopt;
   jsonArray(*objects, path, "objects");
+  const bool two_rooms = jsonString(jsonMember(m, "layout", path, ""), path, "layout") == "tworooms";
   for (std::size_t i = 0; i < objects->size(); ++i) {
     const std::string where = jsonPath("objects", i);
     const nlohmann::json& o = jsonObject((*objects)[i], path, where);
     for (const char* key : {"mesh", "texture"}) {
       const nlohmann::json* v = jsonFind(o, key, path, where);
-      // Files given to --mesh / --texture are not recorded well enough to rebuild.
-      if (!v || jsonString(*v, path, jsonPath(where, key)).rfind("procedural:", 0) != 0) return std::nullopt;
+      // Files given to --mesh / --texture are not recorded well enough to rebuild; the
+      // procedural objects and tworooms' built-in cgal: meshes are.
+      if (!v) return std::nullopt;
+      const std::string src = jsonString(*v, path, jsonPath(where, key));
+      if (src.rfind("procedural:", 0) != 0 && !(two_rooms && std::string(key) == "mesh" && src.rfind("cgal:", 0) == 0))
+        return std::nullopt;
     }
   }
   // Every value is checked before anything is built: a corrupt count must not become

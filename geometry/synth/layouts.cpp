@@ -400,4 +400,95 @@ LayoutResult makeUnbalancedLayout(const Assets& assets, int width, int height,
   return out;
 }
 
+const std::vector<std::string>& twoRoomsDefaultMeshes() {
+  static const std::vector<std::string> kMeshes = {"cgal:cow",  "cgal:elephant",   "cgal:camel",
+                                                   "cgal:homer", "cgal:triceratops", "cgal:pig"};
+  return kMeshes;
+}
+
+LayoutResult makeTwoRoomsLayout(const Assets& assets, int width, int height, std::uint64_t seed,
+                                int num_views) {
+  LayoutResult out;
+  const std::uint64_t s = mix64(seed + 2222);
+  RoomTextures rt;
+  rt.floor = makePlanks(0.2f, 1.4f, rgb(196, 150, 98), rgb(110, 70, 40), s + 10);
+  rt.ceiling = makeSpeckle(1.4f, rgb(238, 236, 228), rgb(160, 158, 150), s + 11);
+  rt.xlo = makeBricks(0.28f, 0.11f, 0.018f, rgb(170, 80, 55), rgb(210, 205, 195), s + 12);
+  rt.xhi = makeMarble(0.8f, rgb(215, 225, 235), rgb(60, 70, 110), s + 13);
+  rt.ylo = makeStripes(Vector3f(0, 0, 1), 0.2f, rgb(120, 170, 110), rgb(240, 236, 205),
+                       rgb(80, 120, 80), s + 14);
+  rt.yhi = makeTiles(0.45f, 0.03f, rgb(210, 170, 80), rgb(245, 240, 225), rgb(90, 80, 70), s + 15);
+  const float half_w = 3.0f, top = 3.0f;
+  addRoom(out, Vector3f(-6, -half_w, 0), Vector3f(6, half_w, top), rt);
+
+  // The dividing wall at x = 0 (16 cm thick) with a doorway |y| <= 0.55, z <= 2.1: two
+  // wall pieces and a lintel. Named room_* like the room's faces (structure, not content).
+  const float t = 0.08f, door = 0.55f, door_top = 2.1f;
+  auto wallTexture = [&](std::uint64_t k) {
+    return makeChecker(0.25f, rgb(235, 230, 220), rgb(70, 90, 120), s + k);
+  };
+  out.objects.push_back(fixedObject("room_divider_south", "box",
+                                    makeBox(Vector3f(-t, -half_w, 0), Vector3f(t, -door, top), 1),
+                                    wallTexture(20), true));
+  out.objects.push_back(fixedObject("room_divider_north", "box",
+                                    makeBox(Vector3f(-t, door, 0), Vector3f(t, half_w, top), 1),
+                                    wallTexture(20), true));
+  out.objects.push_back(fixedObject("room_divider_lintel", "box",
+                                    makeBox(Vector3f(-t, -door, door_top), Vector3f(t, door, top), 1),
+                                    wallTexture(20), true));
+
+  Rng rng(seed ^ 0x2D002D00ull);
+  struct Slot {
+    const char* kind;  // the texture's (and, with no mesh files, the mesh's) kind
+    Vector2f xy;
+    float size;
+  };
+  // Three objects per room around its centre (x = -3 and x = 3), apart by construction.
+  const Slot slots[6] = {{"blob", {-3.0f, 0.0f}, 0.55f},  {"crate", {-3.8f, -0.8f}, 0.45f},
+                         {"cone", {-2.3f, 0.9f}, 0.45f},  {"superquadric", {3.0f, 0.0f}, 0.55f},
+                         {"ball", {3.7f, 0.9f}, 0.45f},   {"donut", {2.4f, -0.9f}, 0.45f}};
+  for (int k = 0; k < 6; ++k) {
+    out.objects.push_back(placeOnFloor(assets, k, contentSpec(slots[k].kind, s + 100 * (k + 1)),
+                                       slots[k].xy, 0.0f, slots[k].size,
+                                       static_cast<float>(rng.uniform(0, 2 * kPi))));
+    // A built-in mesh names its object ("cow"); a file keeps the slot's name.
+    SceneObject& o = out.objects.back();
+    if (o.mesh_source.rfind("cgal:", 0) == 0) o.name = o.mesh_source.substr(5);
+  }
+
+  const int n = num_views > 0 ? num_views : 150;
+  const std::vector<int> counts = apportion({56.0, 16.0, 56.0, 22.0}, n);
+  const Intrinsics K = layoutIntrinsics(width, height, 60.0);
+  auto jitteredCentre = [&](double cx) {
+    return Vector3d(cx + rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.5), 0.4 + rng.uniform(-0.2, 0.2));
+  };
+  // A three-quarter arc of radius 2 about (cx, 0), its gap towards the door, looking in.
+  auto arc = [&](double cx, double from, int m) {
+    for (int i = 0; i < m; ++i) {
+      const double a = from + 1.5 * kPi * (i + 0.5 + rng.uniform(-0.25, 0.25)) / m;
+      const double r = 2.0 + rng.uniform(-0.1, 0.1);
+      const Vector3d eye(cx + r * std::cos(a), r * std::sin(a), 1.6 + 0.2 * std::sin(2 * a) + rng.uniform(-0.05, 0.05));
+      out.cameras.push_back(lookAtf(K, eye, jitteredCentre(cx)));
+    }
+  };
+  arc(-3.0, 0.25 * kPi, counts[0]);  // first room: 45 .. 315 degrees
+  // Through the door, looking ahead (yaw within +-0.35 rad) and a little down.
+  for (int i = 0; i < counts[1]; ++i) {
+    const double x = -1.5 + 3.0 * (i + 0.5) / counts[1];
+    const Vector3d eye(x, rng.uniform(-0.1, 0.1), 1.5 + rng.uniform(-0.05, 0.05));
+    const double yaw = rng.uniform(-0.35, 0.35);
+    const Vector3d target = eye + 2.5 * Vector3d(std::cos(yaw), std::sin(yaw), 0) + Vector3d(0, 0, -0.8);
+    out.cameras.push_back(lookAtf(K, eye, target));
+  }
+  arc(3.0, -0.75 * kPi, counts[2]);  // second room: 225 .. 495 degrees
+  // Looking back from the second room towards the first one's centre: the wall hides
+  // most of it, the doorway shows a slice.
+  for (int i = 0; i < counts[3]; ++i) {
+    const Vector3d eye(rng.uniform(1.0, 2.4), rng.uniform(-1.6, 1.6), 1.5 + rng.uniform(-0.1, 0.1));
+    out.cameras.push_back(lookAtf(K, eye, jitteredCentre(-3.0)));
+  }
+  out.test = everyEighthTest(static_cast<int>(out.cameras.size()), out.train);
+  return out;
+}
+
 }  // namespace saresgs::synth

@@ -13,6 +13,13 @@
 //   unbalanced room [-5,5] x [-3.5,3.5] x [0,3.2] with five objects, two pillars and a
 //              partition wall; 150 cameras along a walk: four dense clusters joined by
 //              sparse stretches; every 8th a test view.
+//   tworooms   two rooms [-6,0] and [0,6] x [-3,3] x [0,3] joined by a doorway (1.1 m wide,
+//              2.1 m high) in the dividing wall at x = 0; three content objects per room
+//              (real meshes by default: makeSyntheticScene passes CGAL's animal and figure
+//              meshes when none are given); 150 cameras on one walk: a three-quarter arc
+//              in the first room, through the door, a three-quarter arc in the second, and
+//              looks back towards the first room, most of which the wall hides; every 8th
+//              a test view.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <memory>
@@ -55,5 +62,11 @@ LayoutResult makeRoom360Layout(const Assets& assets, int width, int height, std:
                                int num_views);
 LayoutResult makeUnbalancedLayout(const Assets& assets, int width, int height,
                                   std::uint64_t seed, int num_views);
+LayoutResult makeTwoRoomsLayout(const Assets& assets, int width, int height, std::uint64_t seed,
+                                int num_views);
+
+// The real meshes the tworooms layout uses when no mesh file is given (cgal:NAME specs
+// for resolveAsset; their up axis is +y).
+const std::vector<std::string>& twoRoomsDefaultMeshes();
 
 }  // namespace saresgs::synth

@@ -8,6 +8,7 @@
 
 #include "geometry/error.h"
 #include "geometry/scene/manifest.h"
+#include "geometry/synth/assets.h"
 #include "geometry/synth/layouts.h"
 #include "geometry/synth/noise.h"
 #include "geometry/synth/procedural_meshes.h"
@@ -274,18 +275,27 @@ SyntheticScene makeSyntheticScene(const SyntheticOptions& opts) {
     throw InputError("options", "num_views",
                      "expected 0 (the layout's default) .. " + std::to_string(kMaxSyntheticViews) + ", got " +
                          std::to_string(opts.num_views));
-  if (opts.layout != "object" && opts.layout != "room360" && opts.layout != "unbalanced")
+  if (opts.layout != "object" && opts.layout != "room360" && opts.layout != "unbalanced" &&
+      opts.layout != "tworooms")
     throw InputError("options", "layout",
-                     "expected object, room360 or unbalanced, got '" + opts.layout + "'");
+                     "expected object, room360, unbalanced or tworooms, got '" + opts.layout + "'");
   synth::Assets assets;
   assets.projection = synth::parseProjection(opts.projection);
   const Eigen::Matrix3f up = synth::upAxisRotation(opts.up_axis);
-  for (const auto& path : opts.meshes) {
-    TriangleMesh m = readMeshFile(path);
+  // tworooms is built from real meshes: CGAL's when the user gives none (recorded by their
+  // cgal:NAME spec, which lets a dataset's manifest rebuild the scene).
+  std::vector<std::string> mesh_files = opts.meshes, mesh_names = opts.meshes;
+  if (mesh_files.empty() && opts.layout == "tworooms")
+    for (const auto& spec : synth::twoRoomsDefaultMeshes()) {
+      mesh_files.push_back(resolveAsset(spec));
+      mesh_names.push_back(spec);
+    }
+  for (std::size_t i = 0; i < mesh_files.size(); ++i) {
+    TriangleMesh m = readMeshFile(mesh_files[i]);
     for (auto& v : m.vertices) v = up * v;
     synth::normaliseMesh(m, 1.0f);
     assets.meshes.push_back(std::move(m));
-    assets.mesh_paths.push_back(path);
+    assets.mesh_paths.push_back(mesh_names[i]);
   }
   for (const auto& path : opts.textures) {
     const Image8 img = readImage(path);
@@ -299,8 +309,10 @@ SyntheticScene makeSyntheticScene(const SyntheticOptions& opts) {
     layout = synth::makeObjectLayout(assets, opts.width, opts.height, opts.seed, opts.num_views);
   else if (opts.layout == "room360")
     layout = synth::makeRoom360Layout(assets, opts.width, opts.height, opts.seed, opts.num_views);
-  else
+  else if (opts.layout == "unbalanced")
     layout = synth::makeUnbalancedLayout(assets, opts.width, opts.height, opts.seed, opts.num_views);
+  else
+    layout = synth::makeTwoRoomsLayout(assets, opts.width, opts.height, opts.seed, opts.num_views);
 
   SyntheticScene scene;
   scene.cameras = std::move(layout.cameras);

@@ -364,7 +364,7 @@ TEST(SyntheticLayouts, ObjectLayoutCountsAndHemisphere) {
 }
 
 TEST(SyntheticLayouts, RoomLayoutsKeepCamerasInsideTheRoomAndOutsideObjects) {
-  for (const char* layout : {"room360", "unbalanced"}) {
+  for (const char* layout : {"room360", "unbalanced", "tworooms"}) {
     const SyntheticScene& s = scene(layout);
     const auto n = s.cameras.size();
     EXPECT_GE(n, 140u) << layout;
@@ -394,7 +394,7 @@ TEST(SyntheticLayouts, RoomLayoutsKeepCamerasInsideTheRoomAndOutsideObjects) {
 }
 
 TEST(SyntheticLayouts, ContentObjectsDoNotIntersect) {
-  for (const char* layout : {"room360", "unbalanced"}) {
+  for (const char* layout : {"room360", "unbalanced", "tworooms"}) {
     const SyntheticScene& s = scene(layout);
     std::vector<Eigen::AlignedBox3f> boxes;
     for (const auto& o : s.manifest["objects"])
@@ -443,8 +443,66 @@ TEST(SyntheticLayouts, SomeObjectsAreHiddenFromSomeUnbalancedViews) {
   EXPECT_GT(blocked_by_occluder, 10);
 }
 
+TEST(SyntheticLayouts, TwoRoomsIsRealMeshesBehindAWallWithADoor) {
+  const SyntheticScene& s = scene("tworooms");
+  const auto names = s.objectNames();
+  // The content is CGAL's meshes, three per room; the divider has a doorway.
+  std::vector<Eigen::AlignedBox3f> dividers;
+  std::vector<Eigen::Vector3f> first_room;  // centres of the content objects at x < 0
+  int content = 0;
+  for (const auto& o : s.manifest["objects"]) {
+    const std::string name = o["name"];
+    const Eigen::AlignedBox3f box(vec3(o["bbox_min"]), vec3(o["bbox_max"]));
+    if (name.rfind("room_divider", 0) == 0) {
+      dividers.push_back(box);
+    } else if (name.rfind("room_", 0) != 0) {
+      ++content;
+      EXPECT_EQ(o["mesh"].get<std::string>().rfind("cgal:", 0), 0u) << name;
+      if (box.center().x() < 0) first_room.push_back(box.center());
+    }
+  }
+  EXPECT_EQ(content, 6);
+  EXPECT_EQ(first_room.size(), 3u);
+  ASSERT_EQ(dividers.size(), 3u);
+  // The walk passes the wall's plane through the door only: no camera inside the wall.
+  int in_first = 0, in_second = 0;
+  for (const Camera& c : s.cameras) {
+    const Eigen::Vector3f p = c.center().cast<float>();
+    for (const auto& b : dividers) EXPECT_FALSE(b.contains(p));
+    (p.x() < 0 ? in_first : in_second) += 1;
+  }
+  EXPECT_GT(in_first, 50);
+  EXPECT_GT(in_second, 50);
+  // From the second room the wall hides the first room's objects from most cameras, and
+  // the doorway shows them to some.
+  int hidden_by_wall = 0, through_door = 0;
+  for (const Camera& c : s.cameras) {
+    const Eigen::Vector3f cc = c.center().cast<float>();
+    if (cc.x() < 0.1f) continue;
+    for (const Eigen::Vector3f& target : first_room) {
+      const SurfaceHit h = s.intersect(cc, target - cc, 0.0f, 1.0f);
+      const bool by_wall = h.hit && names[h.object].rfind("room_divider", 0) == 0;
+      hidden_by_wall += by_wall;
+      // Where the segment crosses x = 0: clear inside the doorway (|y| < 0.55, z < 2.1),
+      // stopped by the wall, or by something before it, outside (10 cm margins: the
+      // wall is 16 cm thick).
+      const float t0 = cc.x() / (cc.x() - target.x());
+      const Eigen::Vector3f at = cc + t0 * (target - cc);
+      const bool in_door = std::abs(at.y()) < 0.45f && at.z() < 2.0f;
+      const bool outside = std::abs(at.y()) > 0.65f || at.z() > 2.2f;
+      if (in_door) EXPECT_FALSE(by_wall) << "segment through the door at (" << at.y() << ", " << at.z() << ")";
+      if (outside)
+        EXPECT_TRUE(by_wall || (h.hit && h.distance < t0 * (target - cc).norm()))
+            << "segment through the wall at (" << at.y() << ", " << at.z() << ")";
+      through_door += in_door;
+    }
+  }
+  EXPECT_GT(hidden_by_wall, 100);
+  EXPECT_GT(through_door, 5);
+}
+
 TEST(SyntheticLayouts, NumViewsOverridesTheCountAndSeedsChangeLayouts) {
-  for (const char* layout : {"object", "room360", "unbalanced"}) {
+  for (const char* layout : {"object", "room360", "unbalanced", "tworooms"}) {
     SyntheticOptions o;
     o.layout = layout;
     o.width = 64;
