@@ -79,9 +79,20 @@ void runSweep(const AblationGrid& g, const AblationJob& j, const std::string& ou
   if (!truth) throw InputError(sc.dataset, "manifest.json", "the prefilter sweep lifts SA-Points from ground-truth renders: needs a `saresgs scene` dataset");
   const ViewRenderer render = [&](const Camera& c) { return truth->render(c); };
   const DepthRenderer depth = [&](const Camera& c) { return truth->renderDepth(c); };
-  const SweepReport report{j.scene, sc.dataset, toString(g.sweep->lifting),
-                           "exact encoding of the Embree-visible sets, same score",
-                           prefilterSweep(scene, *g.sweep, render, depth, 0)};
+  // The occupancy grid of the scene's type (the paper's m = 5 indoors, 2 outdoors), as the
+  // active loop chooses it from the same manifest.
+  PrefilterConfig grid;
+  const std::string layout = truth->manifest.value("layout", std::string());
+  const std::optional<SceneType> type = sceneTypeOfLayout(layout);
+  if (type) applySceneType(grid, *type);
+  PrefilterRegime regime;
+  SweepReport report{j.scene, sc.dataset, toString(g.sweep->lifting),
+                     "exact encoding of the Embree-visible sets, same score",
+                     prefilterSweep(scene, *g.sweep, render, depth, 0, grid, &regime)};
+  report.scene_type = type ? toString(*type) : "";
+  report.resolution = regime.resolution;
+  report.min_points = regime.min_points;
+  report.scene_voxels = regime.scene_voxels;
   fs::create_directories(jobFolder(out, j));
   writeFileAtomic(jobResultFile(out, j), toJson(report).dump(2) + "\n");
 }

@@ -290,8 +290,10 @@ Table sweepTable(const std::vector<JobResult>& results) {
   Table t{"prefilter_sweep",
           "Prefilter variants against the exact visible-set reference (same score): top-N % overlap and Kendall "
           "tau-b of the candidate ranking (mean over observed states), scoring time per selection (encode + "
-          "compare all candidates, median of repeats) and the time to build every candidate's voxel set once",
-          {"scene", "set", "score", "encoding", "top-N overlap", "Kendall tau", "scoring ms", "sets ms"},
+          "compare all candidates, median of repeats) and the time to build every candidate's voxel set once; "
+          "grid: the scene type's occupancy grid (resolution, SfM points per voxel, scene-occupied voxels); load: "
+          "scene voxels / hash table size",
+          {"scene", "grid", "set", "score", "encoding", "load", "top-N overlap", "Kendall tau", "scoring ms", "sets ms"},
           {}};
   for (const JobResult& r : results) {
     if (r.job.kind != AblationJob::Kind::kSweep) continue;
@@ -303,16 +305,23 @@ Table sweepTable(const std::vector<JobResult>& results) {
       if (!rows.count(k)) order.push_back(k);
       rows[k].push_back(&row);
     }
+    const std::string grid = r.sweep.resolution > 0 ? r.sweep.scene_type + " r" + std::to_string(r.sweep.resolution) + " m" +
+                                                          std::to_string(r.sweep.min_points) + ", " +
+                                                          std::to_string(r.sweep.scene_voxels) + " voxels"
+                                                    : "-";
     for (const auto& k : order) {
       std::vector<double> ov, tau, sc, st;
+      double load = 0;
       for (const SweepRow* row : rows[k]) {
         ov.push_back(row->overlap);
         tau.push_back(row->kendall_tau);
         sc.push_back(1000 * row->seconds_scoring);
         st.push_back(1000 * row->seconds_sets);
+        load = row->load;  // the same in every observed state
       }
-      t.rows.push_back({r.job.scene, std::get<0>(k), std::get<1>(k), std::get<2>(k), fmt(meanStd(ov).first, 3),
-                        fmt(meanStd(tau).first, 3), fmt(meanStd(sc).first, 2), fmt(meanStd(st).first, 1)});
+      t.rows.push_back({r.job.scene, grid, std::get<0>(k), std::get<1>(k), std::get<2>(k), load > 0 ? fmt(load, 3) : "-",
+                        fmt(meanStd(ov).first, 3), fmt(meanStd(tau).first, 3), fmt(meanStd(sc).first, 2),
+                        fmt(meanStd(st).first, 1)});
     }
   }
   return t;

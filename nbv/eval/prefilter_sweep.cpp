@@ -53,10 +53,14 @@ nlohmann::json toJson(const SweepReport& r) {
   res["dataset"] = r.dataset;
   res["lifting"] = r.lifting;
   res["reference"] = r.reference;
+  if (r.resolution > 0)
+    res["grid"] = {{"scene_type", r.scene_type}, {"resolution", r.resolution}, {"min_points", r.min_points},
+                   {"scene_voxels", r.scene_voxels}};
   for (const SweepRow& w : r.rows)
     res["rows"].push_back({{"set", w.set}, {"encoding", w.encoding}, {"score", w.score}, {"views", w.views},
                            {"candidates", w.candidates}, {"overlap", w.overlap}, {"kendall_tau", w.kendall_tau},
-                           {"seconds_scoring", w.seconds_scoring}, {"seconds_sets", w.seconds_sets}});
+                           {"seconds_scoring", w.seconds_scoring}, {"seconds_sets", w.seconds_sets},
+                           {"load", w.load}});
   return res;
 }
 
@@ -79,13 +83,21 @@ SweepReport sweepReportFromJson(const nlohmann::json& j, const std::string& sour
   r.dataset = text(j, "dataset", "");
   r.lifting = text(j, "lifting", "");
   r.reference = text(j, "reference", "");
+  if (const nlohmann::json* g = jsonFind(j, "grid", source, "")) {
+    jsonObject(*g, source, "grid");
+    r.scene_type = text(*g, "scene_type", "grid");
+    r.resolution = count(*g, "resolution", "grid");
+    r.min_points = count(*g, "min_points", "grid");
+    r.scene_voxels = static_cast<std::size_t>(count(*g, "scene_voxels", "grid"));
+  }
   const auto& rows = jsonArray(jsonMember(j, "rows", source, ""), source, "rows");
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const std::string at = jsonPath("rows", i);
     const auto& w = rows[i];
     r.rows.push_back({text(w, "set", at), text(w, "encoding", at), text(w, "score", at), count(w, "views", at),
                       count(w, "candidates", at), number(w, "overlap", at), number(w, "kendall_tau", at),
-                      number(w, "seconds_scoring", at), number(w, "seconds_sets", at)});
+                      number(w, "seconds_scoring", at), number(w, "seconds_sets", at),
+                      jsonFind(w, "load", source, at) ? number(w, "load", at) : 0.0});
   }
   return r;
 }
@@ -118,17 +130,19 @@ double topOverlap(const std::vector<double>& a, const std::vector<double>& b, do
 }
 
 std::vector<SweepRow> prefilterSweep(const Scene& scene, const SweepSpec& spec, const ViewRenderer& render,
-                                     const DepthRenderer& depth, std::uint64_t seed) {
+                                     const DepthRenderer& depth, std::uint64_t seed, const PrefilterConfig& grid,
+                                     PrefilterRegime* regime) {
   if (spec.view_counts.empty()) throw std::invalid_argument("prefilter sweep: no view counts");
   std::vector<int> counts = spec.view_counts;
   std::sort(counts.begin(), counts.end());
   const std::vector<int> order = observedOrder(scene, counts.back(), seed);
 
-  PrefilterConfig config;
+  PrefilterConfig config = grid;
   config.lifting = spec.lifting;
-  config.scoring.encoding = CoverageEncoding::Exact;
+  config.scoring = {CoverageEncoding::Exact, CoverageCriterion::Hamming, 0};
   std::unique_ptr<CoveragePrefilter> pf = makeCoveragePrefilter(scene, config);
   const OccupancyGrids& grids = pf->grids();
+  if (regime) *regime = pf->regime();
 
   // Every train view's candidate sets, once per kind, timed per view; the reference
   // always needs the visible sets, whether or not they are swept.
@@ -175,6 +189,8 @@ std::vector<SweepRow> prefilterSweep(const Scene& scene, const SweepSpec& spec, 
         for (std::size_t i : cand) set_s += set_seconds.at(kind)[i];
         for (CoverageScoring o : spec.encodings) {
           o.criterion = score;
+          // hash:auto resolves here as in the active loop (load <= 0.5 on this grid).
+          if (o.encoding == CoverageEncoding::Hashed && o.table_size == 0) o.table_size = hashTableSizeFor(grids.sceneCount());
           std::vector<double> times, v;
           for (int r = 0; r < std::max(1, spec.timing_repeats); ++r) {
             const auto t0 = Clock::now();
@@ -192,6 +208,8 @@ std::vector<SweepRow> prefilterSweep(const Scene& scene, const SweepSpec& spec, 
           row.kendall_tau = kendallTauB(v, ref);
           row.seconds_scoring = times[times.size() / 2];
           row.seconds_sets = set_s;
+          if (o.encoding == CoverageEncoding::Hashed)
+            row.load = static_cast<double>(grids.sceneCount()) / static_cast<double>(o.table_size);
           rows.push_back(row);
         }
       }

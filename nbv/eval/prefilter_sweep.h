@@ -40,19 +40,30 @@ struct SweepRow {
   double kendall_tau = 0;      // tau-b between the variant's and the reference's scores
   double seconds_scoring = 0;  // encode + compare all candidates (median of repeats)
   double seconds_sets = 0;     // building the candidates' voxel sets (no cache)
+  double load = 0;             // hash: scene-occupied voxels / table size (0 for exact sets)
 };
 
 // One sweep job's result file (sweep.json).
 struct SweepReport {
   std::string scene, dataset, lifting, reference;
   std::vector<SweepRow> rows;
+  // The occupancy grid swept (the scene type's, from the dataset's layout): scene type
+  // ("" when unknown: the outdoor defaults), resolution, SfM points per voxel, and the
+  // scene-occupied voxels every hash encodes. Absent from older sweep.json files (0).
+  std::string scene_type;
+  int resolution = 0, min_points = 0;
+  std::size_t scene_voxels = 0;
 };
 nlohmann::json toJson(const SweepReport& r);
 // Throws InputError naming `source` and the field.
 SweepReport sweepReportFromJson(const nlohmann::json& j, const std::string& source);
 
+// `grid` gives the occupancy grid and ray settings (resolution, min_points, upsample,
+// visible_stride; its lifting and scoring are the spec's); `regime`, if given, receives the
+// grid's (exact) regime: resolution, min_points, scene voxels.
 std::vector<SweepRow> prefilterSweep(const Scene& scene, const SweepSpec& spec, const ViewRenderer& render,
-                                     const DepthRenderer& depth, std::uint64_t seed = 0);
+                                     const DepthRenderer& depth, std::uint64_t seed = 0,
+                                     const PrefilterConfig& grid = {}, PrefilterRegime* regime = nullptr);
 
 // Kendall's tau-b of two score vectors of equal length (ties counted as in tau-b); 1 for
 // fewer than two items or when either vector is constant and the other is too.

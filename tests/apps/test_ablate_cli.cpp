@@ -89,6 +89,8 @@ TEST(AblateCli, TwoShardsAndAMergeMakeTablesAndPlots) {
   EXPECT_TRUE(fs::exists(a + "/tables/time.csv"));
   const std::string sweep = readBytes(a + "/tables/prefilter_sweep.md");
   EXPECT_EQ(count(sweep, "| tiny |"), 2 * 2 * 3) << sweep;  // sets x scores x encodings
+  // The object layout sweeps the outdoor grid (m = 2), and says so with each hash's load.
+  EXPECT_NE(sweep.find("| tiny | outdoor r64 m2, "), std::string::npos) << sweep;
   for (const char* p : {"psnr", "final_fit_psnr", "final_fit_per_view", "psnr_vs_views", "psnr_vs_selection_time", "prefilter_sweep_tiny"}) {
     const saresgs::Image8 img = saresgs::readImage(a + "/plots/" + p + ".png");
     EXPECT_GT(img.width, 100) << p;

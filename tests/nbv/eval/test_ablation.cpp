@@ -263,8 +263,10 @@ TEST(Ablation, PrefilterSweepReferenceIsExactAndACollisionFreeHashMatchesIt) {
   }
   spec.lifting = LiftingSource::kDepth;
   spec.timing_repeats = 1;
+  PrefilterRegime regime;
   const auto rows = prefilterSweep(
-      scene, spec, [&](const Camera& c) { return truth->render(c); }, [&](const Camera& c) { return truth->renderDepth(c); });
+      scene, spec, [&](const Camera& c) { return truth->render(c); }, [&](const Camera& c) { return truth->renderDepth(c); },
+      0, PrefilterConfig{}, &regime);
   ASSERT_EQ(rows.size(), 2u * 2 * 2 * 3);  // views x scores x sets x encodings
   // Are the scene voxels collision-free in a 2^20 table? Then hashed scores order the
   // candidates exactly as the exact ones do.
@@ -287,6 +289,26 @@ TEST(Ablation, PrefilterSweepReferenceIsExactAndACollisionFreeHashMatchesIt) {
     }
   }
   EXPECT_TRUE(collision_free) << "pick a larger table for the test";
+  // The grid swept is reported, and each hash's load is its scene voxels over its size.
+  EXPECT_EQ(regime.scene_voxels, pf->grids().sceneCount());
+  EXPECT_EQ(regime.min_points, PrefilterConfig{}.min_points);
+  for (const SweepRow& r : rows) {
+    const double expected = r.encoding == "hash:2" ? regime.scene_voxels / 4.0
+                            : r.encoding == "hash:20" ? regime.scene_voxels / double(1u << 20)
+                                                      : 0.0;
+    EXPECT_DOUBLE_EQ(r.load, expected) << r.encoding;
+  }
+  // An indoor grid (the paper's m = 5, resolution 32) is the one swept when given.
+  PrefilterConfig indoor;
+  applySceneType(indoor, SceneType::kIndoor);
+  spec.view_counts = {4};
+  spec.encodings.resize(1);
+  PrefilterRegime indoor_regime;
+  prefilterSweep(scene, spec, [&](const Camera& c) { return truth->render(c); },
+                 [&](const Camera& c) { return truth->renderDepth(c); }, 0, indoor, &indoor_regime);
+  EXPECT_EQ(indoor_regime.min_points, 5);
+  EXPECT_EQ(indoor_regime.resolution, 32);
+  EXPECT_EQ(indoor_regime.scene_voxels, makeCoveragePrefilter(scene, indoor)->grids().sceneCount());
 }
 
 // Found with the ablation-config fuzz target (fuzz/fuzz_ablation_config.cpp): numbers of
