@@ -24,7 +24,7 @@ std::string findModelDir(const fs::path& root, const std::string& requested) {
     if (fs::exists(c / "cameras.bin") || fs::exists(c / "cameras.txt")) return c.string();
   throw InputError(root.string(), "sparse model",
                    "expected a COLMAP model in sparse/0, sparse or the folder itself, or a "
-                   "transforms_train.json (Blender)");
+                   "transforms_train.json (Blender) or transforms.json (nerfstudio)");
 }
 
 std::string modelFile(const std::string& dir, const char* stem) {

@@ -96,6 +96,7 @@ Scene loadDataset(const std::string& path, const DatasetOptions& opts) {
   const fs::path p(path);
   if (!fs::exists(p)) throw InputError(path, "dataset", "folder does not exist");
   if (fs::exists(p / "transforms_train.json")) return loadBlenderDataset(path, opts);
+  if (fs::exists(p / "transforms.json")) return loadNerfstudioDataset(path, opts);
   return loadColmapDataset(path, opts);
 }
 

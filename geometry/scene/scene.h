@@ -89,10 +89,18 @@ struct DatasetOptions {
 };
 
 // Loads a dataset folder: a NeRF-synthetic/Blender folder (transforms_train.json), a
+// nerfstudio folder (transforms.json), a
 // COLMAP folder (sparse model + images/), or a synthetic scene written by `saresgs scene`
 // (a COLMAP folder with depth/). Throws InputError with file and field on bad input.
 Scene loadDataset(const std::string& path, const DatasetOptions& opts = {});
 Scene loadColmapDataset(const std::string& path, const DatasetOptions& opts = {});
 Scene loadBlenderDataset(const std::string& path, const DatasetOptions& opts = {});
+// nerfstudio's transforms.json: fl_x, fl_y, cx, cy, w, h at the top level or per frame;
+// camera_model PINHOLE / SIMPLE_PINHOLE, or OPENCV / SIMPLE_RADIAL / RADIAL with zero
+// distortion (anything else is refused by field: saresgs does not undistort); poses in
+// OpenGL axes as Blender's; applied_transform checked; ply_file_path gives the points;
+// split from train_filenames / test_filenames (or val_filenames), else every
+// test_every-th view by name. JPEG or PNG images.
+Scene loadNerfstudioDataset(const std::string& path, const DatasetOptions& opts = {});
 
 }  // namespace saresgs
