@@ -11,6 +11,7 @@
 #include "apps/progress.h"
 #include "geometry/io/atomic_file.h"
 #include "geometry/io/json_file.h"
+#include "geometry/scene/cameras_json.h"
 #include "nbv/active_run.h"
 #include "nbv/eval/camera_plot.h"
 #include "nbv/preset.h"
@@ -130,6 +131,7 @@ int runActive(const ActiveArgs& a) {
   const Trainer& t = run.trainer();
   writeTestRenders(t, r.test, a.out + "/test_renders");
   writeGaussiansPly(a.out + "/point_cloud.ply", t.gaussians());
+  writeCamerasJson(a.out + "/cameras.json", scene);  // beside the .ply files, for splat viewers
   writeImage(a.out + "/cameras.png", plotCameras(scene, r.initial_views, r.selected_views));
   if (const Trainer* f = run.finalFitTrainer()) writeGaussiansPly(a.out + "/final_fit.ply", f->gaussians());
   if (const Trainer* f = run.finalFitViewsTrainer()) writeGaussiansPly(a.out + "/final_fit_views.ply", f->gaussians());

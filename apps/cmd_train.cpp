@@ -13,6 +13,7 @@
 #include "apps/view_list.h"
 #include "geometry/error.h"
 #include "geometry/io/atomic_file.h"
+#include "geometry/scene/cameras_json.h"
 #include "geometry/scene/scene.h"
 #include "splat/ply.h"
 #include "splat/raster_execution.h"
@@ -88,6 +89,7 @@ int runTrain(TrainArgs& a) {
   const Evaluation ev = trainer.evaluate(eval_views);
   writeTestRenders(trainer, ev, a.out + "/test_renders");
   writeGaussiansPly(a.out + "/point_cloud.ply", trainer.gaussians());
+  writeCamerasJson(a.out + "/cameras.json", scene);  // beside the .ply, for splat viewers
 
   nlohmann::json j;
   j["dataset"] = a.dataset;

@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
@@ -93,7 +94,12 @@ TEST(NerfstudioCli, TransformsJsonTrainsAsTheBlenderFolderDoes) {
     r = run("train --dataset " + d.file(which) + " --iterations 300 --seed 0 --threads 1 --out " + d.file(std::string("t_") + which));
     ASSERT_EQ(r.code, 0) << r.output;
   }
+  // cameras.json beside the .ply: every view, named by its image.
+  const json cams = saresgs::readJsonFile(d.file("t_ns/cameras.json"));
+  ASSERT_EQ(cams.size(), n.views.size());
+  EXPECT_EQ(cams[5]["img_name"], fs::path(n.views[5].name).stem().string());
   const double pb = psnrOf(d.file("t_blender/results.json")), pn = psnrOf(d.file("t_ns/results.json"));
+  std::printf("trained PSNR: Blender folder %.3f dB, nerfstudio folder %.3f dB\n", pb, pn);
   EXPECT_GT(pb, 15.0);
   EXPECT_NEAR(pn, pb, 0.25) << "Blender " << pb << " dB, nerfstudio " << pn << " dB";
 }
