@@ -9,6 +9,7 @@
 #include "apps/commands.h"
 #include "apps/prefilter_flags.h"
 #include "apps/progress.h"
+#include "geometry/scene/dataset_checks.h"
 #include "geometry/io/atomic_file.h"
 #include "geometry/io/json_file.h"
 #include "geometry/scene/cameras_json.h"
@@ -107,6 +108,7 @@ int runActive(const ActiveArgs& a) {
   DatasetOptions dopt;
   dopt.load.downscale = a.downscale;
   const Scene scene = loadDataset(a.dataset, dopt);
+  std::cerr << formatWarnings(checkDataset(scene));
   if (!a.replay.empty()) {
     const RunReport replayed = runReportFromJson(readJsonFile(a.replay), a.replay);
     opt.replay = replaySequence(scene, replayed, a.replay);

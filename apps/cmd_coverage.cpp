@@ -11,6 +11,7 @@
 #include "apps/commands.h"
 #include "apps/prefilter_flags.h"
 #include "apps/view_list.h"
+#include "geometry/scene/dataset_checks.h"
 #include "geometry/error.h"
 #include "geometry/io/atomic_file.h"
 #include "geometry/synth/from_manifest.h"
@@ -34,6 +35,7 @@ int runCoverage(const CoverageArgs& a) {
   DatasetOptions dopt;
   dopt.load.downscale = a.downscale;
   const Scene scene = loadDataset(a.dataset, dopt);
+  std::cerr << formatWarnings(checkDataset(scene));
   const std::vector<int> views = parseTrainViews(a.views, scene, "--views");
   ViewRenderer render;
   DepthRenderer depth;

@@ -2,6 +2,7 @@
 #include <iostream>
 
 #include "apps/commands.h"
+#include "geometry/scene/dataset_checks.h"
 #include "geometry/scene/scene.h"
 
 namespace saresgs::apps {
@@ -15,6 +16,7 @@ struct InfoArgs {
 
 int runInfo(const InfoArgs& a) {
   const Scene s = loadDataset(a.dataset, a.opts);
+  std::cerr << formatWarnings(checkDataset(s));
   const Intrinsics& K = s.views.front().camera.K;
   int with_depth = 0;
   for (size_t i = 0; i < s.views.size(); ++i) with_depth += s.hasDepth(static_cast<int>(i));

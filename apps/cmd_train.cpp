@@ -11,6 +11,7 @@
 #include "apps/commands.h"
 #include "apps/progress.h"
 #include "apps/view_list.h"
+#include "geometry/scene/dataset_checks.h"
 #include "geometry/error.h"
 #include "geometry/io/atomic_file.h"
 #include "geometry/scene/cameras_json.h"
@@ -52,6 +53,7 @@ int runTrain(TrainArgs& a) {
   DatasetOptions dopt;
   dopt.load.downscale = a.downscale;
   const Scene scene = loadDataset(a.dataset, dopt);
+  std::cerr << formatWarnings(checkDataset(scene));
   if (a.schedule_scale != 1.0) a.opt = scaledSchedule(a.opt, a.schedule_scale);
   const std::vector<int> views = a.views.empty() ? scene.train : parseTrainViews(a.views, scene, "--views");
   fs::create_directories(a.out);

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
+#include <sstream>
 
 #include "common/run_command.h"
 #include "common/test_support.h"
@@ -199,4 +200,44 @@ TEST(Cli, FinalFitEqualsTrainOnTheChosenViews) {
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.output.find("--views"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("twice"), std::string::npos) << r.output;
+}
+
+// Intrinsics typed in the wrong unit: a focal length of 0.001 px (every point squeezed
+// onto the principal point) is warned about by view and field; a principal point at
+// (5000, -3000) for a 64x48 image leaves every view blind to the model's points, and the
+// commands refuse it, naming the cameras and the first view's field.
+TEST(Cli, ImplausibleIntrinsicsAreWarnedAboutOrRefusedByField) {
+  TempDir d;
+  Result r = run("scene --layout room360 --views 16 --width 64 --height 48 --out " + d.file("s"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  const std::string cams = d.file("s/sparse/0/cameras.txt"), original = saresgs::test::readBytes(cams);
+  auto edit = [&](const std::string& f, const std::string& cx, const std::string& cy) {
+    std::istringstream in(original);
+    std::string out;
+    for (std::string line; std::getline(in, line);) {
+      if (!line.empty() && line[0] != '#') {
+        // SIMPLE_PINHOLE: f cx cy; PINHOLE: fx fy cx cy.
+        std::istringstream fields(line);
+        std::string id, model, w, h, fx, fy, x, y;
+        fields >> id >> model >> w >> h >> fx;
+        if (model == "PINHOLE") fields >> fy;
+        fields >> x >> y;
+        line = id + " " + model + " " + w + " " + h + " " + (f.empty() ? fx : f) +
+               (model == "PINHOLE" ? " " + (f.empty() ? fy : f) : std::string()) + " " + (cx.empty() ? x : cx) + " " +
+               (cy.empty() ? y : cy);
+      }
+      out += line + "\n";
+    }
+    saresgs::test::writeBytes(cams, out);
+  };
+  edit("0.001", "", "");
+  r = run("info --dataset " + d.file("s"));
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("warning: 0001.png: fx: fx = 0.001 px"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("more like these"), std::string::npos) << r.output;
+  edit("", "5000", "-3000");
+  r = run("info --dataset " + d.file("s"));
+  EXPECT_NE(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("intrinsics or poses"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("cx = 5000"), std::string::npos) << r.output;
 }
