@@ -229,12 +229,33 @@ void Trainer::train(const std::vector<int>& views, int iterations,
     if (v < 0 || v >= static_cast<int>(scene_.views.size()))
       throw std::invalid_argument("Trainer::train: view index " + std::to_string(v) + " is not in the scene");
   plan_end_ = std::max(planned_until_, iteration_ + iterations);
+  int view = -1;
   for (int k = 0; k < iterations; ++k) {
-    const double loss = step(nextView(views));
+    view = nextView(views);
+    const double loss = step(view);
     loss_ema_ = iteration_ == 1 ? loss : 0.4 * loss + 0.6 * loss_ema_;
     if (progress) progress({iteration_, k + 1, iterations, loss, loss_ema_, g_.size()});
   }
+  if (opt_.finite_check_interval > 0 && view >= 0) checkFinite(view);
   plan_end_ = 0;
+}
+
+void Trainer::checkFinite(int view) const {
+  static constexpr const char* kNames[] = {"means", "log_scales", "rotations", "opacities", "sh"};
+  int k = 0;
+  std::string bad;
+  std::size_t index = 0;
+  g_.forEachArray([&](const std::vector<float>& a, std::size_t per) {
+    for (std::size_t i = 0; i < a.size() && bad.empty(); ++i)
+      if (!std::isfinite(a[i])) {
+        bad = kNames[k];
+        index = i / per;
+      }
+    ++k;
+  });
+  if (!bad.empty())
+    throw TrainingDiverged(iteration_, view, scene_.views.at(static_cast<std::size_t>(view)).name, bad,
+                           "of Gaussian " + std::to_string(index) + " is not finite");
 }
 
 double Trainer::step(int view) {
@@ -250,6 +271,9 @@ double Trainer::step(int view) {
 
   const ViewLoss vl = viewLossAndGradient(g_, cam, s, gt, opt_.lambda_ssim, opt_.residual, rng_, grad_, grad2d_, seconds_);
   const double loss = vl.loss;
+  if (!std::isfinite(loss))
+    throw TrainingDiverged(iteration_, view, scene_.views.at(static_cast<std::size_t>(view)).name, "loss",
+                           "is " + std::to_string(loss));
   const std::vector<float>& radii = vl.radii;
   const std::vector<std::uint8_t>& visible = vl.visible;
 
@@ -278,6 +302,7 @@ double Trainer::step(int view) {
     if (due && room) resetOpacity(g_, adam_);
   }
   seconds_.densify += since(t0);
+  if (opt_.finite_check_interval > 0 && iteration_ % opt_.finite_check_interval == 0) checkFinite(view);
   return loss;
 }
 

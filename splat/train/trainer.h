@@ -17,6 +17,8 @@
 #include <map>
 #include <random>
 #include <string>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "geometry/scene/scene.h"
@@ -41,6 +43,27 @@ struct TrainerOptions {
   int random_init_points = 100000;  // used when the scene has no sparse points (3DGS's count)
   float initial_opacity = 0.1f;
   std::uint64_t seed = 0;
+  // Divergence guard: every step checks its loss, and every this many iterations (and at
+  // the end of train()) the model's arrays are checked for NaN or infinity (0: never).
+  int finite_check_interval = 100;
+};
+
+// Thrown when training stops being finite: the iteration, the view, and what was found
+// not finite ("loss", or a model array: "means", "log_scales", "rotations", "opacities",
+// "sh"). Nothing after it should be written as a result.
+class TrainingDiverged : public std::runtime_error {
+ public:
+  TrainingDiverged(int iteration, int view, const std::string& view_name, const std::string& what,
+                   const std::string& detail)
+      : std::runtime_error("training diverged at iteration " + std::to_string(iteration) + " (view " +
+                           std::to_string(view) + ", " + view_name + "): " + what + " " + detail +
+                           "; lower the learning rates (--schedule-scale, or the preset), or check the data"),
+        iteration(iteration), view(view), what_(what) {}
+  int iteration, view;
+  const std::string& quantity() const { return what_; }
+
+ private:
+  std::string what_;
 };
 
 struct StageSeconds {
@@ -100,6 +123,8 @@ class Trainer {
   void planUntil(int iteration) { planned_until_ = iteration; }
   // One iteration on view `view`; returns its loss.
   double step(int view);
+  // Throws TrainingDiverged naming the first model array that holds NaN or infinity.
+  void checkFinite(int view) const;
 
   RenderResult render(const Camera& cam) const;
   Evaluation evaluate(const std::vector<int>& views) const;

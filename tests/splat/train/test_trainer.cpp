@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 
 #include "splat/raster/raster_test_scenes.h"
@@ -111,6 +112,44 @@ TEST(Trainer, TrainingRaisesTrainPsnr) {
   EXPECT_GT(after, before + 3.0) << before << " -> " << after;
   EXPECT_NE(t.gaussians().size(), s.points.size());  // densification ran
   EXPECT_TRUE(allFinite(t.gaussians()));
+}
+
+// The divergence guard: a non-finite value in the model is found and named (array and
+// Gaussian), a step that meets it stops with TrainingDiverged, and learning rates 1e4
+// times too large either train finite or stop named, never leave NaN in a finished model.
+TEST(Trainer, DivergenceIsStoppedAndNamed) {
+  const Scene& s = tinyDataset();
+  {
+    Trainer t(s, quickOptions());
+    t.checkFinite(s.train[0]);  // a fresh model is finite
+    t.mutableGaussians().opacities[5] = std::numeric_limits<float>::quiet_NaN();
+    try {
+      t.checkFinite(s.train[0]);
+      ADD_FAILURE() << "a NaN opacity passed the check";
+    } catch (const TrainingDiverged& e) {
+      EXPECT_EQ(e.quantity(), "opacities");
+      EXPECT_NE(std::string(e.what()).find("Gaussian 5 "), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(s.views[s.train[0]].name), std::string::npos) << e.what();
+    }
+  }
+  {
+    TrainerOptions o = quickOptions();
+    o.finite_check_interval = 1;
+    Trainer t(s, o);
+    for (float& m : t.mutableGaussians().means) m = std::numeric_limits<float>::infinity();
+    EXPECT_THROW(t.step(s.train[0]), TrainingDiverged);
+  }
+  TrainerOptions o = quickOptions();
+  for (float* lr : {&o.lr.means, &o.lr.log_scales, &o.lr.rotations, &o.lr.opacities, &o.lr.sh_dc, &o.lr.sh_rest}) *lr *= 1e4f;
+  Trainer t(s, o);
+  bool stopped = false;
+  try {
+    t.train(s.train, 200);
+  } catch (const TrainingDiverged& e) {
+    stopped = true;
+    EXPECT_GT(e.iteration, 0);
+  }
+  if (!stopped) EXPECT_TRUE(allFinite(t.gaussians()));
 }
 
 TEST(Trainer, SameSeedSameParametersBitForBit) {
