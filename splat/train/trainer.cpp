@@ -1,6 +1,8 @@
 #include "splat/train/trainer.h"
 
 #include <algorithm>
+#include <optional>
+#include <utility>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -107,6 +109,20 @@ struct Reader {
     return g;
   }
 };
+
+// The first model array holding NaN or infinity ("means", "log_scales", "rotations",
+// "opacities", "sh", in forEachArray's order) and the Gaussian it belongs to.
+std::optional<std::pair<const char*, std::size_t>> firstNonFinite(const Gaussians& g) {
+  static constexpr const char* kNames[] = {"means", "log_scales", "rotations", "opacities", "sh"};
+  std::optional<std::pair<const char*, std::size_t>> found;
+  int k = 0;
+  g.forEachArray([&](const std::vector<float>& a, std::size_t per) {
+    for (std::size_t i = 0; i < a.size() && !found; ++i)
+      if (!std::isfinite(a[i])) found = std::pair{kNames[k], i / per};
+    ++k;
+  });
+  return found;
+}
 
 }  // namespace
 
@@ -241,21 +257,9 @@ void Trainer::train(const std::vector<int>& views, int iterations,
 }
 
 void Trainer::checkFinite(int view) const {
-  static constexpr const char* kNames[] = {"means", "log_scales", "rotations", "opacities", "sh"};
-  int k = 0;
-  std::string bad;
-  std::size_t index = 0;
-  g_.forEachArray([&](const std::vector<float>& a, std::size_t per) {
-    for (std::size_t i = 0; i < a.size() && bad.empty(); ++i)
-      if (!std::isfinite(a[i])) {
-        bad = kNames[k];
-        index = i / per;
-      }
-    ++k;
-  });
-  if (!bad.empty())
-    throw TrainingDiverged(iteration_, view, scene_.views.at(static_cast<std::size_t>(view)).name, bad,
-                           "of Gaussian " + std::to_string(index) + " is not finite");
+  if (const auto bad = firstNonFinite(g_))
+    throw TrainingDiverged(iteration_, view, scene_.views.at(static_cast<std::size_t>(view)).name, bad->first,
+                           "of Gaussian " + std::to_string(bad->second) + " is not finite");
 }
 
 double Trainer::step(int view) {
@@ -386,13 +390,8 @@ void Trainer::loadCheckpoint(const std::string& path) {
   const auto step = r.pod<std::int64_t>("adam.step");
   if (step < 0) throw InputError(path, "adam.step", "negative");
   // NaN or infinity in the model or its moments would poison every later step.
-  for (const auto& [model, name] : {std::pair{&g, "gaussians"}, std::pair{&m, "adam.m"}, std::pair{&v, "adam.v"}}) {
-    bool finite = true;
-    model->forEachArray([&](const std::vector<float>& a, std::size_t) {
-      for (float x : a) finite = finite && std::isfinite(x);
-    });
-    if (!finite) throw InputError(path, name, "holds NaN or infinite values");
-  }
+  for (const auto& [model, name] : {std::pair{&g, "gaussians"}, std::pair{&m, "adam.m"}, std::pair{&v, "adam.v"}})
+    if (firstNonFinite(*model)) throw InputError(path, name, "holds NaN or infinite values");
   DensifyStats st;
   st.grad_accum = r.vec<float>("stats.grad_accum", g.size());
   st.count = r.vec<std::int32_t>("stats.count", g.size());
