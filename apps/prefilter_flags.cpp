@@ -32,12 +32,7 @@ PrefilterConfig parsePrefilterFlags(const PrefilterFlags& f, PrefilterConfig c, 
       applySceneType(c, parseSceneType(f.scene));
       return;
     }
-    std::optional<SceneType> t;
-    const std::string manifest = dataset + "/manifest.json";
-    if (!dataset.empty() && std::filesystem::exists(manifest)) {
-      const nlohmann::json j = readJsonFile(manifest);
-      if (j.is_object() && j.contains("layout") && j["layout"].is_string()) t = sceneTypeOfLayout(j["layout"].get<std::string>());
-    }
+    const std::optional<SceneType> t = sceneTypeOfDataset(dataset);
     applySceneType(c, t.value_or(SceneType::kOutdoor));
   });
   parseOption(prefix + "set", [&] { c.set = parseCandidateSet(f.set); });

@@ -40,6 +40,9 @@ ActiveRun::ActiveRun(const Scene& scene, const ActiveOptions& opt, std::string c
   to.seed = opt_.seed;
   to.residual.enabled = needs.residual;
   if (!opt_.replay.empty()) checkReplay();
+  if (opt_.method == Method::kCustom && !opt_.custom_selector && opt_.replay.empty())
+    throw std::invalid_argument("method custom: a selector function written by the caller (the Python module's "
+                                "saresgs.ActiveRun(dataset, selector=f)); the command line has none");
   trainer_ = std::make_unique<Trainer>(scene_, to);
   // A replay selects nothing, so it needs no prefilter.
   if (needs.coverage && opt_.replay.empty()) prefilter_ = makeCoveragePrefilter(scene_, opt_.prefilter);
@@ -103,6 +106,17 @@ int ActiveRun::selectNext(SelectionLog& log) {
     const int next = opt_.replay.at(selected_.size());
     log.candidates = {next};
     return next;
+  }
+  if (opt_.method == Method::kCustom) {
+    log.candidates = candidates;
+    const int v = opt_.custom_selector(SelectionContext{scene_, *trainer_, selected_, candidates, rng_, opt_.fisher_lambda}, log);
+    if (std::find(candidates.begin(), candidates.end(), v) == candidates.end())
+      throw std::invalid_argument("custom selector: it chose view " + std::to_string(v) + ", which is not a candidate (a train view not held)");
+    if (!log.scores.empty() && log.scores.size() != candidates.size())
+      throw std::invalid_argument("custom selector: " + std::to_string(log.scores.size()) + " scores for " +
+                                  std::to_string(candidates.size()) + " candidates");
+    log.candidates = candidates;
+    return v;
   }
   const MethodNeeds needs = needsOf(opt_.method);
   std::vector<int> pool = candidates;
@@ -177,9 +191,10 @@ int ActiveRun::selectNext(SelectionLog& log) {
   return pool[argmaxScore(log.scores, pool)];
 }
 
-ActiveResult ActiveRun::run(const std::function<void(const ActiveProgress&)>& progress) {
-  const auto start = Clock::now();
-  progress_ = progress;
+void ActiveRun::begin() {
+  if (begun_) return;
+  begun_ = true;
+  start_ = Clock::now();
   last_ = {};
   last_.max_views = opt_.max_views;
   if (!loadCheckpoint()) {
@@ -189,47 +204,105 @@ ActiveResult ActiveRun::run(const std::function<void(const ActiveProgress&)>& pr
     if (!opt_.replay.empty()) initial_.assign(opt_.replay.begin(), opt_.replay.begin() + static_cast<long>(initial_.size()));
     selected_ = initial_;
   }
-  std::vector<int> progress_views;
+  progress_views_.clear();
   for (std::size_t i = 0; i < scene_.test.size() && static_cast<int>(i) < opt_.progress_test_views; ++i)
-    progress_views.push_back(scene_.test[i * scene_.test.size() / std::min<std::size_t>(scene_.test.size(), opt_.progress_test_views)]);
-  double last_psnr = 0;
-  while (true) {
-    const int k = static_cast<int>(selected_.size());
-    const bool last = k >= opt_.max_views || k >= static_cast<int>(scene_.train.size());
-    const int phase = last ? std::max(opt_.total_iterations - iterations_done_, k * opt_.interval) : k * opt_.interval;
-    if (opt_.reset_after_add) {
-      trainer_->reset();
-      if (opt_.global_sh_clock) trainer_->setShClockStart(iterations_done_);
-    }
-    const auto t0 = Clock::now();
-    last_.views = k;
-    last_.total_iterations = std::max(opt_.total_iterations, iterations_done_ + phase);
-    last_.psnr = last_psnr;
-    trainer_->train(selected_, phase, [&](const TrainProgress& p) {
-      last_.iteration = iterations_done_ + p.done;
-      last_.loss = p.loss_ema;
-      report(ActivePhase::kTraining, p.done, phase);
-    });
-    const double train_s = since(t0);
-    iterations_done_ += phase;
-    if (!progress_views.empty()) last_psnr = trainer_->evaluate(progress_views).psnr;
-    if (last) {
-      // The final phase's training belongs to no selection; a log entry without a
-      // selected view keeps it in the totals.
-      SelectionSeconds tail;
-      tail.training = train_s;
-      steps_.push_back({k, -1, {}, {}, {}, tail, last_psnr});
-      break;
-    }
-    SelectionLog log;
-    log.seconds.training = train_s;
-    log.progress_psnr = last_psnr;
-    const int next = selectNext(log);
-    log.selected = next;
-    selected_.push_back(next);
-    steps_.push_back(std::move(log));
-    saveCheckpoint();
+    progress_views_.push_back(scene_.test[i * scene_.test.size() / std::min<std::size_t>(scene_.test.size(), opt_.progress_test_views)]);
+  last_psnr_ = 0;
+}
+
+bool ActiveRun::lastPhase() const {
+  const int k = static_cast<int>(selected_.size());
+  return k >= opt_.max_views || k >= static_cast<int>(scene_.train.size());
+}
+
+void ActiveRun::trainPhase() {
+  begin();
+  if (phase_trained_) return;
+  const int k = static_cast<int>(selected_.size());
+  const bool last = lastPhase();
+  const int phase = last ? std::max(opt_.total_iterations - iterations_done_, k * opt_.interval) : k * opt_.interval;
+  if (opt_.reset_after_add) {
+    trainer_->reset();
+    if (opt_.global_sh_clock) trainer_->setShClockStart(iterations_done_);
   }
+  const auto t0 = Clock::now();
+  last_.views = k;
+  last_.total_iterations = std::max(opt_.total_iterations, iterations_done_ + phase);
+  last_.psnr = last_psnr_;
+  trainer_->train(selected_, phase, [&](const TrainProgress& p) {
+    last_.iteration = iterations_done_ + p.done;
+    last_.loss = p.loss_ema;
+    report(ActivePhase::kTraining, p.done, phase);
+  });
+  phase_seconds_ = since(t0);
+  iterations_done_ += phase;
+  phase_trained_ = true;
+  if (!progress_views_.empty()) last_psnr_ = trainer_->evaluate(progress_views_).psnr;
+  if (last) {
+    // The final phase's training belongs to no selection; a log entry without a
+    // selected view keeps it in the totals.
+    SelectionSeconds tail;
+    tail.training = phase_seconds_;
+    steps_.push_back({k, -1, {}, {}, {}, tail, last_psnr_});
+    finished_ = true;
+  }
+}
+
+int ActiveRun::nextView(SelectionLog* out) {
+  trainPhase();
+  if (finished_) throw std::logic_error("nextView: the run holds its last view (" + std::to_string(selected_.size()) + ")");
+  if (!pending_) {
+    SelectionLog log;
+    log.seconds.training = phase_seconds_;
+    log.progress_psnr = last_psnr_;
+    log.selected = selectNext(log);
+    pending_ = std::move(log);
+  }
+  if (out) *out = *pending_;
+  return pending_->selected;
+}
+
+void ActiveRun::addView(int v) {
+  trainPhase();
+  if (finished_) throw std::logic_error("addView: the run holds its last view (" + std::to_string(selected_.size()) + ")");
+  if (std::find(scene_.train.begin(), scene_.train.end(), v) == scene_.train.end())
+    throw std::invalid_argument("addView: view " + std::to_string(v) + " is not a train view");
+  if (std::find(selected_.begin(), selected_.end(), v) != selected_.end())
+    throw std::invalid_argument("addView: view " + std::to_string(v) + " is held already");
+  SelectionLog log;
+  if (pending_) {
+    log = std::move(*pending_);  // the method's record, whichever view is added
+  } else {
+    log.views_before = static_cast<int>(selected_.size());
+    log.seconds.training = phase_seconds_;
+    log.progress_psnr = last_psnr_;
+  }
+  pending_.reset();
+  log.selected = v;
+  selected_.push_back(v);
+  steps_.push_back(std::move(log));
+  phase_trained_ = false;
+  saveCheckpoint();
+}
+
+ActiveResult ActiveRun::run(const std::function<void(const ActiveProgress&)>& progress) {
+  progress_ = progress;
+  begin();
+  while (true) {
+    trainPhase();
+    if (finished_) break;
+    addView(nextView());
+  }
+  ActiveResult r = finish();
+  progress_ = {};
+  return r;
+}
+
+ActiveResult ActiveRun::finish() {
+  if (begun_ && !finished_ && lastPhase()) trainPhase();
+  if (!finished_)
+    throw std::logic_error("finish: the run holds " + std::to_string(selected_.size()) + " of " +
+                           std::to_string(opt_.max_views) + " views; add views first (or call run())");
   ActiveResult r;
   r.initial_views = initial_;
   r.selected_views = selected_;
@@ -274,8 +347,7 @@ ActiveResult ActiveRun::run(const std::function<void(const ActiveProgress&)>& pr
       r.final_fit_views = f;
     }
   }
-  r.seconds = since(start);
-  progress_ = {};
+  r.seconds = since(start_);
   return r;
 }
 

@@ -7,9 +7,11 @@
 // lets a killed run resume and end with the same numbers.
 #include <nlohmann/json.hpp>
 
+#include <chrono>
 #include <functional>
 #include <memory>
 #include <optional>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -22,6 +24,23 @@
 #include "splat/train/trainer.h"
 
 namespace saresgs {
+
+struct SelectionLog;
+
+// What a caller's selector (ActiveOptions::custom_selector; the Python module's) sees when
+// the loop asks it for the next view: the model trained on the held views, the
+// candidates (train views not held) and the run's random generator (the one `random`
+// draws from, so a caller's random selector can reproduce it). Valid during the call only.
+struct SelectionContext {
+  const Scene& scene;
+  const Trainer& trainer;
+  const std::vector<int>& held;
+  const std::vector<int>& candidates;
+  std::mt19937_64& rng;
+  double fisher_lambda = 1e-6;
+};
+// Returns the chosen candidate; may fill log.scores (one per candidate) for results.json.
+using CustomSelector = std::function<int(const SelectionContext&, SelectionLog& log)>;
 
 struct ActiveOptions {
   Method method = Method::kSaResgs;
@@ -65,6 +84,8 @@ struct ActiveOptions {
   // order (the initial ones first, as many as initial_views): the run trains with its own
   // method's training on this sequence instead of selecting (replaySequence, nbv/run_report.h).
   std::vector<int> replay;
+  // Method::kCustom: the caller's selector (required for it, unused otherwise).
+  CustomSelector custom_selector;
   TrainerOptions trainer;
   std::uint64_t seed = 0;
 };
@@ -127,7 +148,32 @@ class ActiveRun {
  public:
   // `checkpoint` names the checkpoint file (empty: none). A present checkpoint is resumed.
   ActiveRun(const Scene& scene, const ActiveOptions& opt, std::string checkpoint = {});
+  // The whole loop: begin(), then per phase trainPhase(), nextView() and addView() until
+  // the last phase is trained, then finish().
   ActiveResult run(const std::function<void(const ActiveProgress&)>& progress = {});
+
+  // The same loop one piece at a time (what the Python module's ActiveRun steps through);
+  // run() is exactly these calls. begin() resumes the checkpoint or holds the initial
+  // views (the other calls begin when needed).
+  void begin();
+  void setProgress(std::function<void(const ActiveProgress&)> progress) { progress_ = std::move(progress); }
+  const std::vector<int>& held() const { return selected_; }
+  // True once the last phase (max_views held, or every train view) has been trained.
+  bool finished() const { return finished_; }
+  // Trains the phase of the views held now; nothing when it is trained already.
+  void trainPhase();
+  // The method's choice after the current phase (trained first when needed), computed once
+  // per phase; `log` receives the selection's record. Throws std::logic_error when the run
+  // holds its last view.
+  int nextView(SelectionLog* log = nullptr);
+  // Holds train view v next (the method's choice or any other train view not held),
+  // records the selection and writes the checkpoint. Throws std::invalid_argument for a
+  // view that is not a train view or is held, std::logic_error after the last phase.
+  void addView(int v);
+  // The final evaluation and final fit; throws std::logic_error before the last phase
+  // was trained (trainPhase() trains it once the run holds its last view).
+  ActiveResult finish();
+
   const Trainer& trainer() const { return *trainer_; }
   // The final fit's model (null before run() or without a final fit).
   const Trainer* finalFitTrainer() const { return final_fit_.get(); }
@@ -136,6 +182,7 @@ class ActiveRun {
 
  private:
   int selectNext(SelectionLog& log);
+  bool lastPhase() const;
   void checkReplay() const;
   // Passes the latest state, in `phase` at done/total, to the caller's progress callback.
   void report(ActivePhase phase, int done, int total);
@@ -157,6 +204,13 @@ class ActiveRun {
   int observed_upto_ = 0;  // selected_[0..observed_upto_) are in the prefilter's grids
   std::function<void(const ActiveProgress&)> progress_;  // during run()
   ActiveProgress last_;                                   // what was last reported
+  // Stepping state: begun, the current phase trained (and its seconds), the last phase
+  // trained, the selection computed for the current phase.
+  bool begun_ = false, phase_trained_ = false, finished_ = false;
+  double phase_seconds_ = 0, last_psnr_ = 0;
+  std::vector<int> progress_views_;
+  std::optional<SelectionLog> pending_;
+  std::chrono::steady_clock::time_point start_;
 };
 
 }  // namespace saresgs

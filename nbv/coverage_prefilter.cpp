@@ -1,6 +1,7 @@
 #include "nbv/coverage_prefilter.h"
 
 #include <algorithm>
+#include <filesystem>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -8,6 +9,7 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "geometry/io/json_file.h"
 #include "geometry/error.h"
 #include "geometry/occupancy/candidate_sets.h"
 #include "geometry/occupancy/coverage_score.h"
@@ -237,6 +239,14 @@ void applySceneType(PrefilterConfig& c, SceneType t) {
 std::optional<SceneType> sceneTypeOfLayout(std::string_view layout) {
   if (layout == "room360" || layout == "unbalanced" || layout == "tworooms") return SceneType::kIndoor;
   if (layout == "object") return SceneType::kOutdoor;
+  return std::nullopt;
+}
+
+std::optional<SceneType> sceneTypeOfDataset(const std::string& folder) {
+  const std::string manifest = folder + "/manifest.json";
+  if (folder.empty() || !std::filesystem::exists(manifest)) return std::nullopt;
+  const nlohmann::json j = readJsonFile(manifest);
+  if (j.is_object() && j.contains("layout") && j["layout"].is_string()) return sceneTypeOfLayout(j["layout"].get<std::string>());
   return std::nullopt;
 }
 

@@ -62,6 +62,9 @@ void applySceneType(PrefilterConfig& c, SceneType t);
 // The scene type of a built-in layout (`saresgs scene --layout`): the rooms are indoor,
 // the object outdoor; none for an unknown layout.
 std::optional<SceneType> sceneTypeOfLayout(std::string_view layout);
+// The scene type of a dataset folder written by `saresgs scene` (its manifest.json's
+// layout); none for any other folder or an unknown layout.
+std::optional<SceneType> sceneTypeOfDataset(const std::string& folder);
 
 // What the prefilter's grid and encoding are: scene-occupied voxels (what is hashed),
 // the encoding used ("hash:K" with K resolved, or "exact"), and for a hash its load.

@@ -25,6 +25,9 @@ constexpr MethodRow kMethodTable[] = {
     {Method::kFisherLogDet, "fisher-logdet", {true, false, false}},
     // Fisher information and occlusion-aware coverage of unobserved surface (selectors.h).
     {Method::kHybrid, "hybrid", {true, false, false, true}},
+    // A selector function given by the caller (ActiveOptions::custom_selector: the Python
+    // module's selectors); plain training, nothing precomputed.
+    {Method::kCustom, "custom", {false, false, false}},
 };
 
 const MethodRow& rowOf(Method m) {

@@ -11,6 +11,8 @@ packages=(
   libopencv-dev libcgal-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev libcli11-dev
   # COLMAP: the tests convert our models with `colmap model_converter`; `--sfm colmap`
   colmap libsqlite3-dev
+  # the Python module (python/): pybind11, Debian's Python headers, NumPy, and pytest for its tests
+  pybind11-dev python3-dev python3-numpy python3-pytest
   # GNU parallel: shards of an ablation grid on one machine (results/README.md)
   parallel
   # the fuzz targets (fuzz/): clang 14 and its runtimes (libFuzzer, ASan, UBSan), which

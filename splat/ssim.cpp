@@ -1,5 +1,6 @@
 // The fused SSIM (+ L1) kernel (splat/ssim.h).
 #include "splat/ssim.h"
+#include "geometry/float_env.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -557,6 +558,7 @@ void forRowBlocks(int h, F&& f) {
   tbb::parallel_for(
       tbb::blocked_range<int>(0, blocks, 1),
       [&](const tbb::blocked_range<int>& br) {
+        const FloatEnvGuard fenv;  // geometry/float_env.h
         for (int b = br.begin(); b != br.end(); ++b)
           f(b * kBlockRows, std::min(h, (b + 1) * kBlockRows));
       },

@@ -1,4 +1,5 @@
 #include "geometry/lifting/epipolar_refine.h"
+#include "geometry/float_env.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -172,6 +173,7 @@ std::vector<Correspondence> refineOnEpipolarLines(const Camera& cam0, const Imag
   std::vector<std::optional<Correspondence>> slot(matches.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, matches.size(), 64),
                     [&](const tbb::blocked_range<std::size_t>& rg) {
+                      const FloatEnvGuard fenv;  // geometry/float_env.h
                       for (std::size_t i = rg.begin(); i != rg.end(); ++i)
                         slot[i] = refineOne(g, l0, l1, matches[i], opts);
                     });

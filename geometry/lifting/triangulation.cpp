@@ -1,4 +1,5 @@
 #include "geometry/lifting/triangulation.h"
+#include "geometry/float_env.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -159,6 +160,7 @@ std::vector<TriangulatedPoint> triangulateAll(const Camera& cam0, const Camera& 
   // how TBB splits the range.
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, matches.size(), 256),
                     [&](const tbb::blocked_range<std::size_t>& r) {
+                      const FloatEnvGuard fenv;  // geometry/float_env.h
                       for (std::size_t i = r.begin(); i != r.end(); ++i)
                         out[i] = triangulateWith(cam0, cam1, g, matches[i], opts);
                     });

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "geometry/error.h"
+#include "geometry/float_env.h"
 
 namespace saresgs {
 
@@ -72,6 +73,7 @@ VoxelSet frustumSet(const OccupancyGrids& grids, const Camera& cam, const DepthR
   std::vector<std::uint8_t> inside(keys.size(), 0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nblocks, 16),
                     [&](const tbb::blocked_range<std::size_t>& br) {
+    const FloatEnvGuard fenv;  // geometry/float_env.h
     for (std::size_t b = br.begin(); b != br.end(); ++b) {
       const Voxel base = unpackVoxel(keys[starts[b]] & ~VoxelKey{511});  // block corner
       const Eigen::Vector3d lo =
@@ -294,6 +296,7 @@ std::vector<std::int64_t> VisibilityTracer::tracePixels(const Camera& cam, int s
   const Eigen::Vector3d c = cam.center();
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, uv.size(), 256),
                     [&](const tbb::blocked_range<std::size_t>& r) {
+    const FloatEnvGuard fenv;  // geometry/float_env.h
     for (std::size_t i = r.begin(); i != r.end(); ++i) hits[i] = firstHit(c, cam.rayDirection(uv[i]));
   });
   return hits;

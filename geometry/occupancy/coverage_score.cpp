@@ -11,6 +11,7 @@
 #include <string>
 
 #include "geometry/error.h"
+#include "geometry/float_env.h"
 
 namespace saresgs {
 
@@ -76,6 +77,7 @@ std::vector<CoverageScore> scoreCandidates(const VoxelSet& observed,
   std::vector<CoverageScore> out(candidates.size());
   if (opts.encoding == CoverageEncoding::Exact) {
     tbb::parallel_for(std::size_t{0}, candidates.size(), [&](std::size_t j) {
+      const FloatEnvGuard fenv;  // geometry/float_env.h
       out[j] = scoreExact(observed, candidates[j], universe);
     });
     return out;
@@ -91,6 +93,7 @@ std::vector<CoverageScore> scoreCandidates(const VoxelSet& observed,
   // order, so the result does not depend on the thread schedule.
   tbb::enumerable_thread_specific<HashedBits> scratch([&] { return HashedBits(opts.table_size); });
   tbb::parallel_for(std::size_t{0}, candidates.size(), [&](std::size_t j) {
+    const FloatEnvGuard fenv;  // geometry/float_env.h
     HashedBits& seen = scratch.local();
     std::size_t distinct = 0, common = 0;
     for (VoxelKey k : candidates[j].keys()) {

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "geometry/scene/scene.h"
+#include "geometry/float_env.h"
 
 namespace saresgs {
 
@@ -47,7 +48,10 @@ void simulateSfm(const SyntheticScene& scene, ColmapModel& model, const Simulate
   // computed in parallel into fixed slots, so the result does not depend on threads.
   std::vector<std::vector<Observation>> seen(samples.size());
   tbb::parallel_for(std::size_t(0), samples.size(),
-                    [&](std::size_t k) { seen[k] = observe(scene, samples[k]); });
+                    [&](std::size_t k) {
+                      const FloatEnvGuard fenv;  // geometry/float_env.h
+                      seen[k] = observe(scene, samples[k]);
+                    });
 
   AABB box;
   for (const auto& s : samples) box.extend(s.point.cast<double>());

@@ -14,6 +14,7 @@
 #include "geometry/synth/procedural_meshes.h"
 #include "geometry/synth/render_detail.h"
 #include "geometry/synth/world.h"
+#include "geometry/float_env.h"
 
 namespace saresgs {
 
@@ -141,6 +142,7 @@ ImageF SyntheticScene::renderDepth(const Camera& cam) const {
   const Vector3f c = cam.center().cast<float>();
   const Eigen::Vector3d view = cam.viewDirection();
   tbb::parallel_for(tbb::blocked_range<int>(0, H), [&](const tbb::blocked_range<int>& rows) {
+    const FloatEnvGuard fenv;  // geometry/float_env.h
     for (int j = rows.begin(); j != rows.end(); ++j)
       for (int i = 0; i < W; ++i) {
         const Eigen::Vector3d d = cam.rayDirection(Eigen::Vector2d(i + 0.5, j + 0.5));
@@ -209,6 +211,7 @@ ImageF renderGrid(const SyntheticScene& scene, const Camera& cam, int grid, bool
   const Vector3f eye = cam.center().cast<float>();
   const float inv = 1.0f / static_cast<float>(grid * grid);
   tbb::parallel_for(tbb::blocked_range<int>(0, H), [&](const tbb::blocked_range<int>& rows) {
+    const FloatEnvGuard fenv;  // geometry/float_env.h
     for (int j = rows.begin(); j != rows.end(); ++j)
       for (int i = 0; i < W; ++i) {
         Vector3f sum = Vector3f::Zero(), hits_sum = Vector3f::Zero();

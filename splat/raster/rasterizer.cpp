@@ -25,6 +25,7 @@
 #define SARESGS_KERNEL_LANES 4
 #include "splat/raster/raster_kernels_impl.h"
 #include "splat/raster/raster_kernels_pair_impl.h"
+#include "geometry/float_env.h"
 #undef SARESGS_KERNEL_NS
 #undef SARESGS_KERNEL_LANES
 
@@ -348,6 +349,7 @@ TileCover projectAll(const GaussiansT<T>& g, const CameraT<T>& camT, std::span<c
   cover.rect.resize(n);
   arena(st).execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& r) {
+      const FloatEnvGuard fenv;  // geometry/float_env.h
       for (std::size_t i = r.begin(); i < r.end(); ++i) {
         if (!mask.empty() && !mask[i]) {
           st.proj[i] = Projected<T>{};
@@ -384,6 +386,7 @@ void binAndSort(const TileCover& cover, RasterStateT<T>& st) {
   std::vector<std::uint32_t> slot_tile(pairs);
   arena(st).execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& r) {
+      const FloatEnvGuard fenv;  // geometry/float_env.h
       for (std::size_t i = r.begin(); i < r.end(); ++i) {
         if (!cover.count[i]) continue;
         const auto& [tx0, tx1, ty0, ty1] = cover.rect[i];
@@ -422,6 +425,7 @@ void compositeTiles(int W, int H, RasterStateT<T>& st, RenderOutputT<T>& out) {
   const T bg[3] = {T(rs.background[0]), T(rs.background[1]), T(rs.background[2])};
   arena(st).execute([&] {
     tbb::parallel_for(0, st.tiles_x * st.tiles_y, [&](int tile) {
+      const FloatEnvGuard fenv;  // geometry/float_env.h
       thread_local std::vector<TileGaussian<T>> q;
       gatherTile(st, tile, q);
       int x0, y0, x1, y1;
@@ -564,6 +568,7 @@ RenderPair rasterizeWithSubset(const Gaussians& g, const Camera& cam, const Rast
   const raster_kernels::CompositePairFn kernel = kPairKernelSets[st->isa].composite;
   arena(*st).execute([&] {
     tbb::parallel_for(0, st->tiles_x * st->tiles_y, [&](int tile) {
+      const FloatEnvGuard fenv;  // geometry/float_env.h
       thread_local std::vector<TileGaussian<float>> q;
       gatherTile(*st, tile, q);
       int x0, y0, x1, y1;
@@ -616,6 +621,7 @@ void rasterizeBackwardWithSubset(const Gaussians& g, const Camera& cam, const Ra
   const raster_kernels::BackwardPairFn kernel = kPairKernelSets[st.isa].backward;
   arena(st).execute([&] {
     tbb::parallel_for(0, st.tiles_x * st.tiles_y, [&](int tile) {
+      const FloatEnvGuard fenv;  // geometry/float_env.h
       thread_local std::vector<TileGaussian<float>> q;
       gatherTile(st, tile, q);
       if (q.empty()) return;
@@ -630,6 +636,7 @@ void rasterizeBackwardWithSubset(const Gaussians& g, const Camera& cam, const Ra
   arena(st).execute([&] {
     const CameraT<float> camT(cam, rs.guard_band);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& r) {
+      const FloatEnvGuard fenv;  // geometry/float_env.h
       for (std::size_t i = r.begin(); i < r.end(); ++i) {
         if (st.gauss_start[i] == st.gauss_start[i + 1]) continue;
         // Each branch's slots are reduced in slot order, as the single backward does; the
@@ -718,6 +725,7 @@ void walkAllPixels(const RasterStateT<T>& st, int W, int H, Weights&& weights, V
   const T bg[3] = {T(rs.background[0]), T(rs.background[1]), T(rs.background[2])};
   arena(st).execute([&] {
     tbb::parallel_for(0, st.tiles_x * st.tiles_y, [&](int tile) {
+      const FloatEnvGuard fenv;  // geometry/float_env.h
       std::vector<TileGaussian<T>> q;
       gatherTile(st, tile, q);
       const std::uint32_t base = st.tile_start[tile];
@@ -763,6 +771,7 @@ void backwardSlots<float>(const RasterStateT<float>& st, int W, int H, const flo
   const raster_kernels::BackwardFn kernel = kKernelSets[st.isa].backward;
   arena(st).execute([&] {
     tbb::parallel_for(0, st.tiles_x * st.tiles_y, [&](int tile) {
+      const FloatEnvGuard fenv;  // geometry/float_env.h
       thread_local std::vector<TileGaussian<float>> q;
       gatherTile(st, tile, q);
       if (q.empty()) return;
@@ -803,6 +812,7 @@ void rasterizeBackwardT(const GaussiansT<T>& g, const Camera& cam, const RasterS
     // Reduce each Gaussian's slots in slot order, then chain to its parameters.
     const CameraT<T> camT(cam, T(rs.guard_band));
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& r) {
+      const FloatEnvGuard fenv;  // geometry/float_env.h
       for (std::size_t i = r.begin(); i < r.end(); ++i) {
         if (st.gauss_start[i] == st.gauss_start[i + 1]) continue;
         ProjectedGrad<T> dP;
@@ -879,6 +889,7 @@ void fisherMoments(const RasterStateT<float>& st, int W, int H, float* slots) {
   const raster_kernels::FisherFn kernel = kFisherKernels[st.isa];
   arena(st).execute([&] {
     tbb::parallel_for(0, st.tiles_x * st.tiles_y, [&](int tile) {
+      const FloatEnvGuard fenv;  // geometry/float_env.h
       thread_local std::vector<TileGaussian<float>> q;
       gatherTile(st, tile, q);
       if (q.empty()) return;
@@ -907,6 +918,7 @@ void squaredGradientsFloat(const Gaussians& g, const Camera& cam, const RenderOu
   const CameraT<float> camT(cam, float(rs.guard_band));
   arena(st).execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& r) {
+      const FloatEnvGuard fenv;  // geometry/float_env.h
       const int K = g.shCoeffs(), active = shCoeffCount(rs.sh_degree);
       for (std::size_t i = r.begin(); i < r.end(); ++i) {
         if (st.gauss_start[i] == st.gauss_start[i + 1]) continue;
@@ -975,6 +987,7 @@ void rasterizeSquaredGradientsWalkT(const GaussiansT<T>& g, const Camera& cam, c
   std::vector<T> dlogit(n, T(0));         // d logit per d opacity
   arena(st).execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& r) {
+      const FloatEnvGuard fenv;  // geometry/float_env.h
       for (std::size_t i = r.begin(); i < r.end(); ++i) {
         if (st.gauss_start[i] == st.gauss_start[i + 1]) continue;
         const Projected<T>& P = st.proj[i];
@@ -1019,6 +1032,7 @@ void rasterizeSquaredGradientsWalkT(const GaussiansT<T>& g, const Camera& cam, c
       });
   arena(st).execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& r) {
+      const FloatEnvGuard fenv;  // geometry/float_env.h
       const int K = g.shCoeffs(), active = shCoeffCount(rs.sh_degree);
       for (std::size_t i = r.begin(); i < r.end(); ++i) {
         if (st.gauss_start[i] == st.gauss_start[i + 1]) continue;

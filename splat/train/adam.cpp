@@ -1,4 +1,5 @@
 #include "splat/train/adam.h"
+#include "geometry/float_env.h"
 
 #include <cmath>
 #include <stdexcept>
@@ -37,6 +38,7 @@ void adamArray(std::vector<float>& p, const std::vector<float>& g, std::vector<f
                std::size_t per, std::size_t head, float lr_head, float lr_tail, const AdamCoeffs& c) {
   const std::size_t n = per ? p.size() / per : 0;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
+    const FloatEnvGuard fenv;  // geometry/float_env.h
     if (head == per) {
       const std::size_t b = r.begin() * per, len = (r.end() - r.begin()) * per;
       adamSpan(p.data() + b, g.data() + b, m.data() + b, v.data() + b, len, lr_head, c);

@@ -1,4 +1,5 @@
 #include "splat/train/init.h"
+#include "geometry/float_env.h"
 
 #include <algorithm>
 #include <cmath>
@@ -92,6 +93,7 @@ std::vector<double> meanSquaredKnnDistance(const std::vector<Eigen::Vector3d>& p
   const KdTree tree(pts);
   const std::size_t kk = std::min<std::size_t>(static_cast<std::size_t>(k), n - 1);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+    const FloatEnvGuard fenv;  // geometry/float_env.h
     std::vector<double> best;
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
       best.assign(kk, std::numeric_limits<double>::infinity());

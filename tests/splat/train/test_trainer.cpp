@@ -15,7 +15,11 @@
 #include "common/test_support.h"
 #include "splat/loss.h"
 #include "splat/train/residual.h"
+#include "splat/train/adam.h"
 #include "splat/train/trainer.h"
+
+#include <tbb/task_arena.h>
+#include <xmmintrin.h>
 #include "common/tiny_dataset.h"
 
 namespace saresgs {
@@ -458,4 +462,68 @@ TEST(Trainer, ResidualStepEqualsItsTwoBranches) {
 }
 
 }  // namespace
+}  // namespace saresgs
+
+namespace saresgs {
+
+namespace {
+
+// Runs f as Embree's BVH builds leave TBB: flush-to-zero and denormals-are-zero set on the
+// calling thread while a new task arena starts, so that the arena's workers take that mode
+// on for every task (TBB hands the arena's captured floating-point mode to its workers;
+// an Embree build that happens to create the process's default arena leaves every later
+// parallel loop's workers so, geometry/float_env.h).
+template <typename F>
+auto withThreadsInFlushToZero(F&& f) {
+  const unsigned saved = _mm_getcsr();
+  _mm_setcsr(saved | 0x8040u);
+  tbb::task_arena arena(2);
+  arena.initialize();
+  auto r = arena.execute(f);
+  _mm_setcsr(saved);
+  return r;
+}
+
+}  // namespace
+
+// Adam's second moment of a gradient of 1e-20 is 1e-43, a denormal: flushed to zero it
+// changes the step (its square root, 1e-20 after bias correction, is 1e-5 of eps). With the
+// threads in flush-to-zero mode the update is the IEEE one all the same, bit for bit.
+TEST(Trainer, AdamIgnoresTheThreadsFlushToZeroMode) {
+  Gaussians p;
+  p.resize(5000);
+  Gaussians g = p.zerosLike();
+  for (std::size_t i = 0; i < g.rotations.size(); ++i) g.rotations[i] = 1e-20f * static_cast<float>(1 + i % 7);
+  auto run = [&] {
+    Gaussians q = p;
+    AdamState s;
+    s.resetFor(q);
+    for (int k = 0; k < 3; ++k) adamStep(q, g, s, LearningRates{});
+    return q.rotations;
+  };
+  const std::vector<float> ieee = run();
+  const std::vector<float> flushed = withThreadsInFlushToZero(run);
+  EXPECT_EQ(ieee, flushed) << ieee[0] << " " << flushed[0];
+  EXPECT_NE(ieee[0], 0.0f);  // the tiny gradient did move the parameter
+}
+
+// Training after something left the worker threads in flush-to-zero mode (in the field:
+// making a synthetic scene or Embree-visible sets in the same process, then training)
+// trains the same model as a fresh process, bit for bit.
+TEST(Trainer, TrainingIgnoresTheThreadsFlushToZeroMode) {
+  const Scene& s = tinyDataset();
+  auto train = [&] {
+    Trainer t(s, quickOptions());
+    t.train(s.train, 60);
+    return t.gaussians();
+  };
+  const Gaussians ieee = train();
+  const Gaussians flushed = withThreadsInFlushToZero(train);
+  EXPECT_EQ(ieee.means, flushed.means);
+  EXPECT_EQ(ieee.log_scales, flushed.log_scales);
+  EXPECT_EQ(ieee.rotations, flushed.rotations);
+  EXPECT_EQ(ieee.opacities, flushed.opacities);
+  EXPECT_EQ(ieee.sh, flushed.sh);
+}
+
 }  // namespace saresgs

@@ -1,0 +1,50 @@
+#pragma once
+// The pieces of the Python module (python/src/*.cpp), one per room of the library, and the
+// conversions they share. Arrays cross as NumPy arrays: images as H x W x C (H x W for one
+// channel) float32 or uint8, cameras' matrices as float64, model parameters as float32
+// views of the model's own storage.
+#include <pybind11/eigen.h>
+#include <pybind11/functional.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <string>
+#include <vector>
+
+#include "geometry/image/image.h"
+
+namespace saresgs::python {
+
+namespace py = pybind11;
+
+void bindData(py::module_& m);   // cameras, datasets, built-in scenes (bind_data.cpp)
+void bindModel(py::module_& m);  // Gaussians, render, gradients, loss, metrics (bind_model.cpp)
+void bindTrain(py::module_& m);  // Trainer (bind_train.cpp)
+void bindNbv(py::module_& m);    // scores, coverage, ActiveRun (bind_nbv.cpp)
+
+// A NumPy array that owns `v` (moved, not copied), of the given shape.
+template <typename T>
+py::array_t<T> ownedArray(std::vector<T>&& v, std::vector<py::ssize_t> shape) {
+  auto* holder = new std::vector<T>(std::move(v));
+  py::capsule owner(holder, [](void* p) { delete static_cast<std::vector<T>*>(p); });
+  return py::array_t<T>(std::move(shape), holder->data(), owner);
+}
+
+// An image as H x W x C (H x W when it has one channel), owning its pixels.
+template <typename T>
+py::array_t<T> imageArray(ImageT<T>&& img) {
+  std::vector<py::ssize_t> shape{img.height, img.width};
+  if (img.channels != 1) shape.push_back(img.channels);
+  return ownedArray(std::move(img.data), std::move(shape));
+}
+
+// A float image from an H x W x C or H x W array (C = `channels`); throws ValueError
+// naming `what` and the shape expected.
+ImageF imageFromArray(const py::array& a, int channels, const std::string& what);
+
+// Raises the pending Python exception (KeyboardInterrupt on Ctrl-C) in C++, so that a long
+// call stops at its next progress point. Call with the GIL held.
+void checkSignals();
+
+}  // namespace saresgs::python
