@@ -151,9 +151,16 @@ void bindData(py::module_& m) {
         DatasetOptions o;
         o.load.downscale = downscale;
         o.test_every = test_every;
-        py::gil_scoped_release nogil;
-        auto s = std::make_shared<Scene>(loadDataset(path, o));
-        (void)checkDataset(*s);  // refuses a dataset that no train view sees (InputError)
+        std::shared_ptr<Scene> s;
+        std::vector<DatasetWarning> warnings;
+        {
+          py::gil_scoped_release nogil;
+          s = std::make_shared<Scene>(loadDataset(path, o));
+          warnings = checkDataset(*s);  // refuses a dataset that no train view sees (InputError)
+        }
+        // As the command line prints them: implausible intrinsics, views that see no point.
+        if (!warnings.empty() && PyErr_WarnEx(PyExc_UserWarning, (path + ":\n" + formatWarnings(warnings)).c_str(), 1) != 0)
+          throw py::error_already_set();
         return s;
       },
       py::arg("path"), py::arg("downscale") = 1, py::arg("test_every") = 8,

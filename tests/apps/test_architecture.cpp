@@ -47,8 +47,8 @@ std::string rel(const fs::path& p) { return fs::relative(p, kRoot).string(); }
 TEST(Architecture, RoomsIncludeOnlyWhatIsBelowThem) {
   int checked = 0;
   for (const auto& [room, forbidden] : std::vector<std::pair<std::string, std::vector<std::string>>>{
-           {"geometry", {"splat/", "nbv/", "apps/", "fuzz/"}}, {"splat", {"nbv/", "apps/", "fuzz/"}},
-           {"nbv", {"apps/", "fuzz/"}}})
+           {"geometry", {"splat/", "nbv/", "apps/", "python/", "fuzz/"}}, {"splat", {"nbv/", "apps/", "python/", "fuzz/"}},
+           {"nbv", {"apps/", "python/", "fuzz/"}}, {"apps", {"python/"}}, {"python", {"apps/"}}})
     for (const fs::path& f : sources(room))
       for (const std::string& i : includes(f)) {
         ++checked;
@@ -64,10 +64,17 @@ TEST(Architecture, TheAlgorithmDoesNotIncludeItsEvaluationHarness) {
   }
 }
 
-TEST(Architecture, AppsIncludeNoDetailHeader) {
-  for (const fs::path& f : sources("apps"))
-    for (const std::string& i : includes(f))
-      EXPECT_EQ(i.find("_detail.h"), std::string::npos) << rel(f) << " includes " << i;
+// The command line and the Python module are thin front ends over the libraries' public
+// headers (and neither is built on the other).
+TEST(Architecture, FrontEndsIncludeNoDetailHeader) {
+  int checked = 0;
+  for (const std::string room : {"apps", "python"})
+    for (const fs::path& f : sources(room))
+      for (const std::string& i : includes(f)) {
+        ++checked;
+        EXPECT_EQ(i.find("_detail.h"), std::string::npos) << rel(f) << " includes " << i;
+      }
+  EXPECT_GT(checked, 40);
 }
 
 // Paths cited in a text: `room/...` or docs/third_party_notes/results paths with a file
@@ -127,7 +134,7 @@ std::string comments(const std::string& text) {
 TEST(Architecture, EveryDocumentTheCodeCitesExists) {
   static const std::regex doc(R"re(([A-Za-z0-9_./-]*(?:[A-Za-z0-9_]\.md\b|STACK_NOTES)))re");
   int cited = 0;
-  for (const std::string room : {"geometry", "splat", "nbv", "apps", "tests", "fuzz"})
+  for (const std::string room : {"geometry", "splat", "nbv", "apps", "python", "tests", "fuzz"})
     for (const fs::path& f : sources(room)) {
       if (f.filename() == "test_architecture.cpp") continue;
       const std::string c = comments(read(f));
