@@ -128,7 +128,8 @@ int runActive(const ActiveArgs& a) {
     char detail[200];
     std::snprintf(detail, sizeof detail, "%s %d/%d  views %d/%d  loss %.4f  PSNR %.2f  Gaussians %zu", toString(p.phase),
                   p.phase_done, p.phase_total, p.views, p.max_views, p.loss, p.psnr, p.gaussians);
-    progress.update("active", p.iteration, p.total_iterations, detail);
+    // A phase is a phase of its own per number of views held (a log line each).
+    progress.update("active", p.iteration, p.total_iterations, detail, std::string(toString(p.phase)) + " " + std::to_string(p.views));
   });
   const Trainer& t = run.trainer();
   writeTestRenders(t, r.test, a.out + "/test_renders");
