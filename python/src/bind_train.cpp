@@ -110,7 +110,16 @@ void bindTrain(py::module_& m) {
             return py::make_tuple(imageArray(std::move(r.rgb)), imageArray(std::move(r.depth)), imageArray(std::move(r.alpha)));
           },
           py::arg("camera"), "Renders the current model at its active SH degree: (rgb, depth, alpha).")
-      .def_property_readonly("gaussians", [](const Trainer& t) { return Gaussians(t.gaussians()); }, "a copy of the current model")
+      .def_property(
+          "gaussians", [](const Trainer& t) { return Gaussians(t.gaussians()); },
+          [](Trainer& t, const Gaussians& g) {
+            if (g.max_sh_degree != t.gaussians().max_sh_degree)
+              throw py::value_error("gaussians: SH degree " + std::to_string(g.max_sh_degree) + ", the trainer's is " +
+                                    std::to_string(t.gaussians().max_sh_degree));
+            t.mutableGaussians() = g;
+          },
+          "a copy of the current model; assigning a model (e.g. Gaussians.read_ply) continues training from it "
+          "(the optimiser's moments restart when the count changes)")
       .def_property_readonly("iteration", &Trainer::iteration)
       .def_property_readonly("active_sh_degree", &Trainer::activeShDegree)
       .def("reset", &Trainer::reset, "back to the initial model and optimiser (the random generator continues)")
