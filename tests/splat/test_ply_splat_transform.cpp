@@ -19,8 +19,13 @@ using saresgs::test::TempDir;
 
 namespace {
 
-const std::string kTool =
-    std::string(SARESGS_BINARY_DIR) + "/node_tools/node_modules/.bin/splat-transform";
+// scripts/install_node_tools.sh installs it into <repo>/build/node_tools; a second build
+// folder (the sanitizer build, scripts/test_sanitizers.sh) uses that one.
+const std::string kTool = [] {
+  const std::string own = std::string(SARESGS_BINARY_DIR) + "/node_tools/node_modules/.bin/splat-transform";
+  const std::string main = std::string(SARESGS_SOURCE_DIR) + "/build/node_tools/node_modules/.bin/splat-transform";
+  return std::filesystem::exists(own) || !std::filesystem::exists(main) ? own : main;
+}();
 
 ::testing::AssertionResult toolPresent() {
   if (std::filesystem::exists(kTool)) return ::testing::AssertionSuccess();
