@@ -108,7 +108,6 @@ int ActiveRun::selectNext(SelectionLog& log) {
     return next;
   }
   if (opt_.method == Method::kCustom) {
-    log.candidates = candidates;
     const int v = opt_.custom_selector(SelectionContext{scene_, *trainer_, selected_, candidates, rng_, opt_.fisher_lambda}, log);
     if (std::find(candidates.begin(), candidates.end(), v) == candidates.end())
       throw std::invalid_argument("custom selector: it chose view " + std::to_string(v) + ", which is not a candidate (a train view not held)");
@@ -299,7 +298,8 @@ ActiveResult ActiveRun::run(const std::function<void(const ActiveProgress&)>& pr
 }
 
 ActiveResult ActiveRun::finish() {
-  if (begun_ && !finished_ && lastPhase()) trainPhase();
+  begin();
+  if (!finished_ && lastPhase()) trainPhase();
   if (!finished_)
     throw std::logic_error("finish: the run holds " + std::to_string(selected_.size()) + " of " +
                            std::to_string(opt_.max_views) + " views; add views first (or call run())");

@@ -464,3 +464,79 @@ TEST(ActiveRun, HybridAtItsEndsChoosesWhatTheSelectorsItMixesChoose) {
 
 }  // namespace
 }  // namespace saresgs
+
+namespace saresgs {
+namespace {
+
+// The loop one piece at a time (what the Python module steps through) is run() itself:
+// the same views, scores and model; a caller may hold a view of its own instead of the
+// method's, and the calls refuse what the protocol does not allow.
+TEST(ActiveRun, SteppingIsTheLoopAndTakesTheCallersViews) {
+  const Scene& s = tinyDataset();
+  ActiveRun whole(s, tinyOptions(Method::kFvs));
+  const ActiveResult a = whole.run();
+  ActiveRun stepped(s, tinyOptions(Method::kFvs));
+  EXPECT_THROW(stepped.finish(), std::logic_error);  // 2 of 5 views held
+  while (true) {
+    stepped.trainPhase();
+    if (stepped.finished()) break;
+    SelectionLog log;
+    const int v = stepped.nextView(&log);
+    EXPECT_EQ(stepped.nextView(), v);  // computed once per phase
+    EXPECT_EQ(log.scores.size(), log.candidates.size());
+    stepped.addView(v);
+  }
+  EXPECT_THROW(stepped.nextView(), std::logic_error);
+  const ActiveResult b = stepped.finish();
+  EXPECT_EQ(a.selected_views, b.selected_views);
+  EXPECT_EQ(a.test.psnr, b.test.psnr);
+  EXPECT_TRUE(sameModel(whole.trainer().gaussians(), stepped.trainer().gaussians()));
+  ASSERT_EQ(a.steps.size(), b.steps.size());
+  for (std::size_t k = 0; k < a.steps.size(); ++k) EXPECT_EQ(a.steps[k].scores, b.steps[k].scores);
+
+  ActiveRun mine(s, tinyOptions(Method::kFvs));
+  const int proposed = mine.nextView();
+  int other = -1;
+  for (int v : s.train)
+    if (v != proposed && std::find(mine.held().begin(), mine.held().end(), v) == mine.held().end()) other = v;
+  mine.addView(other);
+  EXPECT_EQ(mine.held().back(), other);
+  EXPECT_THROW(mine.addView(other), std::invalid_argument);           // held already
+  EXPECT_THROW(mine.addView(s.test.front()), std::invalid_argument);  // not a train view
+}
+
+// A caller's selector plugged into the loop: drawing from the run's generator as `random`
+// does, it reproduces the built-in random run bit for bit; a choice that is not a
+// candidate is refused by name; the CLI's method `custom` without a selector is refused.
+TEST(ActiveRun, CustomSelectorPlugsIntoTheSameLoop) {
+  const Scene& s = tinyDataset();
+  ActiveRun builtin(s, tinyOptions(Method::kRandom));
+  const ActiveResult a = builtin.run();
+  ActiveOptions o = tinyOptions(Method::kCustom);
+  int calls = 0;
+  o.custom_selector = [&](const SelectionContext& c, SelectionLog&) {
+    ++calls;
+    EXPECT_GT(c.trainer.gaussians().size(), 0u);  // the model trained on the held views
+    EXPECT_EQ(c.held.size() + c.candidates.size(), s.train.size());
+    return selectRandom(c.candidates, c.rng);
+  };
+  ActiveRun custom(s, o);
+  const ActiveResult b = custom.run();
+  EXPECT_EQ(calls, 3);
+  EXPECT_EQ(a.selected_views, b.selected_views);
+  EXPECT_EQ(a.test.psnr, b.test.psnr);
+  EXPECT_TRUE(sameModel(builtin.trainer().gaussians(), custom.trainer().gaussians()));
+
+  o.custom_selector = [](const SelectionContext& c, SelectionLog&) { return c.held.front(); };
+  ActiveRun wrong(s, o);
+  try {
+    wrong.run();
+    ADD_FAILURE() << "a held view was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("not a candidate"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(ActiveRun(s, tinyOptions(Method::kCustom)), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace saresgs
