@@ -13,5 +13,7 @@ set -euo pipefail
 config="${1:?usage: sbatch --array=0-N scripts/slurm_ablate.sh GRID.json OUT}"
 out="${2:?usage: sbatch --array=0-N scripts/slurm_ablate.sh GRID.json OUT}"
 cd "${SLURM_SUBMIT_DIR:-$(dirname "$0")/..}"
+# SHARDS: the grid's shard count when only some tasks are resubmitted (--array=3,7 makes
+# SLURM_ARRAY_TASK_COUNT 2, not the grid's n): SHARDS=16 sbatch --array=3,7 ...
 ./build/apps/saresgs ablate --config "$config" --out "$out" \
-  --shard "${SLURM_ARRAY_TASK_ID}/${SLURM_ARRAY_TASK_COUNT}"
+  --shard "${SLURM_ARRAY_TASK_ID}/${SHARDS:-${SLURM_ARRAY_TASK_COUNT}}"

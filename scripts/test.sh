@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
-# The test command: install what is missing, build, run every test through CTest.
+# The test command: install what is missing, build, run every test through CTest (the C++
+# suites and the Python module's pytest files), then the Slurm path end to end on a
+# one-node cluster of this machine (scripts/test_slurm.sh, about 40 s with its install).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh
 bash scripts/build.sh
 ctest --test-dir build --output-on-failure --parallel "$(nproc)" --timeout 900
+bash scripts/test_slurm.sh
