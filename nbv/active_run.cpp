@@ -147,11 +147,8 @@ int ActiveRun::selectNext(SelectionLog& log) {
       return selectRandom(candidates, rng_);
     }
     case Method::kFvs: {
-      Eigen::Vector3d c = Eigen::Vector3d::Zero();
-      for (int v : scene_.train) c += scene_.views[static_cast<std::size_t>(v)].camera.center();
-      c /= static_cast<double>(scene_.train.size());
       log.candidates = candidates;
-      log.scores = farthestViewScores(scene_, selected_, candidates, opt_.fvs_metric, c);
+      log.scores = fvsScores(scene_, selected_, candidates, opt_.fvs_metric);
       return candidates[argmaxScore(log.scores, candidates)];
     }
     default: break;

@@ -17,6 +17,14 @@ int selectRandom(const std::vector<int>& candidates, std::mt19937_64& rng) {
   return candidates[pick(rng)];
 }
 
+std::vector<double> fvsScores(const Scene& scene, const std::vector<int>& chosen, const std::vector<int>& candidates,
+                              ViewDistance metric) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (int v : scene.train) c += scene.views[static_cast<std::size_t>(v)].camera.center();
+  c /= static_cast<double>(scene.train.size());
+  return farthestViewScores(scene, chosen, candidates, metric, c);
+}
+
 std::vector<double> farthestViewScores(const Scene& scene, const std::vector<int>& chosen,
                                        const std::vector<int>& candidates, ViewDistance metric,
                                        const Eigen::Vector3d& center) {

@@ -24,6 +24,9 @@ enum class ViewDistance { kEuclidean, kGreatCircle };
 std::vector<double> farthestViewScores(const Scene& scene, const std::vector<int>& chosen,
                                        const std::vector<int>& candidates, ViewDistance metric,
                                        const Eigen::Vector3d& center);
+// The fvs method's scores: about the mean of the train cameras' centres.
+std::vector<double> fvsScores(const Scene& scene, const std::vector<int>& chosen, const std::vector<int>& candidates,
+                              ViewDistance metric = ViewDistance::kEuclidean);
 
 // How a candidate's information is scored against H_train (splat/fisher.h): FisherRF's
 // trace, sum H_v / (H_train + lambda), or the D-optimal log-det gain,

@@ -141,11 +141,7 @@ void bindNbv(py::module_& m) {
         checkTrainViews(*scene, held, "held");
         checkTrainViews(*scene, candidates, "candidates");
         if (metric != "euclidean" && metric != "great-circle") throw py::value_error("metric: expected euclidean or great-circle");
-        Eigen::Vector3d c = Eigen::Vector3d::Zero();
-        for (int v : scene->train) c += scene->views[static_cast<std::size_t>(v)].camera.center();
-        c /= static_cast<double>(scene->train.size());
-        return farthestViewScores(*scene, held, candidates,
-                                  metric == "euclidean" ? ViewDistance::kEuclidean : ViewDistance::kGreatCircle, c);
+        return fvsScores(*scene, held, candidates, metric == "euclidean" ? ViewDistance::kEuclidean : ViewDistance::kGreatCircle);
       },
       py::arg("dataset"), py::arg("held"), py::arg("candidates"), py::arg("metric") = "euclidean",
       "Farthest view sampling: each candidate camera's distance to the nearest held one.");
@@ -251,10 +247,8 @@ void bindNbv(py::module_& m) {
           [](const PySelectionContext& c, py::object candidates) {
             const SelectionContext& x = c.get();
             const std::vector<int> cand = candidates.is_none() ? x.candidates : candidates.cast<std::vector<int>>();
-            Eigen::Vector3d center = Eigen::Vector3d::Zero();
-            for (int v : x.scene.train) center += x.scene.views[static_cast<std::size_t>(v)].camera.center();
-            center /= static_cast<double>(x.scene.train.size());
-            return farthestViewScores(x.scene, x.held, cand, ViewDistance::kEuclidean, center);
+            checkTrainViews(x.scene, cand, "candidates");
+            return fvsScores(x.scene, x.held, cand);
           },
           py::arg("candidates") = py::none(), "farthest view sampling's distances, as the fvs method computes them")
       .def(
