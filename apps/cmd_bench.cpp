@@ -5,6 +5,8 @@
 //   fisher     FisherRF's squared-gradient pass of one view against the backward pass of
 //              the same view, same scene and process (the ratio is what the Fisher
 //              selector costs per candidate relative to a training backward);
+//   train      whole training iterations of a real scene (the built-in room360 by default) by
+//              stage, beside `step` at the same size: where a real iteration's time goes;
 //   occupancy  the prefilter's parts on a room360 scene with simulated SfM points: grid
 //              build, observed dilation, frustum vs visible sets, exact vs hashed scoring,
 //              grid memory.
@@ -18,6 +20,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iostream>
@@ -26,6 +29,7 @@
 
 #include "apps/cli_checks.h"
 #include "apps/commands.h"
+#include "apps/heap_count.h"
 #include "geometry/error.h"
 #include "geometry/occupancy/candidate_sets.h"
 #include "geometry/occupancy/coverage_score.h"
@@ -33,6 +37,7 @@
 #include "geometry/synth/simulated_sfm.h"
 #include "geometry/synth/synthetic_scene.h"
 #include "geometry/synth/write_dataset.h"
+#include "geometry/scene/scene.h"
 #include "splat/fisher.h"
 #include "splat/loss.h"
 #include "splat/raster_execution.h"
@@ -110,7 +115,16 @@ struct StepTimes {
   double median_ms = 0;
   StageSeconds stages;  // summed over the timed steps
   double mean_contributors = 0;
+  double allocations_per_step = 0;   // C++ heap allocations (apps/heap_count.h), timed steps
+  double page_faults_per_step = 0;   // minor + major, whole process, timed steps
 };
+
+// Page faults (minor + major) of the whole process so far.
+std::uint64_t pageFaults() {
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  return static_cast<std::uint64_t>(ru.ru_minflt + ru.ru_majflt);
+}
 
 StepTimes timeSteps(const BenchArgs& a, const Camera& cam, const ImageF& target, bool residual) {
   Gaussians g = benchScene(a, a.seed, cam);
@@ -127,7 +141,9 @@ StepTimes timeSteps(const BenchArgs& a, const Camera& cam, const ImageF& target,
   LearningRates lr;
   std::vector<double> ms;
   StepTimes out;
+  std::uint64_t allocs0 = 0, faults0 = 0;
   for (int it = 0; it < a.warmup + a.steps; ++it) {
+    if (it == a.warmup) allocs0 = heapAllocations(), faults0 = pageFaults();
     StageSeconds secs;
     const auto t0 = std::chrono::steady_clock::now();
     grad.forEachArray([](std::vector<float>& x, std::size_t) { std::fill(x.begin(), x.end(), 0.0f); });
@@ -145,6 +161,8 @@ StepTimes timeSteps(const BenchArgs& a, const Camera& cam, const ImageF& target,
       out.stages.optimizer += secs.optimizer;
     }
   }
+  out.allocations_per_step = static_cast<double>(heapAllocations() - allocs0) / a.steps;
+  out.page_faults_per_step = static_cast<double>(pageFaults() - faults0) / a.steps;
   std::sort(ms.begin(), ms.end());
   out.median_ms = ms[ms.size() / 2];
   const RenderResult r = rasterize(g, cam, s);
@@ -205,6 +223,8 @@ int runBench(const BenchArgs& a) {
     j["median_ms"] = plain.median_ms;
     j["stage_ms"] = stageJson(plain.stages, a.steps);
   }
+  j["allocations_per_step"] = plain.allocations_per_step;
+  j["page_faults_per_step"] = plain.page_faults_per_step;
   j["peak_rss_mb"] = peakRssMb();
   j["cpu"] = cpuName();
   std::cout << j.dump() << std::endl;
@@ -274,6 +294,133 @@ int runFisherBench(const BenchArgs& a) {
   j["backward_ms"] = median(backward_ms);
   j["fisher_to_backward_ratio"] = median(fisher_ms) / median(backward_ms);
   j["information_sum"] = checksum;
+  j["peak_rss_mb"] = peakRssMb();
+  j["cpu"] = cpuName();
+  std::cout << j.dump() << std::endl;
+  return 0;
+}
+
+struct TrainBenchArgs {
+  std::string dataset;  // empty: the built-in room360 scene at width x height
+  int width = 512, height = 384;
+  int iterations = 300;
+  int warmup = 10;
+  int threads = 0;
+  int compare_steps = 21;
+  std::uint64_t seed = 0;
+};
+
+// The dataset to train on: the given folder, or the built-in room360 scene at the
+// requested size, written once to out/bench_room360_WxH (reused by later runs).
+std::string trainBenchDataset(const TrainBenchArgs& a) {
+  if (!a.dataset.empty()) return a.dataset;
+  const std::string dir = "out/bench_room360_" + std::to_string(a.width) + "x" + std::to_string(a.height);
+  if (!std::filesystem::exists(dir + "/manifest.json")) {
+    SyntheticOptions so;
+    so.layout = "room360";
+    so.width = a.width;
+    so.height = a.height;
+    std::cerr << "bench train: writing the room360 scene at " << a.width << "x" << a.height << " to " << dir
+              << " (once)\n";
+    writeSyntheticDataset(makeSyntheticScene(so), dir);
+  }
+  return dir;
+}
+
+// Whole training iterations of a real scene (what `saresgs train` pays), by the trainer's
+// own stages, next to `bench step` on a random scene of the same size, resolution, SH
+// degree and threads in the same process: the difference says where a real iteration's
+// extra time goes (the model's footprint per pixel, densification statistics, image
+// decoding, bookkeeping).
+int runTrainBench(const TrainBenchArgs& a) {
+  const std::string path = trainBenchDataset(a);
+  const Scene scene = loadDataset(path);
+  TrainerOptions opt;
+  opt.seed = a.seed;
+  opt.raster.execution.threads = a.threads;
+  Trainer trainer(scene, opt);
+  // Decoding the images is paid once per view in a real run; timed apart here.
+  auto t0 = std::chrono::steady_clock::now();
+  for (int v : scene.train) (void)scene.image(v);
+  const double decode_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const std::size_t gaussians_start = trainer.gaussians().size();
+  trainer.train(scene.train, a.warmup);
+  const StageSeconds s0 = trainer.seconds();
+  const std::uint64_t allocs0 = heapAllocations(), faults0 = pageFaults();
+  std::vector<double> it_ms;
+  auto last = std::chrono::steady_clock::now();
+  t0 = last;
+  trainer.train(scene.train, a.iterations, [&](const TrainProgress&) {
+    const auto now = std::chrono::steady_clock::now();
+    it_ms.push_back(std::chrono::duration<double, std::milli>(now - last).count());
+    last = now;
+  });
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double allocs = static_cast<double>(heapAllocations() - allocs0) / a.iterations;
+  const double faults = static_cast<double>(pageFaults() - faults0) / a.iterations;
+  const StageSeconds& s1 = trainer.seconds();
+  const double k = 1e3 / a.iterations;
+  const double render = (s1.render - s0.render) * k, loss = (s1.loss - s0.loss) * k,
+               backward = (s1.backward - s0.backward) * k, adam = (s1.optimizer - s0.optimizer) * k,
+               densify = (s1.densify - s0.densify) * k;
+  const double per_it = 1e3 * wall / a.iterations;
+  std::sort(it_ms.begin(), it_ms.end());
+
+  // The trained model's footprint, on the first train view.
+  const Camera& cam = scene.views[scene.train.front()].camera;
+  const RenderResult r = trainer.render(cam);
+  double contrib = 0;
+  for (int n : r.contributors) contrib += n;
+  contrib /= static_cast<double>(std::max<std::size_t>(1, r.contributors.size()));
+
+  // bench step at the model's size, the view's resolution and the trainer's SH degree.
+  BenchArgs b;
+  b.width = cam.K.width;
+  b.height = cam.K.height;
+  b.gaussians = static_cast<int>(trainer.gaussians().size());
+  b.sh_degree = trainer.activeShDegree();
+  b.threads = a.threads;
+  b.steps = a.compare_steps;
+  const Camera bcam = benchCamera(b);
+  RasterSettings rs;
+  rs.sh_degree = b.sh_degree;
+  rs.execution.threads = b.threads;
+  const ImageF target = rasterize(benchScene(b, b.seed + 1000, bcam), bcam, rs).rgb;
+  const StepTimes st = timeSteps(b, bcam, target, false);
+  const double sk = 1e3 / b.steps;
+
+  nlohmann::json j;
+  j["benchmark"] = "train";
+  j["dataset"] = path;
+  j["width"] = cam.K.width;
+  j["height"] = cam.K.height;
+  j["train_views"] = scene.train.size();
+  j["iterations"] = a.iterations;
+  j["warmup_iterations"] = a.warmup;
+  j["threads"] = rasterThreadCount(opt.raster.execution);
+  j["kernels"] = rasterKernelName(opt.raster.execution);
+  j["gaussians_start"] = gaussians_start;
+  j["gaussians_end"] = trainer.gaussians().size();
+  j["sh_degree_end"] = trainer.activeShDegree();
+  j["iterations_per_second"] = a.iterations / wall;
+  j["mean_iteration_ms"] = per_it;
+  j["median_iteration_ms"] = it_ms[it_ms.size() / 2];
+  j["stage_ms"] = {{"render", render}, {"loss", loss}, {"backward", backward}, {"adam", adam},
+                   {"densify", densify}, {"other", per_it - (render + loss + backward + adam + densify)}};
+  j["image_decode_ms_per_view"] = 1e3 * decode_s / static_cast<double>(std::max<std::size_t>(1, scene.train.size()));
+  j["mean_contributors_per_pixel"] = contrib;
+  j["allocations_per_iteration"] = allocs;
+  j["page_faults_per_iteration"] = faults;
+  j["bench_step_same_size"] = {{"median_ms", st.median_ms},
+                               {"mean_contributors_per_pixel", st.mean_contributors},
+                               {"stage_ms", stageJson(st.stages, b.steps)},
+                               {"allocations_per_step", st.allocations_per_step}};
+  j["train_minus_step_ms"] = {{"render", render - st.stages.render * sk},
+                              {"loss", loss - st.stages.loss * sk},
+                              {"backward", backward - st.stages.backward * sk},
+                              {"adam", adam - st.stages.optimizer * sk},
+                              {"densify", densify},
+                              {"total", per_it - st.median_ms}};
   j["peak_rss_mb"] = peakRssMb();
   j["cpu"] = cpuName();
   std::cout << j.dump() << std::endl;
@@ -451,6 +598,19 @@ void addBenchCommand(CLI::App& app, Action& action) {
   fisher->add_option("--threads", f->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
   fisher->add_option("--seed", f->seed, "Scene seed")->check(wholeNumberAtLeast(0))->capture_default_str();
   fisher->callback([&action, f] { action = [f] { return runFisherBench(*f); }; });
+
+  auto tr = std::make_shared<TrainBenchArgs>();
+  CLI::App* train = bench->add_subcommand(
+      "train", "Time whole training iterations of a real scene by stage, beside `bench step` at the same size");
+  train->add_option("--dataset", tr->dataset, "Dataset folder (default: the built-in room360 scene at --width x --height, written once to out/)");
+  train->add_option("--width", tr->width, "Image width of the built-in scene")->check(CLI::Range(16, 8192))->capture_default_str();
+  train->add_option("--height", tr->height, "Image height of the built-in scene")->check(CLI::Range(16, 8192))->capture_default_str();
+  train->add_option("--iterations", tr->iterations, "Timed iterations")->check(CLI::Range(1, 1000000))->capture_default_str();
+  train->add_option("--warmup", tr->warmup, "Untimed iterations first")->check(CLI::Range(0, 1000000))->capture_default_str();
+  train->add_option("--compare-steps", tr->compare_steps, "Timed steps of the same-size `bench step`")->check(CLI::Range(1, 100000))->capture_default_str();
+  train->add_option("--threads", tr->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
+  train->add_option("--seed", tr->seed, "Trainer seed")->check(wholeNumberAtLeast(0))->capture_default_str();
+  train->callback([&action, tr] { action = [tr] { return runTrainBench(*tr); }; });
 
   auto o = std::make_shared<OccupancyBenchArgs>();
   CLI::App* occ = bench->add_subcommand(

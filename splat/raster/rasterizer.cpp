@@ -121,6 +121,32 @@ TileGaussian<T> tileData(const Projected<T>& P, int W, int H) {
   return q;
 }
 
+// Whether Gaussian P's alpha ellipse can reach a pixel centre of the tile [x0, x1) x
+// [y0, y1): a pixel passes o G >= 1/255 only where q = a dx^2 + 2 b dx dy + c dy^2 <= k2 =
+// 2 ln(255 o) (rule 7's threshold), so a tile is skipped when the minimum of q over the
+// box of its pixel centres exceeds k2, widened as tileData's chords are (1% + 1e-4,
+// which covers the float test's rounding for kappa <= 250). The minimum of a positive
+// definite quadratic over a box is 0 when the box holds the mean, else it lies on an
+// edge, where q is a parabola in one variable. Needle-like or non-finite Gaussians are
+// never skipped (the rectangle alone decides, as before). Only the list of pairs
+// shrinks: a skipped pair is one no pixel of the tile would take, so images, walks and
+// gradients are those of the rectangle's lists (tested against the reference).
+template <typename T>
+bool tileMeets(const Projected<T>& P, int x0, int y0, int x1, int y1) {
+  const double a = P.conic[0], b = P.conic[1], c = P.conic[2], o = P.opacity;
+  const double det = a * c - b * b;
+  const double k2 = 2.0 * std::log(255.0 * o) * 1.01 + 1e-4;
+  if (!(a > 0 && det > 0 && std::isfinite(a + b + c + det + k2) && (a + c) * (a + c) <= 1000.0 * det)) return true;
+  const double X0 = x0 + 0.5 - static_cast<double>(P.mean2d[0]), X1 = x1 - 0.5 - static_cast<double>(P.mean2d[0]);
+  const double Y0 = y0 + 0.5 - static_cast<double>(P.mean2d[1]), Y1 = y1 - 0.5 - static_cast<double>(P.mean2d[1]);
+  if (X0 <= 0 && 0 <= X1 && Y0 <= 0 && 0 <= Y1) return k2 >= 0;
+  auto q = [&](double x, double y) { return a * x * x + 2.0 * b * x * y + c * y * y; };
+  double m = std::numeric_limits<double>::infinity();
+  for (const double xe : {X0, X1}) m = std::min(m, q(xe, std::clamp(-b * xe / c, Y0, Y1)));
+  for (const double ye : {Y0, Y1}) m = std::min(m, q(std::clamp(-b * ye / a, X0, X1), ye));
+  return m <= k2;
+}
+
 template <typename T>
 void gatherTile(const RasterStateT<T>& st, int tile, std::vector<TileGaussian<T>>& out) {
   const std::uint32_t b = st.tile_start[tile], e = st.tile_start[tile + 1];
@@ -333,6 +359,18 @@ struct TileCover {
   std::vector<std::array<int, 4>> rect;  // per Gaussian: tiles x0, x1, y0, y1 (inclusive)
 };
 
+// Calls f(tx, ty) for the tiles of rect (tiles x0, x1, y0, y1, inclusive) that P's alpha
+// ellipse meets (tileMeets), row by row: projection counts them and binning lists them
+// with the same calls.
+template <typename T, typename F>
+void forEachTileMet(const Projected<T>& P, const std::array<int, 4>& rect, int W, int H, F&& f) {
+  for (int ty = rect[2]; ty <= rect[3]; ++ty)
+    for (int tx = rect[0]; tx <= rect[1]; ++tx) {
+      const int x0 = tx * kTileSize, y0 = ty * kTileSize;
+      if (tileMeets(P, x0, y0, std::min(W, x0 + kTileSize), std::min(H, y0 + kTileSize))) f(tx, ty);
+    }
+}
+
 // Projects every unmasked Gaussian, culls, fills its tile data, radius and visibility,
 // and counts the tiles its pixel rectangle touches.
 template <typename T>
@@ -366,7 +404,9 @@ TileCover projectAll(const GaussiansT<T>& g, const CameraT<T>& camT, std::span<c
         if (px0 > px1 || py0 > py1) continue;
         std::array<int, 4>& rect = cover.rect[i];
         rect = {px0 / kTileSize, px1 / kTileSize, py0 / kTileSize, py1 / kTileSize};
-        cover.count[i] = static_cast<std::uint32_t>((rect[1] - rect[0] + 1) * (rect[3] - rect[2] + 1));
+        std::uint32_t count = 0;
+        forEachTileMet(P, rect, W, H, [&](int, int) { ++count; });
+        cover.count[i] = count;
       }
     });
   });
@@ -377,7 +417,7 @@ TileCover projectAll(const GaussiansT<T>& g, const CameraT<T>& camT, std::span<c
 // tile of the Gaussians in depth order (depthOrder), so each tile comes out sorted by
 // rule 6.
 template <typename T>
-void binAndSort(const TileCover& cover, RasterStateT<T>& st) {
+void binAndSort(const TileCover& cover, int W, int H, RasterStateT<T>& st) {
   const std::size_t n = cover.count.size();
   const int tiles = st.tiles_x * st.tiles_y;
   st.gauss_start.assign(n + 1, 0);
@@ -389,11 +429,10 @@ void binAndSort(const TileCover& cover, RasterStateT<T>& st) {
       const FloatEnvGuard fenv;  // geometry/float_env.h
       for (std::size_t i = r.begin(); i < r.end(); ++i) {
         if (!cover.count[i]) continue;
-        const auto& [tx0, tx1, ty0, ty1] = cover.rect[i];
         std::uint32_t k = st.gauss_start[i];
-        for (int ty = ty0; ty <= ty1; ++ty)
-          for (int tx = tx0; tx <= tx1; ++tx)
-            slot_tile[k++] = static_cast<std::uint32_t>(ty * st.tiles_x + tx);
+        forEachTileMet(st.proj[i], cover.rect[i], W, H, [&](int tx, int ty) {
+          slot_tile[k++] = static_cast<std::uint32_t>(ty * st.tiles_x + tx);
+        });
       }
     });
   });
@@ -464,7 +503,7 @@ RenderOutputT<T> rasterizeT(const GaussiansT<T>& g, const Camera& cam, const Ras
   out.width = W;
   out.height = H;
   const TileCover cover = projectAll(g, camT, mask, W, H, *st, out);
-  binAndSort(cover, *st);
+  binAndSort(cover, W, H, *st);
   compositeTiles(W, H, *st, out);
   out.state = st;
   return out;
@@ -537,7 +576,7 @@ RenderPair rasterizeWithSubset(const Gaussians& g, const Camera& cam, const Rast
 
   RenderOutputT<float> full, sub;
   const TileCover cover = projectAll(g, camT, {}, W, H, *st, full);
-  binAndSort(cover, *st);
+  binAndSort(cover, W, H, *st);
 
   auto ss = std::make_shared<SubsetRasterState>();
   ss->mask.assign(mask.begin(), mask.end());

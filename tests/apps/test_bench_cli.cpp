@@ -7,6 +7,7 @@
 #include <string>
 
 #include "common/run_command.h"
+#include "common/test_support.h"
 
 namespace {
 
@@ -87,4 +88,48 @@ TEST(BenchCli, FisherPrintsOneJsonLineWithTheRatioToTheBackwardPass) {
   // The scene it timed is seen: an empty view would time nothing.
   EXPECT_GT(j.at("information_sum").get<double>(), 0.0);
   EXPECT_GT(j.at("peak_rss_mb").get<double>(), 0.0);
+}
+
+TEST(BenchCli, StepReportsAllocationsAndPageFaultsPerStep) {
+  const Result r = run("bench step --width 40 --height 32 --gaussians 300 --threads 1 --steps 3 --warmup 1");
+  ASSERT_EQ(r.code, 0) << r.output;
+  nlohmann::json j;
+  ASSERT_NO_THROW(j = nlohmann::json::parse(r.output)) << r.output;
+  EXPECT_GE(j.at("allocations_per_step").get<double>(), 0.0);
+  EXPECT_GE(j.at("page_faults_per_step").get<double>(), 0.0);
+}
+
+// `bench train` on a tiny written scene: whole iterations by the trainer's stages, which
+// with "other" add up to the mean iteration, beside the same-size `bench step`.
+TEST(BenchCli, TrainTimesRealIterationsByStageBesideTheSameSizeStep) {
+  saresgs::test::TempDir d;
+  const std::string data = d.file("tiny");
+  Result r = run("scene --layout object --views 12 --width 48 --height 32 --out " + data);
+  ASSERT_EQ(r.code, 0) << r.output;
+  r = saresgs::test::runCommand(std::string(SARESGS_CLI) + " bench train --dataset " + data +
+                                " --iterations 6 --warmup 2 --compare-steps 2 --threads 1 2>/dev/null");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(r.output.find('\n'), r.output.size() - 1) << r.output;
+  nlohmann::json j;
+  ASSERT_NO_THROW(j = nlohmann::json::parse(r.output)) << r.output;
+  EXPECT_EQ(j.at("benchmark"), "train");
+  EXPECT_EQ(j.at("iterations"), 6);
+  EXPECT_EQ(j.at("width"), 48);
+  EXPECT_EQ(j.at("threads"), 1);
+  EXPECT_GT(j.at("gaussians_end").get<int>(), 0);
+  EXPECT_GT(j.at("mean_contributors_per_pixel").get<double>(), 0.0);
+  double sum = 0;
+  for (const char* k : {"render", "loss", "backward", "adam", "densify", "other"}) {
+    ASSERT_TRUE(j.at("stage_ms").contains(k)) << k;
+    sum += j["stage_ms"][k].get<double>();
+  }
+  EXPECT_NEAR(sum, j.at("mean_iteration_ms").get<double>(), 1e-6 * (1 + sum));
+  for (const char* k : {"render", "loss", "backward", "adam"}) EXPECT_GE(j["stage_ms"][k].get<double>(), 0.0) << k;
+  EXPECT_GT(j.at("bench_step_same_size").at("median_ms").get<double>(), 0.0);
+  EXPECT_EQ(j.at("bench_step_same_size").at("mean_contributors_per_pixel").is_number(), true);
+  EXPECT_GE(j.at("allocations_per_iteration").get<double>(), 0.0);
+
+  r = run("bench train --dataset " + d.file("missing") + " --iterations 2");
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.output.find("missing"), std::string::npos) << r.output;
 }
