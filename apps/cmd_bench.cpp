@@ -223,6 +223,23 @@ int runBench(const BenchArgs& a) {
     j["median_ms"] = plain.median_ms;
     j["stage_ms"] = stageJson(plain.stages, a.steps);
   }
+  // How far from the floor: contributing Gaussian-pixel pairs per step, each pass's ns per
+  // pair and core, and the forward arithmetic's own cost on one core with no memory
+  // traffic (rasterForwardFloorNsPerPair). The kernels also evaluate pixels no Gaussian
+  // reaches within its rectangle, so the fraction is a lower bound on their efficiency.
+  {
+    const double pairs = plain.mean_contributors * a.width * a.height;
+    const int threads = rasterThreadCount(s.execution);
+    const double k = 1e6 * threads / (pairs * a.steps);
+    const nlohmann::json& st = j["stage_ms"];
+    const double floor_ns = rasterForwardFloorNsPerPair(s.execution);
+    const double render_ns = plain.stages.render * 1e3 * k, backward_ns = plain.stages.backward * 1e3 * k;
+    j["pairs_per_step"] = pairs;
+    j["ns_per_pair_core"] = {{"render", render_ns}, {"backward", backward_ns}};
+    j["floor_ns_per_pair"] = floor_ns;
+    j["render_fraction_of_floor"] = floor_ns / render_ns;
+    (void)st;
+  }
   j["allocations_per_step"] = plain.allocations_per_step;
   j["page_faults_per_step"] = plain.page_faults_per_step;
   j["peak_rss_mb"] = peakRssMb();

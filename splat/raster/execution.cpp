@@ -1,8 +1,10 @@
 // The rasterizer's execution settings resolved: arenas per thread count, kernels per CPU.
 #include "splat/raster/execution.h"
 
+#include <chrono>
 #include <cstdlib>
 #include <cstring>
+#include <algorithm>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -67,6 +69,35 @@ bool rasterCpuHasAvx2() {
 #else
   return false;
 #endif
+}
+
+double rasterForwardFloorNsPerPair(const RasterExecution& e, double seconds) {
+  const int isa = raster_execution::kernelIndex(e.kernels);
+  auto run = [isa](long n) {
+    return isa == 1 ? raster_kernels::avx2::compositeFloor(n) : raster_kernels::base4::compositeFloor(n);
+  };
+  const int lanes = isa == 1 ? 8 : 4;
+  volatile float sink = run(1000);  // warm up
+  // Doubles the rounds until one timing lasts `seconds`, then takes the best of three.
+  long n = 1 << 14;
+  double best = 0;
+  for (;;) {
+    const auto t0 = std::chrono::steady_clock::now();
+    sink = run(n);
+    const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (t >= seconds || n > (1L << 40)) {
+      best = t;
+      for (int r = 0; r < 2; ++r) {
+        const auto t1 = std::chrono::steady_clock::now();
+        sink = run(n);
+        best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count());
+      }
+      break;
+    }
+    n *= 2;
+  }
+  (void)sink;
+  return 1e9 * best / (static_cast<double>(n) * 2.0 * lanes);
 }
 
 int rasterThreadCount(const RasterExecution& e) { return raster_execution::arena(e.threads).max_concurrency(); }

@@ -99,6 +99,15 @@ void fisherTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, in
                 const FisherIn& in, const std::uint32_t* entry_slot, float* slots);
 }  // namespace avx2
 
+// compositeTile's per-lane arithmetic for n rounds of two blocks in registers (no memory
+// traffic): the floor a tile kernel could reach (raster_kernels_impl.h). Returns a checksum.
+namespace base4 {
+float compositeFloor(long n);
+}
+namespace avx2 {
+float compositeFloor(long n);
+}
+
 namespace base4 {
 void compositeTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
                    const ForwardOut& out);

@@ -19,6 +19,7 @@ bool compiled() { return true; }
 
 namespace saresgs::raster_kernels::avx2 {
 bool compiled() { return false; }
+float compositeFloor(long) { std::abort(); }
 void compositeTile(const TileGaussian<float>*, int, int, int, int, int, const float*, const ForwardOut&) {
   std::abort();
 }

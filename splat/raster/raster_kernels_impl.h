@@ -278,7 +278,7 @@ struct ForwardState {
   }
 
   // Rule 7 for one Gaussian (entry jf - 1) at one block; returns the lanes it stops.
-  inline vi step(ForwardBlock& B, const Lanes& Ln, vf col0, vf col1, vf col2, vf dep, vf jf) {
+  static inline vi step(ForwardBlock& B, const Lanes& Ln, vf col0, vf col1, vf col2, vf dep, vf jf) {
     const vf alpha = Ln.alpha;
     const vf t = B.Tr;
     const vi ok = (t > vs(0.0f)) & Ln.touches;
@@ -343,6 +343,31 @@ void compositeTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1,
     F.n_active -= hsumInt(stopped);
   }
   F.write(x0, y0, w, h, bg, out);
+}
+
+// The machine's floor for the forward kernel's arithmetic (raster_kernels.h): the same
+// per-lane work as compositeTile (evalLanes and ForwardState::step) on two blocks held
+// in registers, with no tile walk, gather or memory traffic, for n rounds. The offsets
+// move every round so nothing folds away; the checksum keeps the result alive.
+float compositeFloor(long n) {
+  ForwardBlock b[2];
+  for (ForwardBlock& B : b) {
+    B.Tr = vs(1.0f);
+    B.C0 = B.C1 = B.C2 = B.D = B.walked = B.contrib = vs(0.0f);
+  }
+  const vf ha = vs(-0.5f * kLog2e * 0.02f), o = vs(0.6f), hx = vs(1e6f), qy = vs(-0.01f), by = vs(0.002f);
+  const vi row_in = vi{} - 1;
+  const vf col0 = vs(0.3f), col1 = vs(0.5f), col2 = vs(0.7f), dep = vs(2.0f), jf = vs(1.0f);
+  vf dx = laneColCentres() - vs(2.0f);
+  for (long i = 0; i < n; ++i) {
+    for (int k = 0; k < 2; ++k) {
+      ForwardState::step(b[k], evalLanes(dx + vs(static_cast<float>(4 * k)), ha, qy, by, o, hx, row_in), col0, col1,
+                         col2, dep, jf);
+      b[k].Tr = vmax(b[k].Tr, vs(0.5f));  // keeps the pixels live (the real blocks mostly are)
+    }
+    dx = dx + vs(1e-3f);
+  }
+  return hsum(b[0].C0 + b[1].C0 + b[0].D + b[1].D + b[0].contrib + b[1].walked);
 }
 
 namespace {

@@ -1,0 +1,134 @@
+#!/usr/bin/env bash
+# Speed against a baseline commit, built beside this tree and run in the same sitting.
+#
+#   bash scripts/perf.sh table   [BASE]   step time against Gaussians, resolution and threads,
+#                                         this tree and BASE alternated; writes
+#                                         results/perf/table.jsonl and docs/PERFORMANCE.md
+#   bash scripts/perf.sh regress [BASE]   bench step 512x384/20k, this tree and BASE
+#                                         alternated (5 rounds); exits 1, loudly, when
+#                                         this tree is more than 10% slower
+#
+# BASE defaults to b0ae65c for `table` (the code issue 26 is judged against) and to
+# HEAD~1 for `regress`. It is built once into build-perf/<sha> (Release, the CLI only;
+# a few minutes on two cores; PERF_BASE_BIN=path uses a binary built before). This tree
+# must already be built (scripts/build.sh).
+# Nothing here is a test: times depend on the machine and its load, which each output
+# names. Not run by scripts/test.sh.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+mode=${1:-}
+case "$mode" in
+  table) base_ref=${2:-b0ae65c} ;;
+  regress) base_ref=${2:-HEAD~1} ;;
+  *) echo "usage: bash scripts/perf.sh table|regress [BASE-COMMIT]" >&2; exit 2 ;;
+esac
+new=./build/apps/saresgs
+[ -x "$new" ] || { echo "perf.sh: $new is missing: run bash scripts/build.sh first" >&2; exit 2; }
+sha=$(git rev-parse --short=7 "$base_ref^{commit}") || { echo "perf.sh: no commit $base_ref" >&2; exit 2; }
+dir=build-perf/$sha
+base=${PERF_BASE_BIN:-$dir/build/apps/saresgs}
+if [ ! -x "$base" ]; then
+  echo "perf.sh: building $sha into $dir (once)" >&2
+  rm -rf "$dir"
+  mkdir -p "$dir"
+  git archive "$sha" | tar -x -C "$dir"
+  cmake -S "$dir" -B "$dir/build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSARESGS_BUILD_TESTS=OFF >/dev/null
+  cmake --build "$dir/build" --parallel "$(nproc)" --target saresgs >/dev/null
+fi
+[ -x "$base" ] || { echo "perf.sh: the build of $sha did not produce $base" >&2; exit 1; }
+load() { cut -d' ' -f1-3 /proc/loadavg; }
+machine="$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(nproc) cores"
+
+if [ "$mode" = regress ]; then
+  args="bench step --width 512 --height 384 --gaussians 20000 --steps 21"
+  echo "regress: this tree ($(git rev-parse --short=7 HEAD)$(git diff --quiet || echo '+changes')) vs $sha; $machine; load $(load)" >&2
+  out=$(for r in 1 2 3 4 5; do
+    for who in new base; do
+      bin=$new; [ $who = base ] && bin=$base
+      echo "$who $($bin $args | tail -1)"
+    done
+  done)
+  /usr/bin/python3 - "$out" <<'EOF'
+import json, statistics, sys
+runs = {"new": [], "base": []}
+for line in sys.argv[1].splitlines():
+    who, js = line.split(" ", 1)
+    runs[who].append(json.loads(js)["median_ms"])
+n, b = statistics.median(runs["new"]), statistics.median(runs["base"])
+print(f"bench step 512x384/20k: this tree {n:.2f} ms, base {b:.2f} ms (medians of 5 alternated runs), ratio {n / b:.3f}")
+print("  this tree:", " ".join(f"{x:.1f}" for x in runs["new"]), "| base:", " ".join(f"{x:.1f}" for x in runs["base"]))
+if n > 1.10 * b:
+    print(f"REGRESSION: this tree's step is {100 * (n / b - 1):.0f}% slower than the base (limit 10%)", file=sys.stderr)
+    sys.exit(1)
+EOF
+  echo "load after: $(load)" >&2
+  exit 0
+fi
+
+# table: configurations, each run alternately by this tree and the base.
+mkdir -p results/perf
+tmp=results/perf/table.jsonl.tmp
+: > "$tmp"
+configs=(
+  "--width 512 --height 384 --gaussians 10000 --threads 1" "--width 512 --height 384 --gaussians 10000 --threads 2"
+  "--width 512 --height 384 --gaussians 20000 --threads 1" "--width 512 --height 384 --gaussians 20000 --threads 2"
+  "--width 512 --height 384 --gaussians 100000 --threads 1" "--width 512 --height 384 --gaussians 100000 --threads 2"
+  "--width 512 --height 384 --gaussians 500000 --threads 1 --steps 7" "--width 512 --height 384 --gaussians 500000 --threads 2 --steps 7"
+  "--width 256 --height 192 --gaussians 20000 --threads 1" "--width 256 --height 192 --gaussians 20000 --threads 2"
+  "--width 1024 --height 768 --gaussians 20000 --threads 1 --steps 11" "--width 1024 --height 768 --gaussians 20000 --threads 2 --steps 11"
+)
+echo "table: this tree ($(git rev-parse --short=7 HEAD)) vs $sha; $machine; load $(load)" >&2
+load_before=$(load)
+for c in "${configs[@]}"; do
+  for who in new base; do
+    bin=$new; [ $who = base ] && bin=$base
+    line=$($bin bench step $c | tail -1)
+    echo "{\"who\": \"$who\", \"args\": \"$c\", \"load\": \"$(load)\", \"result\": $line}" >> "$tmp"
+    echo "  $who $c" >&2
+  done
+done
+mv "$tmp" results/perf/table.jsonl
+/usr/bin/python3 - "$sha" "$(git rev-parse --short=7 HEAD)" "$machine" "$load_before" "$(load)" <<'EOF'
+import json, sys
+base_sha, head, machine, load0, load1 = sys.argv[1:6]
+rows = [json.loads(l) for l in open("results/perf/table.jsonl")]
+def key(r):
+    d = r["result"]
+    return (d["width"], d["height"], d["gaussians"], d["threads"])
+new = {key(r): r["result"] for r in rows if r["who"] == "new"}
+base = {key(r): r["result"] for r in rows if r["who"] == "base"}
+ref = new[(512, 384, 20000, 1)]
+out = []
+w = out.append
+w("# Performance: how a training step grows\n")
+w(f"Made by `bash scripts/perf.sh table` (this tree {head} against {base_sha}, built beside it and run")
+w(f"alternately in the same sitting). Machine: {machine}; load {load0} before, {load1} after.")
+w("Times on this VM vary up to 3x from day to day: compare columns of one table, not tables.\n")
+w("`bench step` on its random scene (16 mean 3-sigma ellipses per pixel, SH degree 3: the Gaussians")
+w("shrink as their number grows, so the Gaussian-pixel pairs stay proportional to the pixels). The")
+w("expected growth is from the reference row (512x384, 20k, 1 thread): pairs grow with the pixels,")
+w("per-Gaussian work (projection, sort, Adam) with the count, and the threads divide both.\n")
+w("| pixels | Gaussians | threads | step ms | base ms | ratio | pairs/px | expected x | measured x | render ns/pair·core | floor ns/pair | fraction of floor |")
+w("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+ref_pairs = ref["pairs_per_step"]
+ref_adam = ref["stage_ms"]["adam"]
+for k in sorted(new, key=lambda k: (k[0] * k[1], k[2], k[3])):
+    n, b = new[k], base.get(k)
+    # Expected: the per-pair part scales with pairs, the Adam part with Gaussians; both / threads.
+    per_pair = ref["median_ms"] - ref_adam
+    expected = (per_pair * n["pairs_per_step"] / ref_pairs + ref_adam * k[2] / 20000) / k[3] / ref["median_ms"]
+    w(f"| {k[0]}x{k[1]} | {k[2]} | {k[3]} | {n['median_ms']:.1f} | {b['median_ms'] if b else float('nan'):.1f} | "
+      f"{n['median_ms'] / b['median_ms'] if b else float('nan'):.2f} | {n['mean_contributors_per_pixel']:.1f} | "
+      f"{expected:.2f} | {n['median_ms'] / ref['median_ms']:.2f} | {n['ns_per_pair_core']['render']:.2f} | "
+      f"{n['floor_ns_per_pair']:.2f} | {n['render_fraction_of_floor']:.2f} |")
+w("")
+w("Columns: *step ms* and *base ms* are medians over the timed steps; *ratio* this tree / base;")
+w("*pairs/px* contributing Gaussians per pixel; *expected x* / *measured x* the step time over the")
+w("reference row's; *render ns/pair·core* the forward pass's time times its threads over the")
+w("contributing pairs; *floor* the forward arithmetic alone on one core with no memory traffic")
+w("(`rasterForwardFloorNsPerPair`); *fraction of floor* floor / render (1 would be the floor).")
+w("The raw lines: results/perf/table.jsonl.")
+open("docs/PERFORMANCE.md.tmp", "w").write("\n".join(out) + "\n")
+EOF
+mv docs/PERFORMANCE.md.tmp docs/PERFORMANCE.md
+echo "wrote docs/PERFORMANCE.md and results/perf/table.jsonl; load after $(load)" >&2
