@@ -12,6 +12,21 @@
 
 namespace saresgs::projection {
 
+// The contract's thresholds (splat/rasterize.h) in the working scalar: the float values
+// for the float path; for double, the decimal values the reference renderer uses
+// (reference_renderer.cpp), so that the double fast path makes the reference's exact
+// decisions (1/255 in float is 6e-8 relative above 1/255 in double: with the float
+// value a 2048x1536 render of large Gaussians skipped a contribution the reference
+// took; FastVsReference.ExtremeFieldsOfViewPrincipalPointsAndImageSizes).
+template <typename T>
+struct Thresholds {
+  static constexpr T min_alpha = kMinAlpha, max_alpha = kMaxAlpha, min_transmittance = kMinTransmittance;
+};
+template <>
+struct Thresholds<double> {
+  static constexpr double min_alpha = 1.0 / 255.0, max_alpha = 0.99, min_transmittance = 1e-4;
+};
+
 template <typename T>
 struct Mat3 {
   T m[3][3];
@@ -137,7 +152,7 @@ Projected<T> project(const GaussiansT<T>& g, std::size_t i, const CameraT<T>& ca
   const T xz = p[0] / p[2], yz = p[1] / p[2];
   if (!(std::abs(xz - cam.gx_mid) <= cam.gx_half && std::abs(yz - cam.gy_mid) <= cam.gy_half)) return P;
   const T o = sigmoid(g.opacities[i]);
-  if (!(o >= T(kMinAlpha))) return P;
+  if (!(o >= Thresholds<T>::min_alpha)) return P;
 
   // Sigma = M M^T, M = Rq S.
   const Mat3<T> Rq = quatToRot(&g.rotations[4 * i]);

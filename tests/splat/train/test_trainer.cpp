@@ -16,6 +16,7 @@
 #include "splat/loss.h"
 #include "splat/train/residual.h"
 #include "splat/train/adam.h"
+#include "splat/fisher.h"
 #include "splat/train/trainer.h"
 
 #include <tbb/task_arena.h>
@@ -246,7 +247,14 @@ TEST(Trainer, ExtremeModelsTrainWithoutNanOrInf) {
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<float> u(-1, 1);
   for (std::size_t i = 0; i < g.size(); ++i) {
-    switch (i % 8) {
+    switch (i % 10) {
+      case 8:  // a nearly singular covariance: one axis a millionth of the others
+        g.log_scales[3 * i] = std::log(1e-6f * static_cast<float>(s.extent));
+        g.log_scales[3 * i + 1] = g.log_scales[3 * i + 2] = std::log(0.05f * static_cast<float>(s.extent));
+        break;
+      case 9:  // huge SH coefficients
+        for (std::size_t k = 0; k < g.sh.size() / g.size(); ++k) g.sh[i * (g.sh.size() / g.size()) + k] = (k % 2 ? -1e6f : 1e6f);
+        break;
       case 0: for (int k = 0; k < 3; ++k) g.log_scales[3 * i + k] = std::log(1e-6f * static_cast<float>(s.extent)); break;
       case 1: for (int k = 0; k < 3; ++k) g.log_scales[3 * i + k] = std::log(1e4f * static_cast<float>(s.extent)); break;
       case 2: g.opacities[i] = 30; break;
@@ -261,10 +269,19 @@ TEST(Trainer, ExtremeModelsTrainWithoutNanOrInf) {
       default: break;
     }
   }
+  // Fisher information of the extreme model (what the selectors score) is finite too.
+  {
+    Gaussians H = g.zerosLike();
+    addViewInformation(g, cam, t.rasterSettings(), H);
+    EXPECT_TRUE(allFinite(H));
+  }
   t.train(s.train, 45);
   EXPECT_TRUE(allFinite(t.gaussians()));
   const RenderResult r = t.render(cam);
   for (float x : r.rgb.data) ASSERT_TRUE(std::isfinite(x));
+  Gaussians H = t.gaussians().zerosLike();
+  addViewInformation(t.gaussians(), cam, t.rasterSettings(), H);
+  EXPECT_TRUE(allFinite(H));
 }
 
 // Found by fuzz/fuzz_trainer_checkpoint.cpp (UBSan: memcpy given the null data() of an
