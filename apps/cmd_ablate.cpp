@@ -66,6 +66,31 @@ void ensureDataset(const AblationScene& sc) {
   if (rc != 0) throw std::runtime_error("generating " + sc.dataset + " failed");
 }
 
+// An exclusive hold on one job of an output folder (runs/<job>.lock, flock): two runners
+// on one folder (a shard started twice, a resubmitted array task beside the old one)
+// never run the same job at once. The kernel drops the hold when its process dies, so a
+// killed runner's job is free for the next one, which resumes it from its checkpoint.
+class JobLock {
+ public:
+  explicit JobLock(const std::string& path) : fd_(::open(path.c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0644)) {
+    if (fd_ < 0) throw std::runtime_error("cannot open lock file " + path);
+    held_ = ::flock(fd_, LOCK_EX | LOCK_NB) == 0;
+  }
+  ~JobLock() {
+    if (held_) ::flock(fd_, LOCK_UN);
+    ::close(fd_);
+  }
+  JobLock(const JobLock&) = delete;
+  JobLock& operator=(const JobLock&) = delete;
+  bool held() const { return held_; }
+
+ private:
+  int fd_;
+  bool held_ = false;
+};
+
+std::string jobLockPath(const std::string& out, const AblationJob& j) { return jobFolder(out, j) + ".lock"; }
+
 const AblationScene& sceneOf(const AblationGrid& g, const std::string& name) {
   for (const auto& s : g.scenes)
     if (s.name == name) return s;
@@ -175,7 +200,7 @@ int runAblate(const AblateArgs& a) {
   // such jobs are left, the runner waits for another shard to finish their sources.
   std::vector<std::size_t> queue(jobs.size());
   for (std::size_t k = 0; k < jobs.size(); ++k) queue[k] = k;
-  std::size_t deferred_in_a_row = 0;
+  std::size_t deferred_in_a_row = 0, held_elsewhere_in_a_row = 0;
   std::set<std::string> failed_ids;
   while (!queue.empty()) {
     const std::size_t k = queue.front();
@@ -199,6 +224,26 @@ int runAblate(const AblateArgs& a) {
     deferred_in_a_row = 0;
     if (jobFinished(a.out, j)) {
       std::cerr << "[ablate] " << k + 1 << "/" << jobs.size() << " " << j.id << ": finished before, skipped\n";
+      ++done;
+      continue;
+    }
+    // Another runner on this folder holds the job: it goes to the back of the queue; when
+    // only held jobs are left, this runner waits for them (finished there, or free again
+    // because that runner died, in which case it runs them here).
+    const JobLock lock(jobLockPath(a.out, j));
+    if (!lock.held()) {
+      queue.push_back(k);
+      if (++held_elsewhere_in_a_row >= queue.size()) {
+        std::cerr << "[ablate] " << queue.size() << " jobs are running in another process (" << j.id
+                  << ", ...): checking again in 5 s\n";
+        std::this_thread::sleep_for(std::chrono::seconds(5));
+        held_elsewhere_in_a_row = 0;
+      }
+      continue;
+    }
+    held_elsewhere_in_a_row = 0;
+    if (jobFinished(a.out, j)) {  // finished by the runner that held it a moment ago
+      std::cerr << "[ablate] " << k + 1 << "/" << jobs.size() << " " << j.id << ": finished by another runner\n";
       ++done;
       continue;
     }

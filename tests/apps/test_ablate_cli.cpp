@@ -150,6 +150,33 @@ TEST(AblateCli, GnuParallelShardsIntoOneFolderThenMerge) {
   EXPECT_EQ(readBytes(out + "/tables/paired.csv").rfind("scene,method,baseline,metric,mean_diff,ci_low,ci_high,n,win_rate\n", 0), 0u);
 }
 
+// Two runners of the whole grid on one folder at once (a shard started twice, an array
+// task resubmitted beside the old one) while merges run: each job runs exactly once (its
+// job lock, runs/<job>.lock), both runners end with every job finished, and the tables
+// equal those of a single clean run.
+TEST(AblateCli, TwoRunnersOnOneFolderRunEachJobOnceWhileMergesRun) {
+  TempDir d;
+  const std::string grid = writeGrid(d);
+  const std::string out = d.file("out"), clean = d.file("clean");
+  Result r = shell(cli() + " ablate --config " + grid + " --out " + out + " > " + d.file("logA") + " 2>&1 & a=$!; " + cli() +
+                   " ablate --config " + grid + " --out " + out + " > " + d.file("logB") + " 2>&1 & b=$!; " +
+                   "while kill -0 $a 2>/dev/null || kill -0 $b 2>/dev/null; do " + cli() + " ablate merge --config " +
+                   grid + " --out " + out + " --allow-partial > /dev/null 2>&1 || exit 9; sleep 0.3; done; " +
+                   "wait $a; sa=$?; wait $b; exit $((sa + $?))");
+  const std::string logs = readBytes(d.file("logA")) + readBytes(d.file("logB"));
+  ASSERT_EQ(r.code, 0) << logs;
+  for (const char* job : {"tiny__prefilter-sweep", "tiny__random__default__s0", "tiny__random__default__s1",
+                          "tiny__fvs__default__s0", "tiny__fvs__default__s1"})
+    EXPECT_EQ(count(logs, std::string(" ") + job + "\n"), 1) << job << " should start once:\n" << logs;
+  r = shell(cli() + " ablate --config " + grid + " --out " + clean);
+  ASSERT_EQ(r.code, 0) << r.output;
+  r = shell(cli() + " ablate merge --config " + grid + " --out " + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  // Same numbers as the clean run (the tables hold no timings but time.csv).
+  for (const char* t : {"results.csv", "paired.csv", "criteria.csv"})
+    EXPECT_EQ(readBytes(out + "/tables/" + t), readBytes(clean + "/tables/" + t)) << t;
+}
+
 // Every job's `saresgs active` arguments are checked when the config is read: a bad value
 // in a variant's args or in method_args stops the grid before any job runs, naming the
 // config and the field.
