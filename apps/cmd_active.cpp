@@ -120,7 +120,9 @@ int runActive(const ActiveArgs& a) {
   const std::string ckpt = a.out + "/checkpoint.json";
   if (!a.resume && fs::exists(ckpt))
     throw std::runtime_error(ckpt + " exists: pass --resume to continue that run, or choose another --out");
+  const bool resuming = a.resume && fs::exists(ckpt);
   ActiveRun run(scene, opt, ckpt);
+  if (resuming) std::cerr << "resuming from " << ckpt << "\n";
   std::cerr << "active run: " << a.method << " on " << a.dataset << " (" << scene.train.size() << " candidates, "
             << scene.test.size() << " test views), preset " << a.preset << ", seed " << opt.seed << "\n";
   Progress progress;
