@@ -7,6 +7,7 @@
 
 #include "apps/cli_checks.h"
 #include "apps/commands.h"
+#include "apps/memory_budget.h"
 #include "apps/prefilter_flags.h"
 #include "apps/progress.h"
 #include "geometry/scene/dataset_checks.h"
@@ -36,7 +37,7 @@ struct ActiveArgs {
   double fisher_lambda = 1e-6;
   std::optional<int> max_views, interval, total, final_iterations, renamed_iterations;
   std::optional<long long> max_gaussians;
-  std::optional<double> beta, prefilter_keep, hybrid_weight;
+  std::optional<double> beta, prefilter_keep, hybrid_weight, memory_budget_gb;
   std::string hybrid_fisher = "logdet", hybrid_coverage = "facility";
   PrefilterFlags prefilter;
 };
@@ -120,6 +121,22 @@ int runActive(const ActiveArgs& a) {
   const std::string ckpt = a.out + "/checkpoint.json";
   if (!a.resume && fs::exists(ckpt))
     throw std::runtime_error(ckpt + " exists: pass --resume to continue that run, or choose another --out");
+  {
+    // The views it will train on: max_views of the candidates (their sizes, as the largest
+    // ones are not known before selection: the first ones); the models it holds: the
+    // loop's, the final fit's and, for residual methods, the plain refit's.
+    std::vector<int> trained(scene.train.begin(),
+                             scene.train.begin() + std::min<std::ptrdiff_t>(static_cast<std::ptrdiff_t>(scene.train.size()),
+                                                                            std::max(opt.max_views, 1)));
+    const std::size_t initial =
+        scene.points.empty() ? static_cast<std::size_t>(opt.trainer.random_init_points) : scene.points.size();
+    const int models = 1 + (opt.final_iterations > 0 ? (needsOf(opt.method).residual ? 2 : 1) : 0);
+    std::size_t cap = opt.trainer.densify.max_gaussians;
+    std::cerr << applyMemoryBudget(estimateTrainingMemory(scene, trained, scene.test.empty() ? scene.train : scene.test,
+                                                          initial, opt.trainer.max_sh_degree, models),
+                                   memoryBudgetBytes(a.memory_budget_gb), a.memory_budget_gb.has_value(), cap);
+    opt.trainer.densify.max_gaussians = opt.final_trainer.densify.max_gaussians = cap;
+  }
   const bool resuming = a.resume && fs::exists(ckpt);
   ActiveRun run(scene, opt, ckpt);
   if (resuming) std::cerr << "resuming from " << ckpt << "\n";
@@ -169,6 +186,10 @@ CLI::App* addActiveOptions(CLI::App& app, const std::shared_ptr<ActiveArgs>& a) 
   sub->add_option("--final-iterations", a->final_iterations,
                   "Final fit: a fresh model trained on the chosen views for N iterations (0: none; preset's by default)")
       ->check(wholeNumberAtLeast(0));
+  sub->add_option("--memory-budget", a->memory_budget_gb,
+                  "GB this run may use: refused before it starts if its images and initial models do not fit, the "
+                  "models capped to fit (default: refused only beyond what the machine has available)")
+      ->check(CLI::Range(0.001, 1e6));
   sub->add_option("--max-gaussians", a->max_gaussians, "Cap on the model size (0: none; preset's by default)")
       ->check(CLI::Range(0.0, 1e9));
   sub->add_option("--residual-beta", a->beta, "Uncertain fraction of the residual subset (default 0.1)")->check(CLI::Range(0.0, 1.0));

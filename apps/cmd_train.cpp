@@ -3,12 +3,14 @@
 #include <nlohmann/json.hpp>
 
 #include <chrono>
+#include <optional>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 
 #include "apps/cli_checks.h"
 #include "apps/commands.h"
+#include "apps/memory_budget.h"
 #include "apps/progress.h"
 #include "apps/view_list.h"
 #include "geometry/scene/dataset_checks.h"
@@ -38,6 +40,7 @@ struct TrainArgs {
   std::string ranking = "both", views;
   double schedule_scale = 1.0;
   TrainerOptions opt;
+  std::optional<double> memory_budget_gb;
 };
 
 std::string shortCount(std::size_t n) {
@@ -59,6 +62,11 @@ int runTrain(TrainArgs& a) {
   fs::create_directories(a.out);
   if (const int n = removeStaleTemporaries(a.out)) std::cerr << "removed " << n << " temporaries left by a killed run\n";
   const std::string ckpt = a.out + "/checkpoint.bin";
+  const std::size_t initial = scene.points.empty() ? static_cast<std::size_t>(a.opt.random_init_points) : scene.points.size();
+  const MemoryEstimate memory = estimateTrainingMemory(scene, views, scene.test.empty() ? scene.train : scene.test,
+                                                       initial, a.opt.max_sh_degree);
+  const double budget = memoryBudgetBytes(a.memory_budget_gb);
+  std::cerr << applyMemoryBudget(memory, budget, a.memory_budget_gb.has_value(), a.opt.densify.max_gaussians);
   Trainer trainer(scene, a.opt);
   if (a.resume && fs::exists(ckpt)) {
     trainer.loadCheckpoint(ckpt);
@@ -100,6 +108,12 @@ int runTrain(TrainArgs& a) {
   j["psnr"] = ev.psnr;
   j["ssim"] = ev.ssim;
   j["gaussians"] = trainer.gaussians().size();
+  j["max_gaussians"] = a.opt.densify.max_gaussians;
+  j["memory"] = {{"estimate_at_start_bytes", memory.bytesFor(initial)},
+                 {"estimate_at_end_bytes", memory.bytesFor(trainer.gaussians().size())},
+                 {"budget_bytes", budget},
+                 {"budget_from", a.memory_budget_gb ? "--memory-budget" : "available"},
+                 {"peak_rss_bytes", peakRssBytes()}};
   j["train_seconds_this_run"] = train_seconds;
   j["threads"] = rasterThreadCount(a.opt.raster.execution);
   j["residual"] = a.opt.residual.enabled;
@@ -131,6 +145,10 @@ void addTrainCommand(CLI::App& app, Action& action) {
   sub->add_option("--threads", a->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
   sub->add_option("--densify-until", a->opt.densify.until_iter, "Last densification iteration")->check(wholeNumberAtLeast(0))->capture_default_str();
   sub->add_option("--max-gaussians", a->opt.densify.max_gaussians, "Cap on the model size (0: none)")->check(CLI::Range(0.0, 1e9))->capture_default_str();
+  sub->add_option("--memory-budget", a->memory_budget_gb,
+                  "GB this run may use: refused before it starts if its images and initial model do not fit, the model "
+                  "capped to fit (default: refused only beyond what the machine has available)")
+      ->check(CLI::Range(0.001, 1e6));
   sub->add_option("--random-init", a->opt.random_init_points, "Random points when the dataset has none")->check(CLI::Range(1, 10000000))->capture_default_str();
   sub->add_flag("--residual", a->opt.residual.enabled, "Add SA-ResGS residual supervision");
   sub->add_option("--views", a->views,

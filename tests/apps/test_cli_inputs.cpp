@@ -141,3 +141,40 @@ TEST(CliInputs, OptionsAndCheckpointsNameTheOptionOrFieldAndTheRenamedIterations
                   {d.file("a/checkpoint.json"), field}, field);
   }
 }
+
+// The memory budget (issue 25): a run whose images and initial model do not fit is refused
+// before it starts, naming --memory-budget with the estimate and what to change; one that
+// fits has its model capped to the budget, and densification honours the cap.
+TEST(CliInputs, MemoryBudgetRefusesEarlyOrCapsTheModel) {
+  saresgs::test::TempDir d;
+  const std::string data = d.file("tiny");
+  Result r = run("scene --layout object --views 12 --width 64 --height 48 --out " + data);
+  ASSERT_EQ(r.code, 0) << r.output;
+  r = run("train --dataset " + data + " --iterations 5 --out " + d.file("o1") + " --memory-budget 0.001");
+  EXPECT_NE(r.code, 0);
+  for (const char* says : {"--memory-budget", "needs about", "images", "initial model", "--downscale"})
+    EXPECT_NE(r.output.find(says), std::string::npos) << says << ": " << r.output;
+  EXPECT_FALSE(std::filesystem::exists(d.file("o1") + "/results.json"));
+  r = run("active --dataset " + data + " --out " + d.file("o2") + " --memory-budget 0.001");
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.output.find("--memory-budget"), std::string::npos) << r.output;
+
+  // A budget with room for about 1.5x the initial 12k Gaussians: the run states the cap
+  // and trains with it (results.json), and the estimate at the end is within the budget.
+  r = run("train --dataset " + data + " --iterations 20 --out " + d.file("o3") + " --memory-budget 0.1");
+  ASSERT_EQ(r.code, 0) << r.output;
+  const std::size_t at = r.output.find("capped at ");
+  ASSERT_NE(at, std::string::npos) << r.output;
+  const std::size_t cap = std::stoull(r.output.substr(at + 10));
+  EXPECT_GT(cap, 12000u);
+  EXPECT_LT(cap, 40000u);
+  const nlohmann::json j = nlohmann::json::parse(saresgs::test::readBytes(d.file("o3") + "/results.json"));
+  EXPECT_EQ(j["max_gaussians"].get<std::size_t>(), cap);
+  EXPECT_LE(j["gaussians"].get<std::size_t>(), cap);
+  EXPECT_LE(j["memory"]["estimate_at_end_bytes"].get<double>(), 1e8);
+  EXPECT_EQ(j["memory"]["budget_from"], "--memory-budget");
+  // Without a budget nothing is capped: the numbers do not depend on what is free.
+  r = run("train --dataset " + data + " --iterations 20 --out " + d.file("o4"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(nlohmann::json::parse(saresgs::test::readBytes(d.file("o4") + "/results.json"))["max_gaussians"], 0);
+}
