@@ -15,6 +15,19 @@ using Result = saresgs::test::CommandResult;
 
 Result run(const std::string& args) { return saresgs::test::runCommand(std::string(SARESGS_CLI) + " " + args); }
 
+// A benchmark's whole output is one JSON line: parsed into j.
+::testing::AssertionResult oneJsonLine(const Result& r, nlohmann::json& j) {
+  if (r.code != 0) return ::testing::AssertionFailure() << "exit " << r.code << ": " << r.output;
+  if (r.output.empty() || r.output.find('\n') != r.output.size() - 1)
+    return ::testing::AssertionFailure() << "not one line: " << r.output;
+  try {
+    j = nlohmann::json::parse(r.output);
+  } catch (const std::exception& e) {
+    return ::testing::AssertionFailure() << e.what() << ": " << r.output;
+  }
+  return ::testing::AssertionSuccess();
+}
+
 }  // namespace
 
 TEST(BenchCli, OccupancyPrintsOneJsonLineWithTheMeasuredParts) {
@@ -90,13 +103,19 @@ TEST(BenchCli, FisherPrintsOneJsonLineWithTheRatioToTheBackwardPass) {
   EXPECT_GT(j.at("peak_rss_mb").get<double>(), 0.0);
 }
 
-TEST(BenchCli, StepReportsAllocationsAndPageFaultsPerStep) {
-  const Result r = run("bench step --width 40 --height 32 --gaussians 300 --threads 1 --steps 3 --warmup 1");
-  ASSERT_EQ(r.code, 0) << r.output;
+TEST(BenchCli, StepReportsAllocationsPageFaultsAndTheFloor) {
   nlohmann::json j;
-  ASSERT_NO_THROW(j = nlohmann::json::parse(r.output)) << r.output;
+  ASSERT_TRUE(oneJsonLine(run("bench step --width 40 --height 32 --gaussians 300 --threads 1 --steps 3 --warmup 1"), j));
   EXPECT_GE(j.at("allocations_per_step").get<double>(), 0.0);
   EXPECT_GE(j.at("page_faults_per_step").get<double>(), 0.0);
+  // Pairs are the contributors of every pixel; the floor is a positive time per pair and
+  // the fraction its ratio to the render's (finite: the scene is seen).
+  EXPECT_NEAR(j.at("pairs_per_step").get<double>(), j.at("mean_contributors_per_pixel").get<double>() * 40 * 32, 1e-6);
+  EXPECT_GT(j.at("pairs_per_step").get<double>(), 0.0);
+  EXPECT_GT(j.at("floor_ns_per_pair").get<double>(), 0.0);
+  EXPECT_GT(j.at("ns_per_pair_core").at("render").get<double>(), 0.0);
+  EXPECT_NEAR(j.at("render_fraction_of_floor").get<double>(),
+              j["floor_ns_per_pair"].get<double>() / j["ns_per_pair_core"]["render"].get<double>(), 1e-9);
 }
 
 // `bench train` on a tiny written scene: whole iterations by the trainer's stages, which
@@ -108,10 +127,8 @@ TEST(BenchCli, TrainTimesRealIterationsByStageBesideTheSameSizeStep) {
   ASSERT_EQ(r.code, 0) << r.output;
   r = saresgs::test::runCommand(std::string(SARESGS_CLI) + " bench train --dataset " + data +
                                 " --iterations 6 --warmup 2 --compare-steps 2 --threads 1 2>/dev/null");
-  ASSERT_EQ(r.code, 0) << r.output;
-  EXPECT_EQ(r.output.find('\n'), r.output.size() - 1) << r.output;
   nlohmann::json j;
-  ASSERT_NO_THROW(j = nlohmann::json::parse(r.output)) << r.output;
+  ASSERT_TRUE(oneJsonLine(r, j));
   EXPECT_EQ(j.at("benchmark"), "train");
   EXPECT_EQ(j.at("iterations"), 6);
   EXPECT_EQ(j.at("width"), 48);
