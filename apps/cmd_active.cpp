@@ -109,7 +109,7 @@ int runActive(const ActiveArgs& a) {
   DatasetOptions dopt;
   dopt.load.downscale = a.downscale;
   const Scene scene = loadDataset(a.dataset, dopt);
-  std::cerr << formatWarnings(checkDataset(scene));
+  std::cerr << formatWarnings(checkDataset(scene, opt.trainer.raster.near_plane));
   if (!a.replay.empty()) {
     const RunReport replayed = runReportFromJson(readJsonFile(a.replay), a.replay);
     opt.replay = replaySequence(scene, replayed, a.replay);

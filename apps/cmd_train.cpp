@@ -56,7 +56,7 @@ int runTrain(TrainArgs& a) {
   DatasetOptions dopt;
   dopt.load.downscale = a.downscale;
   const Scene scene = loadDataset(a.dataset, dopt);
-  std::cerr << formatWarnings(checkDataset(scene));
+  std::cerr << formatWarnings(checkDataset(scene, a.opt.raster.near_plane));
   if (a.schedule_scale != 1.0) a.opt = scaledSchedule(a.opt, a.schedule_scale);
   const std::vector<int> views = a.views.empty() ? scene.train : parseTrainViews(a.views, scene, "--views");
   fs::create_directories(a.out);

@@ -1,5 +1,6 @@
 #include "geometry/scene/dataset_checks.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <sstream>
@@ -31,7 +32,7 @@ std::size_t pointsSeen(const Scene& scene, const Camera& c, std::size_t enough) 
 
 }  // namespace
 
-std::vector<DatasetWarning> checkDataset(const Scene& scene) {
+std::vector<DatasetWarning> checkDataset(const Scene& scene, double near_plane) {
   std::vector<DatasetWarning> out;
   std::size_t blind_train = 0;
   std::vector<bool> is_train(scene.views.size(), false);
@@ -58,6 +59,25 @@ std::vector<DatasetWarning> checkDataset(const Scene& scene) {
                      "none of the " + std::to_string(scene.points.size()) +
                          " sparse points projects into this view: check its intrinsics and pose"});
     }
+  }
+  // The frame: where the train cameras are, and over how much they spread.
+  if (scene.train.size() >= 2) {
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (int i : scene.train) c += scene.views[static_cast<std::size_t>(i)].camera.center();
+    c /= static_cast<double>(scene.train.size());
+    double r = 0;
+    for (int i : scene.train) r = std::max(r, (scene.views[static_cast<std::size_t>(i)].camera.center() - c).norm());
+    const double d = c.norm();
+    if (r > 0 && d > 100 * r)
+      out.push_back({"(scene)", "frame",
+                     "the train cameras are centred " + num(d) + " from the origin, " + num(d / r) +
+                         " times their spread (" + num(r) + "): single-precision Gaussian means resolve only " +
+                         num(d * 6e-8) + " there; recentre the model before training (COLMAP: model_transformer)"});
+    if (r > 0 && r < 50 * near_plane)
+      out.push_back({"(scene)", "scale",
+                     "the train cameras spread over " + num(r) + ", under 50 times the renderer's near plane (" +
+                         num(near_plane) + "): Gaussians nearer than that to a camera are not drawn; scale the model up "
+                         "before training (COLMAP: model_transformer)"});
   }
   if (!scene.points.empty() && !scene.train.empty() && blind_train == scene.train.size())
     throw InputError(scene.source, "intrinsics or poses",

@@ -20,9 +20,14 @@ struct DatasetWarning {
 // Fields of view people shoot (fisheye 150 degrees to long telephoto 1 degree).
 inline constexpr double kMinFovDeg = 1.0, kMaxFovDeg = 150.0;
 
-// The warnings, view by view, in dataset order. Throws InputError(scene.source,
-// "intrinsics or poses", ...) when the scene has points and no train view sees any.
-std::vector<DatasetWarning> checkDataset(const Scene& scene);
+// The warnings, view by view, in dataset order, then the scene's frame (view "(scene)"):
+// "frame" when the train cameras sit more than 100 times their spread from the origin
+// (single-precision means lose the scene's detail there), "scale" when they spread over
+// less than 50 times the renderer's near plane `near_plane` (splat's RasterSettings
+// default; geometry knows nothing of splat, so callers pass theirs). Throws
+// InputError(scene.source, "intrinsics or poses", ...) when the scene has points and no
+// train view sees any.
+std::vector<DatasetWarning> checkDataset(const Scene& scene, double near_plane = 0.01);
 
 // One line per warning (the first `max_lines`, then how many more), for stderr.
 std::string formatWarnings(const std::vector<DatasetWarning>& warnings, std::size_t max_lines = 8);

@@ -84,3 +84,31 @@ TEST(DatasetChecks, NoTrainViewSeeingAnyPointIsRefused) {
   s.points.clear();
   EXPECT_TRUE(checkDataset(s).empty());
 }
+
+// The frame (issue 25): the same ring moved 1e6 from the origin, or shrunk a thousandfold,
+// trains badly and silently without these warnings; scaled up a thousandfold it is fine.
+TEST(DatasetChecks, AFrameFarFromTheOriginOrTooSmallIsNamed) {
+  auto moved = [](double scale, const Eigen::Vector3d& shift) {
+    Scene s = ring(withFocal(300));
+    for (SceneView& v : s.views)
+      v.camera = Camera::lookAt(v.camera.K, scale * v.camera.center() + shift, shift, Eigen::Vector3d::UnitZ());
+    for (SparsePoint& p : s.points) p.xyz = scale * p.xyz + shift;
+    return s;
+  };
+  EXPECT_TRUE(checkDataset(moved(1.0, Eigen::Vector3d::Zero())).empty());
+  EXPECT_TRUE(checkDataset(moved(1e3, Eigen::Vector3d::Zero())).empty());
+  EXPECT_TRUE(checkDataset(moved(1.0, Eigen::Vector3d(300, 0, 0))).empty());  // 75x the spread: fine
+
+  auto far = checkDataset(moved(1.0, Eigen::Vector3d(1e6, 1e6, 0)));
+  ASSERT_EQ(far.size(), 1u);
+  EXPECT_EQ(far[0].view, "(scene)");
+  EXPECT_EQ(far[0].field, "frame");
+  EXPECT_NE(far[0].message.find("recentre"), std::string::npos) << far[0].message;
+
+  auto small = checkDataset(moved(1e-3, Eigen::Vector3d::Zero()));
+  ASSERT_EQ(small.size(), 1u);
+  EXPECT_EQ(small[0].field, "scale");
+  EXPECT_NE(small[0].message.find("near plane (0.01)"), std::string::npos) << small[0].message;
+  // The renderer's near plane is the caller's.
+  EXPECT_TRUE(checkDataset(moved(1e-3, Eigen::Vector3d::Zero()), 1e-6).empty());
+}
