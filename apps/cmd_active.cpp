@@ -128,8 +128,7 @@ int runActive(const ActiveArgs& a) {
     std::vector<int> trained(scene.train.begin(),
                              scene.train.begin() + std::min<std::ptrdiff_t>(static_cast<std::ptrdiff_t>(scene.train.size()),
                                                                             std::max(opt.max_views, 1)));
-    const std::size_t initial =
-        scene.points.empty() ? static_cast<std::size_t>(opt.trainer.random_init_points) : scene.points.size();
+    const std::size_t initial = initialModelSize(scene, opt.trainer);
     const int models = 1 + (opt.final_iterations > 0 ? (needsOf(opt.method).residual ? 2 : 1) : 0);
     std::size_t cap = opt.trainer.densify.max_gaussians;
     std::cerr << applyMemoryBudget(estimateTrainingMemory(scene, trained, scene.test.empty() ? scene.train : scene.test,

@@ -30,6 +30,7 @@
 #include "apps/cli_checks.h"
 #include "apps/commands.h"
 #include "apps/heap_count.h"
+#include "apps/memory_budget.h"
 #include "geometry/error.h"
 #include "geometry/occupancy/candidate_sets.h"
 #include "geometry/occupancy/coverage_score.h"
@@ -105,11 +106,7 @@ std::string cpuName() {
   return "unknown";
 }
 
-double peakRssMb() {
-  rusage ru{};
-  getrusage(RUSAGE_SELF, &ru);
-  return ru.ru_maxrss / 1024.0;
-}
+double peakRssMb() { return peakRssBytes() / (1024.0 * 1024.0); }
 
 struct StepTimes {
   double median_ms = 0;
@@ -231,14 +228,12 @@ int runBench(const BenchArgs& a) {
     const double pairs = plain.mean_contributors * a.width * a.height;
     const int threads = rasterThreadCount(s.execution);
     const double k = 1e6 * threads / (pairs * a.steps);
-    const nlohmann::json& st = j["stage_ms"];
     const double floor_ns = rasterForwardFloorNsPerPair(s.execution);
     const double render_ns = plain.stages.render * 1e3 * k, backward_ns = plain.stages.backward * 1e3 * k;
     j["pairs_per_step"] = pairs;
     j["ns_per_pair_core"] = {{"render", render_ns}, {"backward", backward_ns}};
     j["floor_ns_per_pair"] = floor_ns;
     j["render_fraction_of_floor"] = floor_ns / render_ns;
-    (void)st;
   }
   j["allocations_per_step"] = plain.allocations_per_step;
   j["page_faults_per_step"] = plain.page_faults_per_step;

@@ -62,7 +62,7 @@ int runTrain(TrainArgs& a) {
   fs::create_directories(a.out);
   if (const int n = removeStaleTemporaries(a.out)) std::cerr << "removed " << n << " temporaries left by a killed run\n";
   const std::string ckpt = a.out + "/checkpoint.bin";
-  const std::size_t initial = scene.points.empty() ? static_cast<std::size_t>(a.opt.random_init_points) : scene.points.size();
+  const std::size_t initial = initialModelSize(scene, a.opt);
   const MemoryEstimate memory = estimateTrainingMemory(scene, views, scene.test.empty() ? scene.train : scene.test,
                                                        initial, a.opt.max_sh_degree);
   const double budget = memoryBudgetBytes(a.memory_budget_gb);

@@ -55,35 +55,34 @@ double peakRssBytes() {
 }
 
 std::string applyMemoryBudget(const MemoryEstimate& e, double budget, bool budget_given, std::size_t& max_gaussians) {
-  const double start = e.bytesFor(e.initial_gaussians);
+  const double start = e.bytesFor(e.initial_gaussians), model = e.modelBytes(e.initial_gaussians);
   const std::string source = budget_given ? "--memory-budget" : "available on this machine";
   if (start > budget) {
-    const double images_half = e.image_bytes / 4 + e.buffer_bytes / 4 + e.models * e.bytes_per_gaussian * e.initial_gaussians;
+    // --downscale 2 quarters the images and the per-pixel buffers.
+    const double halved = start - 0.75 * (e.image_bytes + e.buffer_bytes);
     throw InputError("--memory-budget", "memory",
                      "this run needs about " + gb(start) + " before training (images " + gb(e.image_bytes) + " for " +
                          std::to_string(e.views) + " views up to " + std::to_string(e.largest_width) + "x" +
                          std::to_string(e.largest_height) + ", step buffers " + gb(e.buffer_bytes) + ", initial model " +
-                         gb(e.models * e.bytes_per_gaussian * e.initial_gaussians) + " for " +
-                         std::to_string(e.initial_gaussians) + " Gaussians) but the budget is " + gb(budget) + " (" + source + ")" +
-                         ": use --downscale 2 (about " + gb(images_half) + ") or fewer views, or raise --memory-budget");
+                         gb(model) + " for " + std::to_string(e.initial_gaussians) + " Gaussians) but the budget is " +
+                         gb(budget) + " (" + source + "): use --downscale 2 (about " + gb(halved) +
+                         ") or fewer views, or raise --memory-budget");
   }
   std::string line = "memory: about " + gb(start) + " at the start (images " + gb(e.image_bytes) + ", model " +
-                     gb(e.models * e.bytes_per_gaussian * e.initial_gaussians) + "), budget " + gb(budget) + " (" +
-                     source + ")";
+                     gb(model) + "), budget " + gb(budget) + " (" + source + ")";
   const std::size_t fit = e.gaussiansWithin(budget);
-  // Without a cap the model grows with densification: warn when it could outgrow the
-  // machine within a few times its start (3DGS models grow 3-10x).
-  const bool tight = max_gaussians == 0 ? fit < 4 * e.initial_gaussians : fit < max_gaussians;
-  if (tight || (budget_given && (max_gaussians == 0 || fit < max_gaussians))) {
-    if (budget_given) {
-      // An explicit budget caps the model: the same budget gives the same run.
+  if (budget_given) {
+    // An explicit budget caps the model: the same budget gives the same run.
+    if (max_gaussians == 0 || fit < max_gaussians) {
       max_gaussians = fit;
       line += "; the model is capped at " + std::to_string(fit) + " Gaussians to stay within it";
-    } else {
-      // What happens to be free now must not change the numbers of a run: a warning only.
-      line += "\nwarning: the model may grow past what is available (about " + std::to_string(fit) +
-              " Gaussians fit); pass --memory-budget GB to cap it, or --max-gaussians";
     }
+  } else if (max_gaussians == 0 ? fit < 4 * e.initial_gaussians : fit < max_gaussians) {
+    // What happens to be free now must not change the numbers of a run: a warning only,
+    // when the model could outgrow the machine (uncapped, within a few times its start:
+    // 3DGS models grow 3-10x; capped, below its cap).
+    line += "\nwarning: the model may grow past what is available (about " + std::to_string(fit) +
+            " Gaussians fit); pass --memory-budget GB to cap it, or --max-gaussians";
   }
   return line + "\n";
 }

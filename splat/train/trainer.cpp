@@ -22,6 +22,17 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
+}  // namespace
+
+std::size_t initialModelSize(const Scene& scene, const TrainerOptions& opt) {
+  if (!scene.points.empty()) return scene.points.size();
+  // A model cap bounds the initial random model too.
+  const auto n = static_cast<std::size_t>(opt.random_init_points);
+  return opt.densify.max_gaussians > 0 ? std::min(n, opt.densify.max_gaussians) : n;
+}
+
+namespace {
+
 Gaussians initialModel(const Scene& scene, const TrainerOptions& opt) {
   std::vector<ColoredPoint> pts;
   if (!scene.points.empty()) {
@@ -36,10 +47,8 @@ Gaussians initialModel(const Scene& scene, const TrainerOptions& opt) {
     // hemisphere puts well above the objects, is not used.
     const ViewFocus focus = viewFocus(scene.cameras(scene.train));
     std::mt19937_64 init_rng(opt.seed ^ 0x5eed1417ULL);
-    // A model cap bounds the initial model too.
-    int n = opt.random_init_points;
-    if (opt.densify.max_gaussians > 0) n = static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(n), opt.densify.max_gaussians));
-    pts = randomPointsInBall(focus.center, std::max(focus.radius, 1e-6), n, init_rng);
+    pts = randomPointsInBall(focus.center, std::max(focus.radius, 1e-6), static_cast<int>(initialModelSize(scene, opt)),
+                             init_rng);
   }
   return gaussiansFromPoints(pts, opt.max_sh_degree, opt.initial_opacity);
 }

@@ -88,6 +88,10 @@ struct Evaluation {
   double psnr = 0, ssim = 0;  // means over views
 };
 
+// The number of Gaussians the trainer starts from (Trainer's constructor): one per sparse
+// point, or random_init_points when the scene has none, capped by densify.max_gaussians.
+std::size_t initialModelSize(const Scene& scene, const TrainerOptions& opt);
+
 // The loss and its gradient for one view: the full render's loss, or with residual
 // supervision lambda_full L(full) + lambda_sub L(G_sub) (sub-only: L(G_sub)). Gradients
 // are added to `grad` and `grad_mean2d` (2 per Gaussian, pixels); the radii and
