@@ -59,7 +59,7 @@ void ensureDataset(const AblationScene& sc) {
   int rc = 0;
   if (!fs::exists(sc.dataset)) {
     std::cerr << "[ablate] generating " << sc.layout << " into " << sc.dataset << "\n";
-    rc = runCli({"scene", "--layout", sc.layout, "--out", sc.dataset});
+    rc = runCli({"scene", "--layout", sc.layout, "--seed", std::to_string(sc.scene_seed), "--out", sc.dataset});
   }
   ::flock(fd, LOCK_UN);
   ::close(fd);

@@ -151,6 +151,19 @@ int ActiveRun::selectNext(SelectionLog& log) {
       log.scores = fvsScores(scene_, selected_, candidates, opt_.fvs_metric);
       return candidates[argmaxScore(log.scores, candidates)];
     }
+    case Method::kKmedian: {
+      log.candidates = candidates;
+      log.scores = kmedianGains(scene_, selected_, candidates, scene_.train, poseAngleScale(scene_));
+      return candidates[argmaxScore(log.scores, candidates)];
+    }
+    case Method::kKmedianFisher: {
+      const auto t0 = Clock::now();
+      const std::vector<double> gains = kmedianGains(scene_, selected_, candidates, scene_.train, poseAngleScale(scene_));
+      pool = topFraction(gains, candidates, opt_.kmedian_keep);
+      log.prefiltered = pool;
+      log.seconds.prefilter += since(t0);
+      break;
+    }
     default: break;
   }
   // Fisher on the pool (all candidates, or the prefiltered ones).

@@ -67,6 +67,9 @@ struct ActiveOptions {
   FisherCriterion hybrid_criterion = FisherCriterion::kLogDet;
   HybridCoverage hybrid_coverage = HybridCoverage::kFacility;
   SurfaceCoverageOptions hybrid_surface{.grid = {.resolution = 64, .min_points = 2, .upsample = 2}, .stride = 4, .tolerance = 1};
+  // kmedian-fisher: the fraction of candidates, best by k-median gain, that Fisher ranks
+  // (the paper's prefilter keeps its top 20 %; the same cut here).
+  double kmedian_keep = 0.2;
   bool time_exhaustive_fisher = false;  // prefiltered methods: also time Fisher on all
   int progress_test_views = 3;
   // After the last view: a fresh model from the initial state trained on exactly the

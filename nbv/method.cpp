@@ -25,6 +25,11 @@ constexpr MethodRow kMethodTable[] = {
     {Method::kFisherLogDet, "fisher-logdet", {true, false, false}},
     // Fisher information and occlusion-aware coverage of unobserved surface (selectors.h).
     {Method::kHybrid, "hybrid", {true, false, false, true}},
+    // Greedy k-median on pose distances over the train views (kmedianGains): no model.
+    {Method::kKmedian, "kmedian", {false, false, false}},
+    // FisherRF's trace on the k-median's top fraction (ActiveOptions::kmedian_keep): the
+    // paper's shape (a prefilter, then Fisher) with a representativeness prefilter.
+    {Method::kKmedianFisher, "kmedian-fisher", {true, false, false}},
     // A selector function given by the caller (ActiveOptions::custom_selector: the Python
     // module's selectors); plain training, nothing precomputed.
     {Method::kCustom, "custom", {false, false, false}},

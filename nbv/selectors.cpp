@@ -47,6 +47,49 @@ std::vector<double> farthestViewScores(const Scene& scene, const std::vector<int
   return out;
 }
 
+double poseDistance(const Camera& a, const Camera& b, double angle_scale) {
+  const Eigen::Vector3d za = a.R.row(2).transpose(), zb = b.R.row(2).transpose();
+  // atan2 of |cross| and dot: accurate for nearly parallel axes, unlike acos.
+  const double angle = std::atan2(za.cross(zb).norm(), za.dot(zb));
+  return (a.center() - b.center()).norm() + angle_scale * angle;
+}
+
+double poseAngleScale(const Scene& scene) {
+  if (scene.train.empty()) return 1;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (int v : scene.train) mean += scene.views.at(v).camera.center();
+  mean /= static_cast<double>(scene.train.size());
+  std::vector<double> r;
+  for (int v : scene.train) r.push_back((scene.views.at(v).camera.center() - mean).norm());
+  std::nth_element(r.begin(), r.begin() + static_cast<long>(r.size() / 2), r.end());
+  const double median = r[r.size() / 2];
+  return median > 0 && std::isfinite(median) ? median : 1;
+}
+
+std::vector<double> kmedianGains(const Scene& scene, const std::vector<int>& chosen, const std::vector<int>& candidates,
+                                 const std::vector<int>& population, double angle_scale) {
+  if (!(angle_scale >= 0) || !std::isfinite(angle_scale))
+    throw std::invalid_argument("kmedianGains: angle scale " + std::to_string(angle_scale) + " is not a finite value >= 0");
+  auto d = [&](int a, int b) { return poseDistance(scene.views.at(a).camera, scene.views.at(b).camera, angle_scale); };
+  std::vector<double> near(population.size(), 0.0);
+  for (std::size_t i = 0; i < population.size(); ++i) {
+    if (chosen.empty()) {
+      for (int u : population) near[i] = std::max(near[i], d(population[i], u));
+    } else {
+      near[i] = std::numeric_limits<double>::infinity();
+      for (int s : chosen) near[i] = std::min(near[i], d(population[i], s));
+    }
+  }
+  std::vector<double> out;
+  out.reserve(candidates.size());
+  for (int x : candidates) {
+    double gain = 0;
+    for (std::size_t i = 0; i < population.size(); ++i) gain += std::max(0.0, near[i] - d(population[i], x));
+    out.push_back(gain);
+  }
+  return out;
+}
+
 std::vector<double> fisherScores(const Gaussians& g, const RasterSettings& s, const Scene& scene,
                                  const std::vector<int>& chosen, const std::vector<int>& candidates,
                                  double lambda, const std::function<void(int, int)>& tick, FisherCriterion criterion) {

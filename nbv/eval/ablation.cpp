@@ -111,10 +111,19 @@ std::vector<AblationScene> readScenes(const nlohmann::json& j, const std::string
   std::set<std::string> names;
   forEachNamedObject(j["scenes"], path, "scenes", "{name, dataset[, layout]}", [&](const nlohmann::json& s, const std::string& f) {
     if (!s.contains("dataset")) throw InputError(path, f, "expected {name, dataset[, layout]}");
+    for (const auto& [key, value] : s.items())
+      if (key != "name" && key != "dataset" && key != "layout" && key != "scene_seed")
+        throw InputError(path, f + ".\"" + key + "\"", "unknown field (expected name, dataset, layout, scene_seed)");
     AblationScene sc;
     sc.name = uniqueName(s, names, path, f);
     sc.dataset = jsonString(s["dataset"], path, f + ".dataset");
     if (s.contains("layout")) sc.layout = jsonString(s["layout"], path, f + ".layout");
+    if (s.contains("scene_seed")) {
+      if (!s["scene_seed"].is_number_unsigned())
+        throw InputError(path, f + ".scene_seed", "expected a non-negative integer (saresgs scene --seed)");
+      if (sc.layout.empty()) throw InputError(path, f + ".scene_seed", "given without a layout to generate");
+      sc.scene_seed = s["scene_seed"].get<std::uint64_t>();
+    }
     scenes.push_back(sc);
   });
   return scenes;

@@ -21,7 +21,8 @@
 //                 "variants": [...]}],
 //     "sweep": {"scenes": ["room360"], "views": [4, 8, 12], "lifting": "flow"} (optional)
 //   }
-// A scene with a "layout" is generated with `saresgs scene` when its dataset is missing.
+// A scene with a "layout" is generated with `saresgs scene` when its dataset is missing
+// (with "scene_seed": N, `--seed N`: another capture of the same type).
 // Without "variants" every method runs once as variant "default". A variant with "replay"
 // trains its methods on the view sequence of the replayed method's default run of the
 // same scene and seed (`saresgs active --replay`, the paper's fixed-order ablation); the
@@ -42,6 +43,7 @@ namespace saresgs {
 
 struct AblationScene {
   std::string name, dataset, layout;  // layout: empty = the dataset must exist
+  std::uint64_t scene_seed = 0;       // saresgs scene --seed when generated ("scene_seed")
 };
 
 struct AblationVariant {

@@ -16,6 +16,8 @@
 #include "common/tiny_dataset.h"
 #include "geometry/error.h"
 #include "nbv/active_run.h"
+#include "nbv/coverage_prefilter.h"
+#include "nbv/selectors.h"
 
 namespace saresgs {
 namespace {
@@ -536,6 +538,42 @@ TEST(ActiveRun, CustomSelectorPlugsIntoTheSameLoop) {
     EXPECT_NE(std::string(e.what()).find("not a candidate"), std::string::npos) << e.what();
   }
   EXPECT_THROW(ActiveRun(s, tinyOptions(Method::kCustom)), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace saresgs
+
+namespace saresgs {
+namespace {
+
+// kmedian-fisher is Fisher on the k-median's top fraction: with the whole pool kept it is
+// fisher, view for view; with a pool of one it is kmedian; in between every chosen view
+// was in the logged pool, the pool is the top fraction by k-median gain, and Fisher ranked
+// exactly the pool.
+TEST(ActiveRun, KmedianFisherIsFisherOnTheKmediansTopFraction) {
+  const Scene& s = tinyDataset();
+  auto run = [&](Method m, double keep) {
+    ActiveOptions o = tinyOptions(m);
+    o.kmedian_keep = keep;
+    return ActiveRun(s, o).run();
+  };
+  EXPECT_EQ(run(Method::kKmedianFisher, 1).selected_views, run(Method::kFisher, 1).selected_views);
+  EXPECT_EQ(run(Method::kKmedianFisher, 1e-9).selected_views, run(Method::kKmedian, 1).selected_views);
+  const ActiveResult r = run(Method::kKmedianFisher, 0.3);
+  ASSERT_FALSE(r.steps.empty());
+  int selections = 0;
+  for (const SelectionLog& st : r.steps) {
+    if (st.selected < 0) continue;  // the last step logs training, no selection
+    EXPECT_EQ(st.candidates, st.prefiltered);
+    const std::vector<int> held(r.selected_views.begin(), r.selected_views.begin() + st.views_before);
+    std::vector<int> all;
+    for (int v : s.train)
+      if (std::find(held.begin(), held.end(), v) == held.end()) all.push_back(v);
+    EXPECT_EQ(st.prefiltered, topFraction(kmedianGains(s, held, all, s.train, poseAngleScale(s)), all, 0.3));
+    EXPECT_NE(std::find(st.prefiltered.begin(), st.prefiltered.end(), st.selected), st.prefiltered.end());
+    ++selections;
+  }
+  EXPECT_EQ(selections, 3);  // views 3 to 5
 }
 
 }  // namespace

@@ -67,6 +67,18 @@ TEST(Ablation, GridExpandsIntoEveryCombinationOnce) {
 
 // A method may run on fewer seeds than the grid's (method_seeds, among "seeds"); the
 // others keep the grid's seeds, and a seed outside "seeds" is refused by field.
+// A scene's scene_seed is read as the generator's --seed (another capture of the type);
+// without it, seed 0, the built-in captures.
+TEST(Ablation, SceneSeedIsReadPerScene) {
+  TempDir d;
+  writeBytes(d.file("g.json"), R"({"scenes": [{"name": "a", "dataset": "x", "layout": "room360", "scene_seed": 7},
+                                             {"name": "b", "dataset": "y", "layout": "object"}], "methods": ["random"]})");
+  const AblationGrid g = readAblationGrid(d.file("g.json"));
+  ASSERT_EQ(g.scenes.size(), 2u);
+  EXPECT_EQ(g.scenes[0].scene_seed, 7u);
+  EXPECT_EQ(g.scenes[1].scene_seed, 0u);
+}
+
 TEST(Ablation, MethodSeedsNarrowOneMethodsSeeds) {
   TempDir d;
   nlohmann::json j = {{"scenes", {{{"name", "a"}, {"dataset", "x"}}}},
@@ -135,6 +147,12 @@ TEST(Ablation, MalformedGridsNameTheFileAndField) {
            {scene + R"("sweep": {"keep": 2}})", "sweep.keep: expected a number in 0..1"},
            {scene + R"("sweep": {"keep": 0}})", "sweep.keep"},
            {scene + R"("sweep": {"timing_repeats": 0}})", "sweep.timing_repeats"},
+           {R"({"scenes": [{"name": "a", "dataset": "x", "layout": "object", "scene_seed": -1}], "methods": ["random"]})",
+            "scenes[0].scene_seed: expected a non-negative integer"},
+           {R"({"scenes": [{"name": "a", "dataset": "x", "scene_seed": 1}], "methods": ["random"]})",
+            "scenes[0].scene_seed: given without a layout"},
+           {R"({"scenes": [{"name": "a", "dataset": "x", "layuot": "object"}], "methods": ["random"]})",
+            "scenes[0].\"layuot\": unknown field"},
        }) {
     writeBytes(f, text);
     std::string msg;
