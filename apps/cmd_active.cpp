@@ -37,7 +37,7 @@ struct ActiveArgs {
   double fisher_lambda = 1e-6;
   std::optional<int> max_views, interval, total, final_iterations, renamed_iterations;
   std::optional<long long> max_gaussians;
-  std::optional<double> beta, prefilter_keep, hybrid_weight, kmedian_keep, memory_budget_gb;
+  std::optional<double> beta, prefilter_keep, hybrid_weight, gate_keep, adaptive_clustering, memory_budget_gb;
   std::string hybrid_fisher = "logdet", hybrid_coverage = "facility";
   PrefilterFlags prefilter;
 };
@@ -71,7 +71,8 @@ ActiveOptions activeOptions(const ActiveArgs& a) {
   o.prefilter = parsePrefilterFlags(a.prefilter, o.prefilter, "--prefilter-", a.dataset);
   if (a.prefilter_keep) o.prefilter.keep_fraction = *a.prefilter_keep;
   if (a.hybrid_weight) o.hybrid_weight = *a.hybrid_weight;
-  if (a.kmedian_keep) o.kmedian_keep = *a.kmedian_keep;
+  if (a.gate_keep) o.gate_keep = *a.gate_keep;
+  if (a.adaptive_clustering) o.adaptive_clustering = *a.adaptive_clustering;
   o.hybrid_criterion = a.hybrid_fisher == "trace" ? FisherCriterion::kTrace : FisherCriterion::kLogDet;
   o.hybrid_coverage = a.hybrid_coverage == "views"      ? HybridCoverage::kViewDistance
                       : a.hybrid_coverage == "facility" ? HybridCoverage::kFacility
@@ -224,9 +225,15 @@ CLI::App* addActiveOptions(CLI::App& app, const std::shared_ptr<ActiveArgs>& a) 
                   "nearest held camera) | facility (the facility-location gain over the train views, by the overlap of their visible "
                   "surface)")
       ->check(CLI::IsMember({"surface", "views", "facility"}))->capture_default_str();
-  sub->add_option("--kmedian-keep", a->kmedian_keep,
-                  "kmedian-fisher: fraction of the candidates, best by k-median gain, that Fisher ranks (default 0.2)")
+  sub->add_option("--gate-keep", a->gate_keep,
+                  "kmedian-fisher, fvs-fisher, adaptive: fraction of the candidates, best by the gate's spread score (k-median "
+                  "gain or distance to the nearest held view), that Fisher ranks (default 0.2)")
       ->check(CLI::Range(0.0, 1.0));
+  sub->add_option("--adaptive-clustering", a->adaptive_clustering,
+                  "adaptive: a capture whose clustering (the coefficient of variation of each train camera's distance to its "
+                  "5th nearest; `saresgs info` prints it) exceeds this gets the k-median gate, any other the farthest-view gate "
+                  "(default 0.7)")
+      ->check(CLI::Range(0.0, 1e6));
   sub->add_flag("--time-exhaustive-fisher", a->time_exhaustive_fisher, "Also time Fisher over all candidates");
   sub->add_option("--replay", a->replay,
                   "Fixed order: train with this method's training on the views of another run's results.json, in their "

@@ -4,6 +4,8 @@
 #include "apps/commands.h"
 #include "geometry/scene/dataset_checks.h"
 #include "geometry/scene/scene.h"
+#include "nbv/active_run.h"
+#include "nbv/selectors.h"
 
 namespace saresgs::apps {
 
@@ -27,7 +29,11 @@ int runInfo(const InfoArgs& a) {
             << ", fov " << K.fovX() * 180 / M_PI << " x " << K.fovY() * 180 / M_PI << " deg\n"
             << "  points:  " << s.points.size() << "\n"
             << "  aabb:    [" << s.aabb.min.transpose() << "] .. [" << s.aabb.max.transpose() << "]\n"
-            << "  extent:  " << s.extent << "\n";
+            << "  extent:  " << s.extent << "\n"
+            << "  capture: clustering " << captureClustering(s) << " ("
+            << (captureClustering(s) > ActiveOptions{}.adaptive_clustering ? "clustered" : "even")
+            << "; `active --method adaptive` gates Fisher by "
+            << (captureClustering(s) > ActiveOptions{}.adaptive_clustering ? "k-median gain" : "farthest view") << ")\n";
   // Reading one image proves the images are there and of the right size.
   const Image8& img = s.image(s.train.front());
   std::cout << "  image " << s.views[s.train.front()].name << ": " << img.width << "x" << img.height

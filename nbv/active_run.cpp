@@ -156,10 +156,16 @@ int ActiveRun::selectNext(SelectionLog& log) {
       log.scores = kmedianGains(scene_, selected_, candidates, scene_.train, poseAngleScale(scene_));
       return candidates[argmaxScore(log.scores, candidates)];
     }
-    case Method::kKmedianFisher: {
+    case Method::kKmedianFisher:
+    case Method::kFvsFisher:
+    case Method::kAdaptive: {
+      // The gate: a spread score over all candidates, whose top fraction Fisher ranks.
       const auto t0 = Clock::now();
-      const std::vector<double> gains = kmedianGains(scene_, selected_, candidates, scene_.train, poseAngleScale(scene_));
-      pool = topFraction(gains, candidates, opt_.kmedian_keep);
+      const bool kmedian = opt_.method == Method::kKmedianFisher ||
+                           (opt_.method == Method::kAdaptive && captureClustering(scene_) > opt_.adaptive_clustering);
+      const std::vector<double> gate = kmedian ? kmedianGains(scene_, selected_, candidates, scene_.train, poseAngleScale(scene_))
+                                               : fvsScores(scene_, selected_, candidates, opt_.fvs_metric);
+      pool = topFraction(gate, candidates, opt_.gate_keep);
       log.prefiltered = pool;
       log.seconds.prefilter += since(t0);
       break;

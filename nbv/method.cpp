@@ -27,9 +27,14 @@ constexpr MethodRow kMethodTable[] = {
     {Method::kHybrid, "hybrid", {true, false, false, true}},
     // Greedy k-median on pose distances over the train views (kmedianGains): no model.
     {Method::kKmedian, "kmedian", {false, false, false}},
-    // FisherRF's trace on the k-median's top fraction (ActiveOptions::kmedian_keep): the
+    // FisherRF's trace on the k-median's top fraction (ActiveOptions::gate_keep): the
     // paper's shape (a prefilter, then Fisher) with a representativeness prefilter.
     {Method::kKmedianFisher, "kmedian-fisher", {true, false, false}},
+    // FisherRF's trace on farthest view sampling's top fraction (the largest gaps).
+    {Method::kFvsFisher, "fvs-fisher", {true, false, false}},
+    // kmedian-fisher on a clustered capture, fvs-fisher on any other (captureClustering
+    // against ActiveOptions::adaptive_clustering).
+    {Method::kAdaptive, "adaptive", {true, false, false}},
     // A selector function given by the caller (ActiveOptions::custom_selector: the Python
     // module's selectors); plain training, nothing precomputed.
     {Method::kCustom, "custom", {false, false, false}},

@@ -66,6 +66,28 @@ double poseAngleScale(const Scene& scene) {
   return median > 0 && std::isfinite(median) ? median : 1;
 }
 
+double captureClustering(const Scene& scene, int k) {
+  const std::size_t n = scene.train.size();
+  if (k < 1 || n <= static_cast<std::size_t>(k)) return 0;
+  std::vector<Eigen::Vector3d> c;
+  c.reserve(n);
+  for (int v : scene.train) c.push_back(scene.views.at(v).camera.center());
+  std::vector<double> kth(n), d(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = 0; j < n; ++j) d[j] = (c[i] - c[j]).norm();
+    // d[i] = 0 is the camera itself: its k-th nearest other camera is the (k+1)-th smallest.
+    std::nth_element(d.begin(), d.begin() + k, d.end());
+    kth[i] = d[static_cast<std::size_t>(k)];
+  }
+  double mean = 0;
+  for (double x : kth) mean += x;
+  mean /= static_cast<double>(n);
+  if (!(mean > 0) || !std::isfinite(mean)) return 0;
+  double var = 0;
+  for (double x : kth) var += (x - mean) * (x - mean);
+  return std::sqrt(var / static_cast<double>(n)) / mean;
+}
+
 std::vector<double> kmedianGains(const Scene& scene, const std::vector<int>& chosen, const std::vector<int>& candidates,
                                  const std::vector<int>& population, double angle_scale) {
   if (!(angle_scale >= 0) || !std::isfinite(angle_scale))

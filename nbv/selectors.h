@@ -74,6 +74,15 @@ double poseAngleScale(const Scene& scene);
 std::vector<double> kmedianGains(const Scene& scene, const std::vector<int>& chosen, const std::vector<int>& candidates,
                                  const std::vector<int>& population, double angle_scale);
 
+// How clustered the capture is: over the train cameras, the coefficient of variation
+// (standard deviation over mean) of each camera's distance to its k-th nearest other
+// camera. An even path (an orbit, a walk at steady speed) has nearly equal spacing and
+// a small value (the built-in orbit about 0.15); a capture that dwells in places and
+// crosses between them has tight clusters and long gaps (the clustered walk about 1.5).
+// Unitless, so the same in any frame and scale. 0 with k or fewer train cameras, or when
+// every camera sits at one place.
+double captureClustering(const Scene& scene, int k = 5);
+
 // Index (into candidates) of the highest score; ties to the lowest view index.
 std::size_t argmaxScore(const std::vector<double>& scores, const std::vector<int>& candidates);
 

@@ -554,7 +554,7 @@ TEST(ActiveRun, KmedianFisherIsFisherOnTheKmediansTopFraction) {
   const Scene& s = tinyDataset();
   auto run = [&](Method m, double keep) {
     ActiveOptions o = tinyOptions(m);
-    o.kmedian_keep = keep;
+    o.gate_keep = keep;
     return ActiveRun(s, o).run();
   };
   EXPECT_EQ(run(Method::kKmedianFisher, 1).selected_views, run(Method::kFisher, 1).selected_views);
@@ -574,6 +574,58 @@ TEST(ActiveRun, KmedianFisherIsFisherOnTheKmediansTopFraction) {
     ++selections;
   }
   EXPECT_EQ(selections, 3);  // views 3 to 5
+}
+
+}  // namespace
+}  // namespace saresgs
+
+namespace saresgs {
+namespace {
+
+// fvs-fisher is Fisher on farthest view sampling's top fraction, checked as kmedian-fisher
+// is above: its ends (the whole pool: fisher; a pool of one: fvs) and, in between, the
+// logged pool is the top fraction by distance to the nearest held view.
+TEST(ActiveRun, FvsFisherIsFisherOnFarthestViewsTopFraction) {
+  const Scene& s = tinyDataset();
+  auto run = [&](Method m, double keep) {
+    ActiveOptions o = tinyOptions(m);
+    o.gate_keep = keep;
+    return ActiveRun(s, o).run();
+  };
+  EXPECT_EQ(run(Method::kFvsFisher, 1).selected_views, run(Method::kFisher, 1).selected_views);
+  EXPECT_EQ(run(Method::kFvsFisher, 1e-9).selected_views, run(Method::kFvs, 1).selected_views);
+  const ActiveResult r = run(Method::kFvsFisher, 0.3);
+  int selections = 0;
+  for (const SelectionLog& st : r.steps) {
+    if (st.selected < 0) continue;
+    const std::vector<int> held(r.selected_views.begin(), r.selected_views.begin() + st.views_before);
+    std::vector<int> all;
+    for (int v : s.train)
+      if (std::find(held.begin(), held.end(), v) == held.end()) all.push_back(v);
+    EXPECT_EQ(st.prefiltered, topFraction(fvsScores(s, held, all), all, 0.3));
+    EXPECT_NE(std::find(st.prefiltered.begin(), st.prefiltered.end(), st.selected), st.prefiltered.end());
+    ++selections;
+  }
+  EXPECT_EQ(selections, 3);
+}
+
+// adaptive is kmedian-fisher above its clustering threshold and fvs-fisher below it, view
+// for view (thresholds either side of the tiny capture's own clustering), and its default
+// threshold puts the tiny capture, an even ring, on the farthest-view side.
+TEST(ActiveRun, AdaptiveGatesByTheCapturesClustering) {
+  const Scene& s = tinyDataset();
+  const double c = captureClustering(s);
+  auto run = [&](Method m, double threshold) {
+    ActiveOptions o = tinyOptions(m);
+    o.gate_keep = 0.3;
+    o.adaptive_clustering = threshold;
+    return ActiveRun(s, o).run().selected_views;
+  };
+  const std::vector<int> kmed = run(Method::kKmedianFisher, 0), fvs = run(Method::kFvsFisher, 0);
+  ASSERT_NE(kmed, fvs) << "the tiny capture must tell the two gates apart for this test to mean anything";
+  EXPECT_EQ(run(Method::kAdaptive, c * 0.5 - 1e-9), kmed);
+  EXPECT_EQ(run(Method::kAdaptive, c * 2 + 1e-9), fvs);
+  EXPECT_LT(c, ActiveOptions{}.adaptive_clustering);
 }
 
 }  // namespace

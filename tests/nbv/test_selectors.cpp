@@ -2,10 +2,12 @@
 // AUSE against hand-computable cases.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <set>
 
+#include "nbv/active_run.h"
 #include "nbv/ause.h"
 #include "nbv/selectors.h"
 
@@ -169,6 +171,56 @@ TEST(Selectors, PoseDistanceAddsTheScaledAngleOfTheAxes) {
   // The ring's radius is its angle scale; a single place falls back to 1.
   EXPECT_NEAR(poseAngleScale(ringScene(12)), 4, 1e-12);
   EXPECT_EQ(poseAngleScale(lineScene({2, 2, 2})), 1);
+}
+
+}  // namespace
+}  // namespace saresgs
+
+namespace saresgs {
+namespace {
+
+// captureClustering on constructed captures: an evenly spaced line (its 5th neighbour is
+// 3 to 5 away, nearer only at the ends) is even; two tight crowds with a thin string of
+// cameras between them are clustered, on either side of the adaptive selector's default
+// threshold; a moved and scaled copy gives the same value (unitless).
+TEST(Selectors, CaptureClusteringSeparatesEvenFromClusteredCaptures) {
+  std::vector<double> even;
+  for (int i = 0; i < 40; ++i) even.push_back(i);
+  // The definition written out plainly (sorted distances to every camera, itself first at
+  // 0, so index k is the k-th nearest other camera), against the function's nth_element.
+  auto cv = [](const std::vector<double>& xs, int k) {
+    std::vector<double> kth;
+    for (double x : xs) {
+      std::vector<double> d;
+      for (double y : xs) d.push_back(std::abs(x - y));
+      std::sort(d.begin(), d.end());
+      kth.push_back(d[static_cast<std::size_t>(k)]);
+    }
+    double m = 0, v = 0;
+    for (double x : kth) m += x / static_cast<double>(kth.size());
+    for (double x : kth) v += (x - m) * (x - m) / static_cast<double>(kth.size());
+    return std::sqrt(v) / m;
+  };
+  const double c_even = captureClustering(lineScene(even));
+  EXPECT_NEAR(c_even, cv(even, 5), 1e-12);
+  EXPECT_LT(c_even, 0.3);
+  // Two crowds of 15 (0.01 apart) at 0 and 100, and 10 cameras strung between them.
+  std::vector<double> crowds;
+  for (int i = 0; i < 15; ++i) crowds.push_back(0.01 * i);
+  for (int i = 0; i < 15; ++i) crowds.push_back(100 + 0.01 * i);
+  for (int i = 1; i <= 10; ++i) crowds.push_back(9.0 * i);
+  const double c_crowds = captureClustering(lineScene(crowds));
+  EXPECT_NEAR(c_crowds, cv(crowds, 5), 1e-12);
+  EXPECT_GT(c_crowds, 1.0);
+  EXPECT_GT(c_crowds, ActiveOptions{}.adaptive_clustering);
+  EXPECT_LT(c_even, ActiveOptions{}.adaptive_clustering);
+  // Frame and scale free.
+  std::vector<double> moved;
+  for (double x : crowds) moved.push_back(1e5 + 1e-3 * x);
+  EXPECT_NEAR(captureClustering(lineScene(moved)), c_crowds, 1e-6);
+  // Degenerate captures: too few cameras, all at one place.
+  EXPECT_EQ(captureClustering(lineScene({0, 1, 2, 3, 4})), 0);
+  EXPECT_EQ(captureClustering(lineScene(std::vector<double>(10, 3.0))), 0);
 }
 
 }  // namespace
