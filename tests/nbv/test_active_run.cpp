@@ -546,20 +546,21 @@ TEST(ActiveRun, CustomSelectorPlugsIntoTheSameLoop) {
 namespace saresgs {
 namespace {
 
-// kmedian-fisher is Fisher on the k-median's top fraction: with the whole pool kept it is
-// fisher, view for view; with a pool of one it is kmedian; in between every chosen view
-// was in the logged pool, the pool is the top fraction by k-median gain, and Fisher ranked
-// exactly the pool.
-TEST(ActiveRun, KmedianFisherIsFisherOnTheKmediansTopFraction) {
+// A gated selector is Fisher on its gate's top fraction: with the whole pool kept it is
+// fisher, view for view; with a pool of one it is the gate's own selector (`alone`); in
+// between every chosen view was in the logged pool, the pool is the top fraction by the
+// gate's score, and Fisher ranked exactly the pool.
+using GateScores = std::function<std::vector<double>(const Scene&, const std::vector<int>& held, const std::vector<int>& all)>;
+void expectFisherOnTheGatesTopFraction(Method gated, Method alone, const GateScores& gate) {
   const Scene& s = tinyDataset();
   auto run = [&](Method m, double keep) {
     ActiveOptions o = tinyOptions(m);
     o.gate_keep = keep;
     return ActiveRun(s, o).run();
   };
-  EXPECT_EQ(run(Method::kKmedianFisher, 1).selected_views, run(Method::kFisher, 1).selected_views);
-  EXPECT_EQ(run(Method::kKmedianFisher, 1e-9).selected_views, run(Method::kKmedian, 1).selected_views);
-  const ActiveResult r = run(Method::kKmedianFisher, 0.3);
+  EXPECT_EQ(run(gated, 1).selected_views, run(Method::kFisher, 1).selected_views);
+  EXPECT_EQ(run(gated, 1e-9).selected_views, run(alone, 1).selected_views);
+  const ActiveResult r = run(gated, 0.3);
   ASSERT_FALSE(r.steps.empty());
   int selections = 0;
   for (const SelectionLog& st : r.steps) {
@@ -569,44 +570,23 @@ TEST(ActiveRun, KmedianFisherIsFisherOnTheKmediansTopFraction) {
     std::vector<int> all;
     for (int v : s.train)
       if (std::find(held.begin(), held.end(), v) == held.end()) all.push_back(v);
-    EXPECT_EQ(st.prefiltered, topFraction(kmedianGains(s, held, all, s.train, poseAngleScale(s)), all, 0.3));
+    EXPECT_EQ(st.prefiltered, topFraction(gate(s, held, all), all, 0.3));
     EXPECT_NE(std::find(st.prefiltered.begin(), st.prefiltered.end(), st.selected), st.prefiltered.end());
     ++selections;
   }
   EXPECT_EQ(selections, 3);  // views 3 to 5
 }
 
-}  // namespace
-}  // namespace saresgs
+TEST(ActiveRun, KmedianFisherIsFisherOnTheKmediansTopFraction) {
+  expectFisherOnTheGatesTopFraction(Method::kKmedianFisher, Method::kKmedian,
+                                    [](const Scene& s, const auto& held, const auto& all) {
+                                      return kmedianGains(s, held, all, s.train, poseAngleScale(s));
+                                    });
+}
 
-namespace saresgs {
-namespace {
-
-// fvs-fisher is Fisher on farthest view sampling's top fraction, checked as kmedian-fisher
-// is above: its ends (the whole pool: fisher; a pool of one: fvs) and, in between, the
-// logged pool is the top fraction by distance to the nearest held view.
 TEST(ActiveRun, FvsFisherIsFisherOnFarthestViewsTopFraction) {
-  const Scene& s = tinyDataset();
-  auto run = [&](Method m, double keep) {
-    ActiveOptions o = tinyOptions(m);
-    o.gate_keep = keep;
-    return ActiveRun(s, o).run();
-  };
-  EXPECT_EQ(run(Method::kFvsFisher, 1).selected_views, run(Method::kFisher, 1).selected_views);
-  EXPECT_EQ(run(Method::kFvsFisher, 1e-9).selected_views, run(Method::kFvs, 1).selected_views);
-  const ActiveResult r = run(Method::kFvsFisher, 0.3);
-  int selections = 0;
-  for (const SelectionLog& st : r.steps) {
-    if (st.selected < 0) continue;
-    const std::vector<int> held(r.selected_views.begin(), r.selected_views.begin() + st.views_before);
-    std::vector<int> all;
-    for (int v : s.train)
-      if (std::find(held.begin(), held.end(), v) == held.end()) all.push_back(v);
-    EXPECT_EQ(st.prefiltered, topFraction(fvsScores(s, held, all), all, 0.3));
-    EXPECT_NE(std::find(st.prefiltered.begin(), st.prefiltered.end(), st.selected), st.prefiltered.end());
-    ++selections;
-  }
-  EXPECT_EQ(selections, 3);
+  expectFisherOnTheGatesTopFraction(Method::kFvsFisher, Method::kFvs,
+                                    [](const Scene& s, const auto& held, const auto& all) { return fvsScores(s, held, all); });
 }
 
 // adaptive is kmedian-fisher above its clustering threshold and fvs-fisher below it, view
