@@ -20,6 +20,7 @@ int runInfo(const InfoArgs& a) {
   const Scene s = loadDataset(a.dataset, a.opts);
   std::cerr << formatWarnings(checkDataset(s));
   const Intrinsics& K = s.views.front().camera.K;
+  const bool adaptiveKmedian = usesKmedianGate(s, ActiveOptions{.method = Method::kAdaptive});
   int with_depth = 0;
   for (size_t i = 0; i < s.views.size(); ++i) with_depth += s.hasDepth(static_cast<int>(i));
   std::cout << "dataset " << s.source << "\n"
@@ -30,10 +31,8 @@ int runInfo(const InfoArgs& a) {
             << "  points:  " << s.points.size() << "\n"
             << "  aabb:    [" << s.aabb.min.transpose() << "] .. [" << s.aabb.max.transpose() << "]\n"
             << "  extent:  " << s.extent << "\n"
-            << "  capture: clustering " << captureClustering(s) << " ("
-            << (captureClustering(s) > ActiveOptions{}.adaptive_clustering ? "clustered" : "even")
-            << "; `active --method adaptive` gates Fisher by "
-            << (captureClustering(s) > ActiveOptions{}.adaptive_clustering ? "k-median gain" : "farthest view") << ")\n";
+            << "  capture: clustering " << captureClustering(s) << " (" << (adaptiveKmedian ? "clustered" : "even")
+            << "; `active --method adaptive` gates Fisher by " << (adaptiveKmedian ? "k-median gain" : "farthest view") << ")\n";
   // Reading one image proves the images are there and of the right size.
   const Image8& img = s.image(s.train.front());
   std::cout << "  image " << s.views[s.train.front()].name << ": " << img.width << "x" << img.height

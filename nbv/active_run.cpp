@@ -96,6 +96,15 @@ void ActiveRun::report(ActivePhase phase, int done, int total) {
   if (progress_) progress_(last_);
 }
 
+bool usesKmedianGate(const Scene& scene, const ActiveOptions& o) {
+  switch (o.method) {
+    case Method::kKmedianFisher: return true;
+    case Method::kFvsFisher: return false;
+    case Method::kAdaptive: return captureClustering(scene) > o.adaptive_clustering;
+    default: throw std::invalid_argument(std::string("usesKmedianGate: ") + toString(o.method) + " has no gate");
+  }
+}
+
 int ActiveRun::selectNext(SelectionLog& log) {
   std::vector<int> candidates;
   for (int v : scene_.train)
@@ -161,9 +170,7 @@ int ActiveRun::selectNext(SelectionLog& log) {
     case Method::kAdaptive: {
       // The gate: a spread score over all candidates, whose top fraction Fisher ranks.
       const auto t0 = Clock::now();
-      const bool kmedian = opt_.method == Method::kKmedianFisher ||
-                           (opt_.method == Method::kAdaptive && captureClustering(scene_) > opt_.adaptive_clustering);
-      const std::vector<double> gate = kmedian ? kmedianGains(scene_, selected_, candidates, scene_.train, poseAngleScale(scene_))
+      const std::vector<double> gate = usesKmedianGate(scene_, opt_) ? kmedianGains(scene_, selected_, candidates, scene_.train, poseAngleScale(scene_))
                                                : fvsScores(scene_, selected_, candidates, opt_.fvs_metric);
       pool = topFraction(gate, candidates, opt_.gate_keep);
       log.prefiltered = pool;

@@ -148,6 +148,12 @@ struct ActiveResult {
   double seconds = 0;  // end to end, this process
 };
 
+// The gated selectors' gate (kmedian-fisher, fvs-fisher, adaptive): true when Fisher ranks
+// the top of the k-median gains, false for the farthest-view distances. adaptive decides
+// from the capture (captureClustering against o.adaptive_clustering); any other method
+// throws std::invalid_argument.
+bool usesKmedianGate(const Scene& scene, const ActiveOptions& o);
+
 // The trainer options of the final fit: final_trainer with the run's seed and, when
 // `method_training` and the method trains with residual supervision, the loop's residual
 // options (otherwise none). `saresgs train` with these options on the chosen views

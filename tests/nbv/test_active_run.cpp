@@ -606,6 +606,16 @@ TEST(ActiveRun, AdaptiveGatesByTheCapturesClustering) {
   EXPECT_EQ(run(Method::kAdaptive, c * 0.5 - 1e-9), kmed);
   EXPECT_EQ(run(Method::kAdaptive, c * 2 + 1e-9), fvs);
   EXPECT_LT(c, ActiveOptions{}.adaptive_clustering);
+  // usesKmedianGate says the same (what `saresgs active` and `info` print), and refuses a
+  // method without a gate.
+  ActiveOptions o = tinyOptions(Method::kAdaptive);
+  o.adaptive_clustering = c * 0.5;
+  EXPECT_TRUE(usesKmedianGate(s, o));
+  o.adaptive_clustering = c * 2;
+  EXPECT_FALSE(usesKmedianGate(s, o));
+  EXPECT_TRUE(usesKmedianGate(s, tinyOptions(Method::kKmedianFisher)));
+  EXPECT_FALSE(usesKmedianGate(s, tinyOptions(Method::kFvsFisher)));
+  EXPECT_THROW(usesKmedianGate(s, tinyOptions(Method::kFisher)), std::invalid_argument);
 }
 
 }  // namespace
