@@ -143,11 +143,12 @@ int runActive(const ActiveArgs& a) {
   if (resuming) std::cerr << "resuming from " << ckpt << "\n";
   std::cerr << "active run: " << a.method << " on " << a.dataset << " (" << scene.train.size() << " candidates, "
             << scene.test.size() << " test views), preset " << a.preset << ", seed " << opt.seed << "\n";
-  if (opt.method == Method::kAdaptive)
-    std::cerr << "adaptive: capture clustering " << captureClustering(scene) << (usesKmedianGate(scene, opt) ? " > " : " <= ")
+  if (opt.method == Method::kAdaptive) {
+    const bool kmedian = usesKmedianGate(scene, opt);
+    std::cerr << "adaptive: capture clustering " << captureClustering(scene) << (kmedian ? " > " : " <= ")
               << opt.adaptive_clustering << ", so Fisher ranks the top " << opt.gate_keep * 100 << " % by "
-              << (usesKmedianGate(scene, opt) ? "k-median gain (kmedian-fisher)" : "distance to the nearest held view (fvs-fisher)")
-              << "\n";
+              << (kmedian ? "k-median gain (kmedian-fisher)" : "distance to the nearest held view (fvs-fisher)") << "\n";
+  }
   Progress progress;
   const ActiveResult r = run.run([&](const ActiveProgress& p) {
     char detail[200];

@@ -109,6 +109,7 @@ echo "test_tsan: canary ok (a racy parallel_for reported, a race-free one clean)
 
 # 4. The suite. halt_on_error: the first report fails its test with both stacks;
 # second_deadlock_stack: lock-order reports name both acquisitions.
-export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:history_size=7:suppressions=${root}/scripts/tsan.supp"
+# history_size=7: the most memory for old accesses, so both stacks of a report are kept.
+export TSAN_OPTIONS="${TSAN_OPTIONS}:second_deadlock_stack=1:history_size=7"
 export LD_LIBRARY_PATH="${tbb_prefix}/lib${LD_LIBRARY_PATH:+:${LD_LIBRARY_PATH}}"
 ctest --test-dir "${tsan}/build" --output-on-failure --parallel "$(nproc)" --timeout 3600 "$@"
