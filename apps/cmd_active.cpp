@@ -18,6 +18,7 @@
 #include "nbv/eval/camera_plot.h"
 #include "nbv/preset.h"
 #include "nbv/run_report.h"
+#include "splat/model_frame.h"
 #include "splat/ply.h"
 #include "splat/raster_execution.h"
 #include "splat/train/test_renders.h"
@@ -159,11 +160,11 @@ int runActive(const ActiveArgs& a) {
   });
   const Trainer& t = run.trainer();
   writeTestRenders(t, r.test, a.out + "/test_renders");
-  writeGaussiansPly(a.out + "/point_cloud.ply", t.gaussians());
+  writeGaussiansPly(a.out + "/point_cloud.ply", gaussiansToWorld(t.gaussians(), scene.frame));
   writeCamerasJson(a.out + "/cameras.json", scene);  // beside the .ply files, for splat viewers
   writeImage(a.out + "/cameras.png", plotCameras(scene, r.initial_views, r.selected_views));
-  if (const Trainer* f = run.finalFitTrainer()) writeGaussiansPly(a.out + "/final_fit.ply", f->gaussians());
-  if (const Trainer* f = run.finalFitViewsTrainer()) writeGaussiansPly(a.out + "/final_fit_views.ply", f->gaussians());
+  if (const Trainer* f = run.finalFitTrainer()) writeGaussiansPly(a.out + "/final_fit.ply", gaussiansToWorld(f->gaussians(), scene.frame));
+  if (const Trainer* f = run.finalFitViewsTrainer()) writeGaussiansPly(a.out + "/final_fit_views.ply", gaussiansToWorld(f->gaussians(), scene.frame));
   const RunReport report =
       makeRunReport(scene, opt, r, {a.dataset, a.preset, a.replay, t.gaussians().size(), rasterThreadCount(opt.trainer.raster.execution)});
   writeFileAtomic(a.out + "/results.json", toJson(report).dump(2) + "\n");

@@ -16,6 +16,7 @@
 #include "geometry/io/atomic_file.h"
 #include "geometry/synth/from_manifest.h"
 #include "nbv/eval/coverage_report.h"
+#include "splat/model_frame.h"
 #include "splat/ply.h"
 #include "splat/rasterize.h"
 
@@ -43,7 +44,7 @@ int runCoverage(const CoverageArgs& a) {
   std::optional<SyntheticScene> truth;
   Gaussians model;
   if (!a.model.empty()) {
-    model = readGaussiansPly(a.model);
+    model = gaussiansFromWorld(readGaussiansPly(a.model), scene.frame);
     RasterSettings rs;
     rs.sh_degree = model.max_sh_degree;
     if (scene.background) rs.background = *scene.background;

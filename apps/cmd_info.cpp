@@ -1,5 +1,6 @@
 // saresgs info: reads a dataset and prints what saresgs sees in it.
 #include <iostream>
+#include <sstream>
 
 #include "apps/commands.h"
 #include "geometry/scene/dataset_checks.h"
@@ -16,6 +17,15 @@ struct InfoArgs {
   DatasetOptions opts;
 };
 
+// The frame the dataset is computed in (geometry/scene/scene_frame.h).
+std::string frameText(const SceneFrame& f) {
+  if (f.identity()) return "world coordinates (a scene of metres about the origin is kept as it is)";
+  std::ostringstream o;
+  o.precision(17);
+  o << "internal = (world - [" << f.center.transpose() << "]) / " << f.scale;
+  return o.str();
+}
+
 int runInfo(const InfoArgs& a) {
   const Scene s = loadDataset(a.dataset, a.opts);
   std::cerr << formatWarnings(checkDataset(s));
@@ -31,6 +41,7 @@ int runInfo(const InfoArgs& a) {
             << "  points:  " << s.points.size() << "\n"
             << "  aabb:    [" << s.aabb.min.transpose() << "] .. [" << s.aabb.max.transpose() << "]\n"
             << "  extent:  " << s.extent << "\n"
+            << "  frame:   " << frameText(s.frame) << "\n"
             << "  capture: clustering " << captureClustering(s) << " (" << (adaptiveKmedian ? "clustered" : "even")
             << "; `active --method adaptive` gates Fisher by " << (adaptiveKmedian ? "k-median gain" : "farthest view") << ")\n";
   // Reading one image proves the images are there and of the right size.

@@ -18,6 +18,7 @@
 #include "geometry/io/atomic_file.h"
 #include "geometry/scene/cameras_json.h"
 #include "geometry/scene/scene.h"
+#include "splat/model_frame.h"
 #include "splat/ply.h"
 #include "splat/raster_execution.h"
 #include "splat/train/schedule.h"
@@ -98,7 +99,7 @@ int runTrain(TrainArgs& a) {
   const std::vector<int>& eval_views = scene.test.empty() ? scene.train : scene.test;
   const Evaluation ev = trainer.evaluate(eval_views);
   writeTestRenders(trainer, ev, a.out + "/test_renders");
-  writeGaussiansPly(a.out + "/point_cloud.ply", trainer.gaussians());
+  writeGaussiansPly(a.out + "/point_cloud.ply", gaussiansToWorld(trainer.gaussians(), scene.frame));
   writeCamerasJson(a.out + "/cameras.json", scene);  // beside the .ply, for splat viewers
 
   nlohmann::json j;
@@ -117,6 +118,7 @@ int runTrain(TrainArgs& a) {
   j["train_seconds_this_run"] = train_seconds;
   j["threads"] = rasterThreadCount(a.opt.raster.execution);
   j["residual"] = a.opt.residual.enabled;
+  j["frame"] = toJson(scene.frame);
   const StageSeconds& s = trainer.seconds();
   j["stage_seconds"] = {{"render", s.render}, {"loss", s.loss}, {"backward", s.backward},
                         {"optimizer", s.optimizer}, {"densify", s.densify}};

@@ -103,6 +103,7 @@ RunReport makeRunReport(const Scene& scene, const ActiveOptions& opt, const Acti
   if (r.final_fit_views) rep.final_fit_views = fitReport(*r.final_fit_views);
   rep.replay_of = c.replay_of;
   if (r.prefilter) rep.prefilter_regime = toJson(*r.prefilter);
+  rep.frame = scene.frame;
   return rep;
 }
 
@@ -181,6 +182,7 @@ json toJson(const RunReport& r) {
   if (r.final_fit_views) j["final_fit_views"] = fitJson(*r.final_fit_views);
   if (!r.replay_of.empty()) j["replay_of"] = r.replay_of;
   if (r.prefilter_regime) j["prefilter_regime"] = *r.prefilter_regime;
+  if (r.frame) j["frame"] = toJson(*r.frame);
   return j;
 }
 
@@ -238,6 +240,7 @@ RunReport runReportFromJson(const json& j, const std::string& src) {
   else if (r.final_fit && !r.final_fit->residual) r.final_fit_views = r.final_fit;  // written before it was recorded
   if (j.contains("replay_of")) r.replay_of = field<std::string>(j, "replay_of", src, "");
   if (j.contains("prefilter_regime")) r.prefilter_regime = jsonObject(j["prefilter_regime"], src, "prefilter_regime");
+  if (j.contains("frame")) r.frame = sceneFrameFromJson(j["frame"], src, "frame");
   return r;
 }
 

@@ -86,6 +86,9 @@ struct RunReport {
   std::optional<nlohmann::json> prefilter_regime;
   // A fixed-order replay: the results file whose view sequence this run trained on.
   std::string replay_of;
+  // The frame the run computed in (scene_frame.h); absent in reports written before it was
+  // recorded, which all ran in the identity frame.
+  std::optional<SceneFrame> frame;
 };
 
 // Where and how the run was made, which the loop itself does not know.

@@ -188,6 +188,7 @@ Scene loadBlenderDataset(const std::string& path, const DatasetOptions& opts) {
   if (fs::exists(root / "points3d.ply"))
     for (const PlyPoint& p : readPointsPly((root / "points3d.ply").string())) scene.points.push_back({p.xyz, p.rgb});
   scene.finalize();  // without points the AABB spans the train cameras
+  moveToOwnFrame(scene);
   return scene;
 }
 
@@ -257,6 +258,7 @@ Scene loadNerfstudioDataset(const std::string& path, const DatasetOptions& opts)
     for (const PlyPoint& q : readPointsPly(p.string())) scene.points.push_back({q.xyz, q.rgb});
   }
   scene.finalize();
+  moveToOwnFrame(scene);
   return scene;
 }
 

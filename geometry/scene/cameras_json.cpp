@@ -9,7 +9,8 @@ namespace saresgs {
 nlohmann::json camerasJson(const Scene& scene) {
   nlohmann::json out = nlohmann::json::array();
   for (std::size_t i = 0; i < scene.views.size(); ++i) {
-    const Camera& c = scene.views[i].camera;
+    // World coordinates, as the .ply files beside it.
+    const Camera c = scene.frame.toWorld(scene.views[i].camera);
     const Eigen::Matrix3d c2w = c.R.transpose();
     const Eigen::Vector3d p = c.center();
     nlohmann::json rot = nlohmann::json::array();

@@ -157,6 +157,7 @@ Scene loadColmapDataset(const std::string& path, const DatasetOptions& opts) {
   scene.points.reserve(model.points.size());
   for (const auto& [id, p] : model.points) scene.points.push_back({p.xyz, p.rgb});
   scene.finalize();
+  moveToOwnFrame(scene);
   return scene;
 }
 

@@ -67,12 +67,18 @@ std::vector<DatasetWarning> checkDataset(const Scene& scene, double near_plane) 
     c /= static_cast<double>(scene.train.size());
     double r = 0;
     for (int i : scene.train) r = std::max(r, (scene.views[static_cast<std::size_t>(i)].camera.center() - c).norm());
-    const double d = c.norm();
-    if (r > 0 && d > 100 * r)
+    // In world units: a scene in a frame of its own trains there, but writes world .ply files.
+    const double d = scene.frame.toWorld(c).norm(), rw = r * scene.frame.scale;
+    if (rw > 0 && d > 100 * rw)
       out.push_back({"(scene)", "frame",
-                     "the train cameras are centred " + num(d) + " from the origin, " + num(d / r) +
-                         " times their spread (" + num(r) + "): single-precision Gaussian means resolve only " +
-                         num(d * 6e-8) + " there; recentre the model before training (COLMAP: model_transformer)"});
+                     "the train cameras are centred " + num(d) + " from the origin, " + num(d / rw) +
+                         " times their spread (" + num(rw) + "): single-precision Gaussian means resolve only " +
+                         num(d * 6e-8) + " there; " +
+                         (scene.frame.identity()
+                              ? std::string("recentre the model before training (COLMAP: model_transformer)")
+                              : "saresgs trains in a frame of its own about the scene, but the .ply files it writes "
+                                "hold world coordinates in single precision (3DGS's format), so they keep only that; "
+                                "recentre the model for a finer file (COLMAP: model_transformer)")});
     if (r > 0 && r < 50 * near_plane)
       out.push_back({"(scene)", "scale",
                      "the train cameras spread over " + num(r) + ", under 50 times the renderer's near plane (" +

@@ -24,7 +24,11 @@ inline constexpr double kMinFovDeg = 1.0, kMaxFovDeg = 150.0;
 // "frame" when the train cameras sit more than 100 times their spread from the origin
 // (single-precision means lose the scene's detail there), "scale" when they spread over
 // less than 50 times the renderer's near plane `near_plane` (splat's RasterSettings
-// default; geometry knows nothing of splat, so callers pass theirs). Throws
+// default; geometry knows nothing of splat, so callers pass theirs). The loaders move every
+// dataset into a frame of its own (scene_frame.h), where training is fine in either case;
+// "frame" is then still given (in world units) for the .ply files, whose single-precision
+// world coordinates keep only that resolution, and "scale" guards scenes built in memory
+// in world coordinates. Throws
 // InputError(scene.source, "intrinsics or poses", ...) when the scene has points and no
 // train view sees any.
 std::vector<DatasetWarning> checkDataset(const Scene& scene, double near_plane = 0.01);

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <filesystem>
 #include <mutex>
+#include <stdexcept>
 
 #include "geometry/error.h"
 #include "geometry/io/pfm.h"
@@ -62,6 +63,8 @@ ImageF Scene::depth(int i) const {
   ImageF d = readPfm(v.depth_path);
   if (d.channels != 1) throw InputError(v.depth_path, "channels", "expected a 1-channel depth map");
   const int w = v.camera.K.width, h = v.camera.K.height;
+  if (frame.scale != 1.0)
+    for (float& z : d.data) z = static_cast<float>(z / frame.scale);
   if (d.width == w && d.height == h) return d;
   // Downscaled view: sample the depth at the new pixel centres (nearest). Averaging
   // depths would invent surfaces across occlusion edges.
@@ -90,6 +93,20 @@ void Scene::finalize() {
   if (points.empty())
     for (int i : train) aabb.extend(views[i].camera.center());
   extent = sceneExtent(cameras(train));
+}
+
+void moveToOwnFrame(Scene& scene) {
+  if (!scene.frame.identity())
+    throw std::logic_error("moveToOwnFrame: " + scene.source + " is already in a frame of its own");
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (int i : scene.train) mean += scene.views.at(i).camera.center();
+  if (!scene.train.empty()) mean /= static_cast<double>(scene.train.size());
+  const SceneFrame f = chooseSceneFrame(scene.extent, mean);
+  if (f.identity()) return;
+  for (SceneView& v : scene.views) v.camera = f.toInternal(v.camera);
+  for (SparsePoint& p : scene.points) p.xyz = f.toInternal(p.xyz);
+  scene.frame = f;
+  scene.finalize();
 }
 
 Scene loadDataset(const std::string& path, const DatasetOptions& opts) {

@@ -13,6 +13,7 @@
 
 #include "geometry/camera/camera.h"
 #include "geometry/image/image.h"
+#include "geometry/scene/scene_frame.h"
 
 namespace saresgs {
 
@@ -58,6 +59,10 @@ class Scene {
   std::vector<SparsePoint> points;
   AABB aabb;             // of the sparse points (of the cameras when there are none)
   double extent = 0.0;   // 3DGS scene scale from the train cameras
+  // Cameras, points, aabb, extent and depth maps are in this frame's internal coordinates
+  // (scene_frame.h): world = frame.toWorld(internal). The loaders choose it; a Scene built
+  // in memory is in world coordinates (the identity frame) until moveToOwnFrame.
+  SceneFrame frame;
   // The colour behind the content when the dataset knows it (Blender: the compositing
   // background; synthetic scenes: the manifest's), for training against the same one.
   std::optional<std::array<float, 3>> background;
@@ -69,7 +74,8 @@ class Scene {
   // The same as float RGB in [0,1], converted on each call.
   ImageF imageFloat(int i) const { return toFloat(image(i)); }
   bool hasDepth(int i) const { return !views.at(i).depth_path.empty(); }
-  // Ground-truth depth of view i (1 channel, z along the camera axis); throws if none.
+  // Ground-truth depth of view i (1 channel, z along the camera axis, in the frame's
+  // internal units); throws if none.
   ImageF depth(int i) const;
   std::vector<Camera> cameras(const std::vector<int>& which) const;
   // Recomputes aabb and extent from points and the train cameras.
@@ -80,6 +86,11 @@ class Scene {
  private:
   std::shared_ptr<ImageCache> cache_;
 };
+
+// Moves a scene in world coordinates (identity frame) into the frame chooseSceneFrame picks
+// for its train cameras: cameras, points, aabb, extent (and depth maps as read). Every
+// loader below ends with it; a frame that is the identity changes nothing.
+void moveToOwnFrame(Scene& scene);
 
 struct DatasetOptions {
   ImageLoadOptions load;
@@ -92,6 +103,7 @@ struct DatasetOptions {
 // nerfstudio folder (transforms.json), a
 // COLMAP folder (sparse model + images/), or a synthetic scene written by `saresgs scene`
 // (a COLMAP folder with depth/). Throws InputError with file and field on bad input.
+// The scene comes in its own frame (moveToOwnFrame).
 Scene loadDataset(const std::string& path, const DatasetOptions& opts = {});
 Scene loadColmapDataset(const std::string& path, const DatasetOptions& opts = {});
 Scene loadBlenderDataset(const std::string& path, const DatasetOptions& opts = {});

@@ -53,6 +53,10 @@ std::optional<SyntheticScene> rebuildSyntheticScene(const std::string& folder, c
   if (static_cast<std::size_t>(opts->num_views) != dataset.views.size())
     throw InputError((std::filesystem::path(folder) / "manifest.json").string(), "num_views",
                      std::to_string(opts->num_views) + ", but the dataset has " + std::to_string(dataset.views.size()) + " views");
+  // The rebuilt meshes are in the manifest's frame, which is the dataset's only when the
+  // loader kept it (every scene `saresgs scene` writes: metres, about the origin). A dataset
+  // moved out of it has no rebuilt ground truth.
+  if (!dataset.frame.identity()) return std::nullopt;
   SyntheticScene s = makeSyntheticScene(*opts);
   if (s.cameras.size() != dataset.views.size()) return std::nullopt;
   const double tol = 1e-6 * std::max(1.0, dataset.extent);

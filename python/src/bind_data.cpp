@@ -131,6 +131,11 @@ void bindData(py::module_& m) {
         return ownedArray(std::move(rgb), {static_cast<py::ssize_t>(s.points.size()), 3});
       }, "SfM point colours, N x 3 uint8")
       .def_readonly("extent", &Scene::extent, "3DGS scene scale (1.1 x the train cameras' largest distance from their mean)")
+      .def_property_readonly("frame_center", [](const Scene& s) { return s.frame.center; },
+                             "the frame the dataset is computed in: world = internal * frame_scale + frame_center; "
+                             "cameras, points and extent are internal, .ply files world (the identity for a scene "
+                             "of metres about the origin)")
+      .def_property_readonly("frame_scale", [](const Scene& s) { return s.frame.scale; }, "see frame_center")
       .def_property_readonly("background", [](const Scene& s) -> py::object {
         if (!s.background) return py::none();
         return py::make_tuple((*s.background)[0], (*s.background)[1], (*s.background)[2]);

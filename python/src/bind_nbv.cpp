@@ -16,6 +16,7 @@
 #include "geometry/io/atomic_file.h"
 #include "geometry/scene/cameras_json.h"
 #include "python/src/bindings.h"
+#include "splat/model_frame.h"
 #include "splat/ply.h"
 #include "splat/raster_execution.h"
 
@@ -381,9 +382,9 @@ void bindNbv(py::module_& m) {
             const std::string text = py::module_::import("json").attr("dumps")(report, py::arg("indent") = 2).cast<std::string>();
             py::gil_scoped_release nogil;
             std::filesystem::create_directories(out);
-            writeGaussiansPly(out + "/point_cloud.ply", r.run->trainer().gaussians());
-            if (const Trainer* f = r.run->finalFitTrainer()) writeGaussiansPly(out + "/final_fit.ply", f->gaussians());
-            if (const Trainer* f = r.run->finalFitViewsTrainer()) writeGaussiansPly(out + "/final_fit_views.ply", f->gaussians());
+            writeGaussiansPly(out + "/point_cloud.ply", gaussiansToWorld(r.run->trainer().gaussians(), r.dataset->frame));
+            if (const Trainer* f = r.run->finalFitTrainer()) writeGaussiansPly(out + "/final_fit.ply", gaussiansToWorld(f->gaussians(), r.dataset->frame));
+            if (const Trainer* f = r.run->finalFitViewsTrainer()) writeGaussiansPly(out + "/final_fit_views.ply", gaussiansToWorld(f->gaussians(), r.dataset->frame));
             writeCamerasJson(out + "/cameras.json", *r.dataset);
             writeImage(out + "/cameras.png", plotCameras(*r.dataset, r.result->initial_views, r.result->selected_views));
             writeFileAtomic(out + "/results.json", text + "\n");

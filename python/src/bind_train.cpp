@@ -2,6 +2,7 @@
 #include <memory>
 
 #include "python/src/bindings.h"
+#include "splat/model_frame.h"
 #include "splat/ply.h"
 #include "splat/train/schedule.h"
 #include "splat/train/trainer.h"
@@ -123,7 +124,7 @@ void bindTrain(py::module_& m) {
       .def_property_readonly("iteration", &Trainer::iteration)
       .def_property_readonly("active_sh_degree", &Trainer::activeShDegree)
       .def("reset", &Trainer::reset, "back to the initial model and optimiser (the random generator continues)")
-      .def("save_ply", [](const Trainer& t, const std::string& path) { py::gil_scoped_release nogil; writeGaussiansPly(path, t.gaussians()); },
+      .def("save_ply", [](const Trainer& t, const std::string& path) { py::gil_scoped_release nogil; writeGaussiansPly(path, gaussiansToWorld(t.gaussians(), t.scene().frame)); },
            py::arg("path"))
       .def("save_checkpoint", [](const Trainer& t, const std::string& path) { py::gil_scoped_release nogil; t.saveCheckpoint(path); },
            py::arg("path"), "model, optimiser and schedules, for a bit-identical resume")

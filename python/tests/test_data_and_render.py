@@ -20,6 +20,9 @@ def test_dataset_arrays(room):
     img = room.image(room.train[0])
     assert img.shape == (48, 64, 3) and img.dtype == np.uint8 and not img.flags.writeable
     assert room.points.shape[1] == 3 and room.points.shape[0] == room.point_colors.shape[0] > 100
+    # A room of metres about the origin is computed in its own world coordinates.
+    assert room.frame_scale == 1.0 and np.array_equal(room.frame_center, np.zeros(3))
+    assert 1.0 <= room.extent < 10.0
 
 
 def test_bad_input_is_a_clear_error(tmp_path):
