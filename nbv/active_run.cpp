@@ -189,6 +189,14 @@ int ActiveRun::selectNext(SelectionLog& log) {
   log.scores = fisherScores(trainer_->gaussians(), s, scene_, selected_, pool, opt_.fisher_lambda,
                             [this](int done, int total) { report(ActivePhase::kFisher, done, total); }, criterion);
   log.seconds.fisher += since(t0);
+  if (opt_.method == Method::kFisherKmedian) {
+    // Fisher scored every candidate; the k-median gain over them, each weighted by its score
+    // (held views are at distance 0 from a held view: they add nothing).
+    t0 = Clock::now();
+    log.fisher_scores = log.scores;
+    log.scores = kmedianGains(scene_, selected_, pool, pool, poseAngleScale(scene_), log.fisher_scores);
+    log.seconds.prefilter += since(t0);
+  }
   if (needs.surface) {
     // What the held views see is known from the poses: observing all of them again is a
     // union (cached sets), so a resumed run needs no saved state.

@@ -35,6 +35,10 @@ constexpr MethodRow kMethodTable[] = {
     // kmedian-fisher on a clustered capture, fvs-fisher on any other (captureClustering
     // against ActiveOptions::adaptive_clustering).
     {Method::kAdaptive, "adaptive", {true, false, false}},
+    // Greedy k-median over the train views, each weighted by FisherRF's score of it: the
+    // view that brings a held view nearest to the views the model is least sure of
+    // (kmedianGains with weights). No setting.
+    {Method::kFisherKmedian, "fisher-kmedian", {true, false, false}},
     // A selector function given by the caller (ActiveOptions::custom_selector: the Python
     // module's selectors); plain training, nothing precomputed.
     {Method::kCustom, "custom", {false, false, false}},

@@ -70,9 +70,15 @@ double poseAngleScale(const Scene& scene);
 // Unlike farthest view sampling (the largest gap), it counts how many views a gap holds:
 // on a clustered capture it fills the dense clusters first, on a uniform one it spreads.
 // With nothing chosen, near(t) is t's largest distance to the population. Summed in
-// population order: deterministic.
+// population order: deterministic. With `weights` (one per population view, >= 0), term t
+// counts weights[t] times: fisher-kmedian weights each view by FisherRF's score of it, so
+// the gain is the drop in distance to the nearest held view where the model is least sure
+// (a candidate's own term is its score times its distance to the nearest held view).
+// Throws std::invalid_argument on a weight count other than the population's or a
+// negative or non-finite weight.
 std::vector<double> kmedianGains(const Scene& scene, const std::vector<int>& chosen, const std::vector<int>& candidates,
-                                 const std::vector<int>& population, double angle_scale);
+                                 const std::vector<int>& population, double angle_scale,
+                                 const std::vector<double>& weights = {});
 
 // How clustered the capture is: over the train cameras, the coefficient of variation
 // (standard deviation over mean) of each camera's distance to its k-th nearest other

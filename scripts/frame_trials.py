@@ -6,10 +6,13 @@ unchanged), as COLMAP's model_transformer or a georeference does. Each frame is 
 a COLMAP text model beside links to the images and to the manifest of a `saresgs scene`
 folder (its split and background; no depth maps, so every frame, the first one too, is
 the same COLMAP dataset but for the frame), then
-`saresgs train --dataset F --iterations N --seed 0` runs on it and the test PSNR is printed
-as a Markdown table, one column per binary.
+`saresgs train --dataset F --iterations N --seed 0` (or `saresgs active --method M`) runs
+on it and the test PSNR (active: the final fit's, and the selected views) is printed as a
+Markdown table, one column per binary.
 
     python3 scripts/frame_trials.py DATASET OUT --bin build/apps/saresgs [--bin OLD] [--iterations 300]
+    python3 scripts/frame_trials.py DATASET OUT --bin build/apps/saresgs --active fisher --active-args '--max-views 10'
+
 
 DATASET holds images/ and sparse/0/*.txt (what `saresgs scene` writes).
 """
@@ -19,13 +22,17 @@ import os
 import subprocess
 import sys
 
+# Each frame is a list of similarities (s, d) applied in turn. The last one is a control:
+# moved 1e6 away and back, so the file is in the original frame (no frame change at all)
+# but holds every coordinate only to a double's resolution at 1e6, as the moved file does.
 FRAMES = [
-    ("as made", 1.0, (0.0, 0.0, 0.0)),
-    ("translated by (1e5, -5e4, 3e4)", 1.0, (1e5, -5e4, 3e4)),
-    ("translated by (1e6, 1e6, 0)", 1.0, (1e6, 1e6, 0.0)),
-    ("scaled by 1e3 (millimetres)", 1e3, (0.0, 0.0, 0.0)),
-    ("scaled by 1e-3 (kilometres)", 1e-3, (0.0, 0.0, 0.0)),
-    ("scaled by 37.3, translated by (-123456.789, 4.2e5, 17.5)", 37.3, (-123456.789, 4.2e5, 17.5)),
+    ("as made", [(1.0, (0.0, 0.0, 0.0))]),
+    ("translated by (1e5, -5e4, 3e4)", [(1.0, (1e5, -5e4, 3e4))]),
+    ("translated by (1e6, 1e6, 0)", [(1.0, (1e6, 1e6, 0.0))]),
+    ("scaled by 1e3 (millimetres)", [(1e3, (0.0, 0.0, 0.0))]),
+    ("scaled by 1e-3 (kilometres)", [(1e-3, (0.0, 0.0, 0.0))]),
+    ("scaled by 37.3, translated by (-123456.789, 4.2e5, 17.5)", [(37.3, (-123456.789, 4.2e5, 17.5))]),
+    ("control: as made, moved by (1e6, 1e6, 0) and back", [(1.0, (1e6, 1e6, 0.0)), (1.0, (-1e6, -1e6, 0.0))]),
 ]
 
 
@@ -74,15 +81,18 @@ def transform_points(lines, s, d):
     return out
 
 
-def write_frame(src, dst, s, d):
+def write_frame(src, dst, steps):
     os.makedirs(os.path.join(dst, "sparse", "0"), exist_ok=True)
     sp = os.path.join(src, "sparse", "0")
     with open(os.path.join(sp, "cameras.txt")) as f:
         cams = f.read()
     with open(os.path.join(sp, "images.txt")) as f:
-        images = transform_images(f.readlines(), s, d)
+        images = f.readlines()
     with open(os.path.join(sp, "points3D.txt")) as f:
-        points = transform_points(f.readlines(), s, d)
+        points = f.readlines()
+    for s, d in steps:
+        images = transform_images(images, s, d)
+        points = transform_points(points, s, d)
     out = os.path.join(dst, "sparse", "0")
     with open(os.path.join(out, "cameras.txt"), "w") as f:
         f.write(cams)
@@ -108,18 +118,24 @@ def main():
     ap.add_argument("--bin", action="append", required=True, help="a saresgs binary (repeat for several)")
     ap.add_argument("--iterations", type=int, default=300)
     ap.add_argument("--threads", type=int, default=0)
+    ap.add_argument("--active", metavar="METHOD", help="run `saresgs active --method METHOD` instead of train")
+    ap.add_argument("--active-args", default="", help="more options for active, e.g. '--max-views 10'")
     a = ap.parse_args()
     if not os.path.isfile(os.path.join(a.dataset, "sparse", "0", "images.txt")):
         sys.exit(f"{a.dataset}: expected a COLMAP text model in sparse/0 (images.txt)")
     rows = []
-    for k, (name, s, d) in enumerate(FRAMES):
+    for k, (name, steps) in enumerate(FRAMES):
         frame_dir = os.path.join(a.out, f"frame{k}")
-        write_frame(a.dataset, frame_dir, s, d)
+        write_frame(a.dataset, frame_dir, steps)
         row = [name]
         for b, binary in enumerate(a.bin):
             run_dir = os.path.join(a.out, f"frame{k}_bin{b}")
-            cmd = [binary, "train", "--dataset", frame_dir, "--out", run_dir, "--iterations", str(a.iterations),
-                   "--seed", "0"]
+            if a.active:
+                cmd = [binary, "active", "--dataset", frame_dir, "--out", run_dir, "--method", a.active, "--seed", "0"]
+                cmd += a.active_args.split()
+            else:
+                cmd = [binary, "train", "--dataset", frame_dir, "--out", run_dir, "--iterations", str(a.iterations),
+                       "--seed", "0"]
             if a.threads:
                 cmd += ["--threads", str(a.threads)]
             p = subprocess.run(cmd, capture_output=True, text=True)
@@ -129,7 +145,11 @@ def main():
                 continue
             with open(os.path.join(run_dir, "results.json")) as f:
                 r = json.load(f)
-            row.append(f"{r['psnr']:.2f} dB ({r['gaussians']} Gaussians)")
+            if a.active:
+                fit = r.get("final_fit") or r
+                row.append(f"{fit['psnr']:.2f} dB, views {' '.join(v.split('.')[0] for v in r['selected_views'])}")
+            else:
+                row.append(f"{r['psnr']:.2f} dB ({r['gaussians']} Gaussians)")
         rows.append(row)
         print(" | ".join(row), file=sys.stderr, flush=True)
     print("| frame | " + " | ".join(a.bin) + " |")

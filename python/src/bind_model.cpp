@@ -1,10 +1,12 @@
 // The Gaussian model, rendering, gradients, the training loss and the metrics.
 #include <cmath>
 
+#include "geometry/scene/scene.h"
 #include "python/src/bindings.h"
 #include "splat/gaussians.h"
 #include "splat/loss.h"
 #include "splat/metrics.h"
+#include "splat/model_frame.h"
 #include "splat/ply.h"
 #include "splat/rasterize.h"
 
@@ -107,6 +109,11 @@ void bindModel(py::module_& m) {
                   py::arg("path"), "Reads a 3DGS .ply (as the reference implementation, SuperSplat and splat-transform write it).")
       .def("write_ply", [](const Gaussians& g, const std::string& path) { checkModel(g); py::gil_scoped_release nogil; writeGaussiansPly(path, g); },
            py::arg("path"), "Writes the standard 3DGS .ply (atomically: a temporary name, then renamed).")
+      .def("to_world", [](const Gaussians& g, const Scene& d) { return gaussiansToWorld(g, d.frame); }, py::arg("dataset"),
+           "The model in world coordinates, from the dataset's internal frame (Dataset.frame_scale, frame_center), "
+           "as .ply files hold it; a copy (the identity frame: unchanged).")
+      .def("from_world", [](const Gaussians& g, const Scene& d) { return gaussiansFromWorld(g, d.frame); }, py::arg("dataset"),
+           "The model in the dataset's internal frame, from world coordinates (read_ply's); a copy.")
       .def("__repr__", [](const Gaussians& g) {
         return "Gaussians(" + std::to_string(g.size()) + ", sh degree " + std::to_string(g.max_sh_degree) + ")";
       });

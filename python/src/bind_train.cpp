@@ -119,7 +119,7 @@ void bindTrain(py::module_& m) {
                                     std::to_string(t.gaussians().max_sh_degree));
             t.mutableGaussians() = g;
           },
-          "a copy of the current model; assigning a model (e.g. Gaussians.read_ply) continues training from it "
+          "a copy of the current model, in the dataset's internal frame; assigning a model (e.g. Gaussians.read_ply(p).from_world(dataset)) continues training from it "
           "(the optimiser's moments restart when the count changes)")
       .def_property_readonly("iteration", &Trainer::iteration)
       .def_property_readonly("active_sh_degree", &Trainer::activeShDegree)

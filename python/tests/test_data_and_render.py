@@ -1,11 +1,12 @@
 """Datasets, cameras, the model's arrays and rendering, against the CLI and by hand."""
+import importlib.util
 import json
 
 import numpy as np
 import pytest
 
 import saresgs
-from conftest import run_cli
+from conftest import REPO, run_cli
 
 
 def test_dataset_arrays(room):
@@ -127,3 +128,27 @@ def test_loss_and_gradient_is_consistent():
     step = g.copy()
     step.sh = g.sh - 1e-2 * grad.sh / (np.abs(grad.sh).max() + 1e-12)
     assert saresgs.loss_and_gradient(step, cam, target, threads=1)[0] < loss
+
+
+def test_a_dataset_in_millimetres_is_computed_in_its_own_frame(room, tmp_path):
+    """The room written in millimetres (scripts/frame_trials.py's frames) loads into the
+    room's own coordinates; a trained model's .ply holds millimetres and maps back."""
+    spec = importlib.util.spec_from_file_location("frame_trials", REPO / "scripts" / "frame_trials.py")
+    frames = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(frames)
+    frames.write_frame(room.source, str(tmp_path / "mm"), [(1e3, (0.0, 0.0, 0.0))])
+    mm = saresgs.load_dataset(str(tmp_path / "mm"))
+    assert mm.frame_scale == 1e3 and np.array_equal(mm.frame_center, np.zeros(3))
+    assert mm.extent == pytest.approx(room.extent, rel=1e-12)
+    for i in range(len(room)):
+        np.testing.assert_allclose(mm.camera(i).center, room.camera(i).center, atol=1e-9)
+    np.testing.assert_allclose(mm.points, room.points, atol=1e-9)
+    t = saresgs.Trainer(mm, seed=0)
+    t.train(mm.train[:4], 10)
+    t.save_ply(str(tmp_path / "mm.ply"))
+    world = saresgs.Gaussians.read_ply(str(tmp_path / "mm.ply"))
+    internal = t.gaussians
+    np.testing.assert_allclose(world.means, 1e3 * internal.means, rtol=1e-6, atol=1e-6)
+    np.testing.assert_allclose(world.log_scales, internal.log_scales + np.log(1e3), atol=1e-5)
+    np.testing.assert_allclose(world.from_world(mm).means, internal.means, rtol=1e-6, atol=1e-9)
+    np.testing.assert_array_equal(internal.to_world(room).means, internal.means)  # the identity frame

@@ -589,6 +589,30 @@ TEST(ActiveRun, FvsFisherIsFisherOnFarthestViewsTopFraction) {
                                     [](const Scene& s, const auto& held, const auto& all) { return fvsScores(s, held, all); });
 }
 
+// fisher-kmedian scores every candidate by FisherRF (the first selection's scores are the
+// fisher run's: the same model), then takes the k-median gain weighted by those scores.
+TEST(ActiveRun, FisherKmedianWeighsTheKmedianGainByFisher) {
+  const Scene& s = tinyDataset();
+  const ActiveResult r = ActiveRun(s, tinyOptions(Method::kFisherKmedian)).run();
+  const ActiveResult f = ActiveRun(s, tinyOptions(Method::kFisher)).run();
+  ASSERT_FALSE(r.steps.empty());
+  EXPECT_EQ(r.steps[0].fisher_scores, f.steps[0].scores);
+  int selections = 0;
+  for (const SelectionLog& st : r.steps) {
+    if (st.selected < 0) continue;
+    const std::vector<int> held(r.selected_views.begin(), r.selected_views.begin() + st.views_before);
+    std::vector<int> all;
+    for (int v : s.train)
+      if (std::find(held.begin(), held.end(), v) == held.end()) all.push_back(v);
+    EXPECT_EQ(st.candidates, all);
+    ASSERT_EQ(st.fisher_scores.size(), all.size());
+    EXPECT_EQ(st.scores, kmedianGains(s, held, all, all, poseAngleScale(s), st.fisher_scores));
+    EXPECT_EQ(st.selected, all[argmaxScore(st.scores, all)]);
+    ++selections;
+  }
+  EXPECT_EQ(selections, 3);
+}
+
 // adaptive is kmedian-fisher above its clustering threshold and fvs-fisher below it, view
 // for view (thresholds either side of the tiny capture's own clustering), and its default
 // threshold puts the tiny capture, an even ring, on the farthest-view side.

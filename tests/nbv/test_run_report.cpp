@@ -36,6 +36,7 @@ RunReport sampleReport() {
   StepReport sel{2, 18.0, {}, "c.png", {"c.png", "d.png"}, {0.5, 0.25}, {"c.png"}};
   sel.seconds.fisher = 1.5;
   r.steps = {sel, {3, 19.0, {}, {}, {}, {}, {}}};
+  r.frame = SceneFrame{Eigen::Vector3d(1e6, -5e4, 0.5), 1e-3};
   return r;
 }
 

@@ -155,6 +155,48 @@ TEST(Selectors, KmedianGainIsTheDropOfTheSummedNearestPoseDistance) {
   EXPECT_THROW(kmedianGains(s, held, cand, s.train, -1), std::invalid_argument);
 }
 
+// fisher-kmedian's gain: the k-median gain with each view weighted by how unsure the model
+// is of it. On a line of cameras 0..9 with 0 held, weight only on the far end (7, 8, 9):
+// the far end's median, 8, gains 6 + 8 + 8 = 22, its neighbours 21, the unweighted median
+// lies in the middle. The weighted gain is the weighted drop of the objective.
+TEST(Selectors, WeightedKmedianServesTheViewsTheModelIsUnsureOf) {
+  std::vector<double> xs;
+  for (int i = 0; i < 10; ++i) xs.push_back(i);
+  const Scene s = lineScene(xs);
+  std::vector<int> cand;
+  for (int i = 1; i < 10; ++i) cand.push_back(i);
+  const std::vector<double> w = {0, 0, 0, 0, 0, 0, 1, 1, 1};  // per candidate (the population)
+  const std::vector<double> g = kmedianGains(s, {0}, cand, cand, 1.0, w);
+  EXPECT_EQ(cand[argmaxScore(g, cand)], 8);
+  EXPECT_NEAR(g[7], 22, 1e-12);
+  EXPECT_NEAR(g[6], 21, 1e-12);
+  EXPECT_NEAR(g[8], 21, 1e-12);
+  const std::vector<double> u = kmedianGains(s, {0}, cand, cand, 1.0);
+  const int uniform_pick = cand[argmaxScore(u, cand)];
+  EXPECT_TRUE(uniform_pick == 5 || uniform_pick == 6) << uniform_pick;
+  // Equal weights rank as no weights.
+  const std::vector<double> twos = kmedianGains(s, {0}, cand, cand, 1.0, std::vector<double>(cand.size(), 2.0));
+  for (std::size_t i = 0; i < cand.size(); ++i) EXPECT_NEAR(twos[i], 2 * u[i], 1e-12);
+  EXPECT_THROW(kmedianGains(s, {0}, cand, cand, 1.0, {1, 2}), std::invalid_argument);
+  EXPECT_THROW(kmedianGains(s, {0}, cand, cand, 1.0, std::vector<double>(cand.size(), -1.0)), std::invalid_argument);
+  EXPECT_THROW(kmedianGains(s, {0}, cand, cand, 1.0, std::vector<double>(cand.size(), NAN)), std::invalid_argument);
+}
+
+// Where FisherRF repeats itself: two near-duplicate views A (x = 6) and A' (6.05) are the
+// most uncertain, B (x = -6) a little less. FisherRF takes A, then A' (its score barely
+// drops in a trace over its own pixels); with A held, A' brings no view nearer a held one,
+// so the weighted gain takes B.
+TEST(Selectors, WeightedKmedianDoesNotRepeatANearDuplicate) {
+  const Scene s = lineScene({0, 6, 6.05, -6});
+  const std::vector<int> cand = {2, 3};  // A (1) already taken
+  const std::vector<double> fisher_like = {4.9, 3.0};
+  EXPECT_EQ(cand[argmaxScore(fisher_like, cand)], 2);
+  const std::vector<double> g = kmedianGains(s, {0, 1}, cand, cand, 1.0, fisher_like);
+  EXPECT_EQ(cand[argmaxScore(g, cand)], 3);
+  EXPECT_NEAR(g[0], 4.9 * 0.05, 1e-9);
+  EXPECT_NEAR(g[1], 3.0 * 6, 1e-9);
+}
+
 // The pose distance: the centres' distance plus the angle scale times the angle of the
 // optical axes; exact for a pure turn, symmetric, zero for one camera, and accurate for
 // nearly parallel axes.
