@@ -21,19 +21,24 @@ inline SyntheticOptions tinyDatasetOptions() {
   return o;
 }
 
-inline const Scene& tinyDataset() {
+// The folder it is written to (once per test program).
+inline const std::string& tinyDatasetPath() {
   static std::unique_ptr<TempDir> dir;
-  static Scene scene;
+  static std::string path;
   if (!dir) {
     dir = std::make_unique<TempDir>();
-    const SyntheticOptions o = tinyDatasetOptions();
     WriteDatasetOptions w;
     w.simulated.max_points = 1500;
     w.simulated.candidates = 6000;
     w.simulated.seed = 3;
-    writeSyntheticDataset(makeSyntheticScene(o), dir->file("ds"), w);
-    scene = loadDataset(dir->file("ds"));
+    writeSyntheticDataset(makeSyntheticScene(tinyDatasetOptions()), dir->file("ds"), w);
+    path = dir->file("ds");
   }
+  return path;
+}
+
+inline const Scene& tinyDataset() {
+  static const Scene scene = loadDataset(tinyDatasetPath());
   return scene;
 }
 

@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "common/test_support.h"
+#include "common/tiny_active_options.h"
 #include "common/tiny_dataset.h"
 #include "geometry/error.h"
 #include "nbv/active_run.h"
@@ -24,23 +25,6 @@ namespace {
 
 using test::TempDir;
 using test::tinyDataset;
-
-ActiveOptions tinyOptions(Method m) {
-  ActiveOptions o;
-  o.method = m;
-  o.initial_views = 2;
-  o.max_views = 5;
-  o.interval = 6;
-  o.total_iterations = 90;
-  o.trainer.max_sh_degree = 0;
-  o.trainer.densify.from_iter = 10;
-  o.trainer.densify.interval = 10;
-  o.prefilter.scoring.encoding = CoverageEncoding::Exact;
-  o.prefilter.resolution = 24;
-  o.progress_test_views = 1;
-  o.seed = 5;
-  return o;
-}
 
 bool sameModel(const Gaussians& a, const Gaussians& b) {
   if (a.size() != b.size()) return false;

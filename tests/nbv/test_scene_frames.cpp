@@ -17,12 +17,11 @@
 #include <vector>
 
 #include "common/test_support.h"
+#include "common/tiny_active_options.h"
 #include "common/tiny_dataset.h"
 #include "geometry/io/colmap.h"
 #include "geometry/scene/dataset_checks.h"
 #include "geometry/scene/scene.h"
-#include "geometry/synth/synthetic_scene.h"
-#include "geometry/synth/write_dataset.h"
 #include "nbv/active_run.h"
 #include "nbv/eval/coverage_report.h"
 #include "nbv/method.h"
@@ -69,20 +68,8 @@ void writeInFrame(const std::string& src, const std::string& out, const WorldFra
   fs::create_symlink(fs::absolute(src + "/manifest.json"), out + "/manifest.json");
 }
 
-// A small object capture (64x48, 16 views), written once.
-const std::string& sourceDataset() {
-  static TempDir dir;
-  static std::string path;
-  if (path.empty()) {
-    WriteDatasetOptions w;
-    w.simulated.max_points = 1500;
-    w.simulated.candidates = 6000;
-    w.simulated.seed = 3;
-    writeSyntheticDataset(makeSyntheticScene(test::tinyDatasetOptions()), dir.file("src"), w);
-    path = dir.file("src");
-  }
-  return path;
-}
+// The tiny object capture (64x48, 16 views) of the other tests, as written.
+const std::string& sourceDataset() { return test::tinyDatasetPath(); }
 
 TEST(SceneFrames, TheLoadersUndoAChangeOfUnitOrARoundOffset) {
   TempDir d;
@@ -138,20 +125,11 @@ TEST(SceneFrames, AnyOtherFrameComesWithinAFactorOfTenAndAnExtentOfTheOrigin) {
   EXPECT_LE(mean.cwiseAbs().maxCoeff(), 5.0 + 1e-9) << "the centre lies on a grid of 10 internal units";
 }
 
+// The nbv tests' tiny run, with more iterations per view so that Fisher reads a model.
 ActiveOptions smallRun(Method m) {
-  ActiveOptions o;
-  o.method = m;
-  o.initial_views = 2;
-  o.max_views = 5;
+  ActiveOptions o = tinyOptions(m);
   o.interval = 12;
   o.total_iterations = 150;
-  o.trainer.max_sh_degree = 0;
-  o.trainer.densify.from_iter = 10;
-  o.trainer.densify.interval = 10;
-  o.prefilter.scoring.encoding = CoverageEncoding::Exact;
-  o.prefilter.resolution = 24;
-  o.progress_test_views = 1;
-  o.seed = 5;
   return o;
 }
 
