@@ -22,7 +22,9 @@ cleanup() { umount "$mnt" 2>/dev/null || true; rm -rf "$work"; }
 trap cleanup EXIT
 fail() { echo "FAIL: $*" >&2; exit 1; }
 compared=0 lost=0
-# Same content, timing fields aside (JSON files), or same bytes.
+# Same content, timing and machine-state fields aside (JSON files: seconds, threads used,
+# peak RSS and the memory budget, which without --memory-budget is the memory free at the
+# start), or same bytes.
 same() {
   compared=$((compared + 1))
   /usr/bin/python3 - "$1" "$2" <<'EOF' || { lost=$((lost + $(stat -c %s "$1"))); return 1; }
@@ -32,7 +34,8 @@ if not a.endswith(".json"):
     sys.exit(0 if open(a, "rb").read() == open(b, "rb").read() else 1)
 def strip(x):
     if isinstance(x, dict):
-        return {k: strip(v) for k, v in x.items() if "second" not in k and k not in ("threads_used",)}
+        return {k: strip(v) for k, v in x.items()
+                if "second" not in k and k not in ("threads_used", "peak_rss_bytes", "budget_bytes")}
     if isinstance(x, list):
         return [strip(v) for v in x]
     return x
