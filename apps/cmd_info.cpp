@@ -29,6 +29,7 @@ std::string frameText(const SceneFrame& f) {
 int runInfo(const InfoArgs& a) {
   const Scene s = loadDataset(a.dataset, a.opts);
   std::cerr << formatWarnings(checkDataset(s));
+  const std::string internal = s.frame.identity() ? "" : " (internal units; the frame below maps them to the world)";
   const Intrinsics& K = s.views.front().camera.K;
   const bool adaptiveKmedian = usesKmedianGate(s, ActiveOptions{.method = Method::kAdaptive});
   int with_depth = 0;
@@ -39,8 +40,8 @@ int runInfo(const InfoArgs& a) {
             << "  camera:  " << K.width << "x" << K.height << ", fx " << K.fx << ", fy " << K.fy
             << ", fov " << K.fovX() * 180 / M_PI << " x " << K.fovY() * 180 / M_PI << " deg\n"
             << "  points:  " << s.points.size() << "\n"
-            << "  aabb:    [" << s.aabb.min.transpose() << "] .. [" << s.aabb.max.transpose() << "]\n"
-            << "  extent:  " << s.extent << "\n"
+            << "  aabb:    [" << s.aabb.min.transpose() << "] .. [" << s.aabb.max.transpose() << "]" << internal << "\n"
+            << "  extent:  " << s.extent << internal << "\n"
             << "  frame:   " << frameText(s.frame) << "\n"
             << "  capture: clustering " << captureClustering(s) << " (" << (adaptiveKmedian ? "clustered" : "even")
             << "; `active --method adaptive` gates Fisher by " << (adaptiveKmedian ? "k-median gain" : "farthest view") << ")\n";

@@ -26,7 +26,8 @@ SceneFrame chooseSceneFrame(double extent, const Eigen::Vector3d& mean_center) {
   f.scale = std::pow(10.0, std::floor(std::log10(extent)));
   if (!(f.scale > 0) || !std::isfinite(f.scale)) return SceneFrame{};
   const double grid = 10.0 * f.scale;
-  for (int k = 0; k < 3; ++k) f.center[k] = std::round(mean_center[k] / grid) * grid;
+  // + 0.0 turns a rounded -0 into 0 (printed and written as such).
+  for (int k = 0; k < 3; ++k) f.center[k] = std::round(mean_center[k] / grid) * grid + 0.0;
   return f;
 }
 

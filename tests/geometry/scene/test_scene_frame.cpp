@@ -30,6 +30,10 @@ TEST(SceneFrame, ChoosesAPowerOfTenBelowTheExtentAndARoundCentre) {
   EXPECT_EQ(chooseSceneFrame(3.0, Eigen::Vector3d(7, -12, 4)).center, Eigen::Vector3d(10, -10, 0));
   EXPECT_EQ(chooseSceneFrame(3.0, Eigen::Vector3d(1e6 + 2.5, -5e4 - 1, 0)).center, Eigen::Vector3d(1e6, -5e4, 0));
   EXPECT_EQ(chooseSceneFrame(3e3, Eigen::Vector3d(1e6 + 2.5e3, 0, 0)).center, Eigen::Vector3d(1e6, 0, 0));
+  // A centre that rounds to zero from below is 0, not -0 (it is printed and written).
+  const SceneFrame mm = chooseSceneFrame(3e3, Eigen::Vector3d(-20, -4e3, 0));
+  EXPECT_FALSE(std::signbit(mm.center.x()));
+  EXPECT_FALSE(std::signbit(mm.center.y()));
   // Nothing to measure: the identity.
   EXPECT_TRUE(chooseSceneFrame(0.0, o).identity());
   EXPECT_TRUE(chooseSceneFrame(std::numeric_limits<double>::infinity(), o).identity());
