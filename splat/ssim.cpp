@@ -419,6 +419,13 @@ struct Job {
   double* row_l1;      // per-row sums of |x - y|
 };
 
+// What one ssimL1 call needs beside its blocks' scratch (see ssimL1).
+struct CallBuffers {
+  std::vector<float> zeros, wx, wy, partials;
+  std::vector<double> row_om, row_l1;
+  bool busy = false;
+};
+
 // Per-thread scratch, kept between calls (the loss runs every training iteration). A
 // block never waits on other TBB work, so no two blocks share a thread's scratch at once.
 std::vector<float>& scratch(std::size_t n) {
@@ -592,27 +599,41 @@ SsimL1Sums ssimL1(const float* x, const float* y, int w, int h, int channels, fl
   J.ssim_scale = static_cast<float>(ssim_scale);
   J.ssim_grad = grad != nullptr && ssim_scale != 0.0;
   J.k = &kernels();
-  const std::vector<float> zeros(J.W, 0.0f);
-  J.zeros = zeros.data();
-  std::vector<float> wx(J.W), wy(h);
+  // The call's buffers, kept per thread between calls (the loss runs every iteration: no
+  // allocation once they have grown). The calling thread waits in TBB below and may run
+  // another call meanwhile (one nested in a stolen task); that one gets buffers of its own.
+  thread_local CallBuffers kept;
+  CallBuffers fresh;
+  CallBuffers& B = kept.busy ? fresh : kept;
+  const struct Busy {
+    CallBuffers& b;
+    explicit Busy(CallBuffers& x) : b(x) { b.busy = true; }
+    ~Busy() { b.busy = false; }
+  } busy(B);
+  B.zeros.assign(J.W, 0.0f);
+  J.zeros = B.zeros.data();
+  B.wx.resize(J.W);
+  B.wy.resize(static_cast<std::size_t>(h));
   for (int i = 0; i < w; ++i)
-    std::fill_n(wx.begin() + static_cast<std::ptrdiff_t>(i) * channels, channels,
+    std::fill_n(B.wx.begin() + static_cast<std::ptrdiff_t>(i) * channels, channels,
                 static_cast<float>(insideWeight(i, w)));
-  for (int r = 0; r < h; ++r) wy[r] = static_cast<float>(insideWeight(r, h));
-  J.wx = wx.data();
-  J.wy = wy.data();
-  std::vector<double> row_om(h), row_l1(h);
-  J.row_om = row_om.data();
-  J.row_l1 = row_l1.data();
-  std::unique_ptr<float[]> partials;
+  for (int r = 0; r < h; ++r) B.wy[static_cast<std::size_t>(r)] = static_cast<float>(insideWeight(r, h));
+  J.wx = B.wx.data();
+  J.wy = B.wy.data();
+  B.row_om.assign(static_cast<std::size_t>(h), 0.0);
+  B.row_l1.assign(static_cast<std::size_t>(h), 0.0);
+  J.row_om = B.row_om.data();
+  J.row_l1 = B.row_l1.data();
   if (J.ssim_grad) {
     J.dstride = rowStride(J.W);
     const std::size_t n = J.dstride * h;
-    partials.reset(new float[3 * n]);
-    J.da = partials.get();
+    B.partials.resize(3 * n);
+    J.da = B.partials.data();
     J.db = J.da + n;
     J.dc = J.db + n;
   }
+  const std::vector<double>& row_om = B.row_om;
+  const std::vector<double>& row_l1 = B.row_l1;
 
   forRowBlocks(h, [&](int r0, int r1) { forwardBlock(J, r0, r1); });
   if (J.ssim_grad) forRowBlocks(h, [&](int r0, int r1) { backwardBlock(J, r0, r1); });
