@@ -208,15 +208,31 @@ bool evalAlpha(const TileGaussian<T>& q, T px, T py, T& dx, T& dy, T& G, T& alph
 // which costs far less than sorting each tile. Float depths go through a stable LSD radix
 // sort on their bits (mapped so that unsigned order is float order); double uses
 // std::sort.
+//
+// The scratch of binAndSort and depthOrder, kept per thread between renders (no allocation
+// once grown). binAndSort waits in TBB, where its thread may run another render's binning
+// (a task nested in the wait); that one takes scratch of its own (`busy`).
+struct BinScratch {
+  std::vector<std::uint32_t> slot_tile, fill, order, key, key2, order2;
+  bool busy = false;
+};
+
+// Fills `sc.order` with the Gaussians that have pairs, in rule 6's order.
 template <typename T>
-std::vector<std::uint32_t> depthOrder(const std::vector<Projected<T>>& proj, const std::vector<std::uint32_t>& count) {
-  std::vector<std::uint32_t> order;
+void depthOrder(const std::vector<Projected<T>>& proj, const std::vector<std::uint32_t>& count, BinScratch& sc) {
+  std::vector<std::uint32_t>& order = sc.order;
+  order.clear();
   order.reserve(proj.size());
   for (std::size_t i = 0; i < proj.size(); ++i)
     if (count[i]) order.push_back(static_cast<std::uint32_t>(i));
   if constexpr (std::is_same_v<T, float>) {
     const std::size_t m = order.size();
-    std::vector<std::uint32_t> key(m), key2(m), order2(m);
+    std::vector<std::uint32_t>& key = sc.key;
+    std::vector<std::uint32_t>& key2 = sc.key2;
+    std::vector<std::uint32_t>& order2 = sc.order2;
+    key.resize(m);
+    key2.resize(m);
+    order2.resize(m);
     for (std::size_t j = 0; j < m; ++j) {
       // + 0 turns -0 into +0, which the comparison of rule 6 treats as equal.
       const std::uint32_t b = std::bit_cast<std::uint32_t>(proj[order[j]].depth + 0.0f);
@@ -240,7 +256,6 @@ std::vector<std::uint32_t> depthOrder(const std::vector<Projected<T>>& proj, con
       return proj[x].depth < proj[y].depth || (proj[x].depth == proj[y].depth && x < y);
     });
   }
-  return order;
 }
 
 template <typename T>
@@ -426,7 +441,16 @@ void binAndSort(const TileCover& cover, int W, int H, RasterStateT<T>& st) {
   st.gauss_start.assign(n + 1, 0);
   for (std::size_t i = 0; i < n; ++i) st.gauss_start[i + 1] = st.gauss_start[i] + cover.count[i];
   const std::uint32_t pairs = st.gauss_start[n];
-  std::vector<std::uint32_t> slot_tile(pairs);
+  thread_local BinScratch kept;
+  BinScratch fresh;
+  BinScratch& sc = kept.busy ? fresh : kept;
+  const struct Busy {
+    BinScratch& b;
+    explicit Busy(BinScratch& x) : b(x) { b.busy = true; }
+    ~Busy() { b.busy = false; }
+  } busy(sc);
+  std::vector<std::uint32_t>& slot_tile = sc.slot_tile;
+  slot_tile.assign(pairs, 0);
   arena(st).execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& r) {
       const FloatEnvGuard fenv;  // geometry/float_env.h
@@ -444,8 +468,10 @@ void binAndSort(const TileCover& cover, int W, int H, RasterStateT<T>& st) {
   for (int t = 0; t < tiles; ++t) st.tile_start[t + 1] += st.tile_start[t];
   st.entry_gauss.resize(pairs);
   st.entry_slot.resize(pairs);
-  std::vector<std::uint32_t> fill(st.tile_start.begin(), st.tile_start.end() - 1);
-  for (const std::uint32_t i : depthOrder(st.proj, cover.count))
+  std::vector<std::uint32_t>& fill = sc.fill;
+  fill.assign(st.tile_start.begin(), st.tile_start.end() - 1);
+  depthOrder(st.proj, cover.count, sc);
+  for (const std::uint32_t i : sc.order)
     for (std::uint32_t k = st.gauss_start[i]; k < st.gauss_start[i + 1]; ++k) {
       const std::uint32_t e = fill[slot_tile[k]]++;
       st.entry_gauss[e] = i;
