@@ -203,12 +203,6 @@ bool evalAlpha(const TileGaussian<T>& q, T px, T py, T& dx, T& dy, T& G, T& alph
   return alpha >= projection::Thresholds<T>::min_alpha;
 }
 
-// Rule 6 for every tile at once: the Gaussians with pairs, by camera z, ties by index.
-// Binning them in this order (a stable counting sort by tile) leaves every tile sorted,
-// which costs far less than sorting each tile. Float depths go through a stable LSD radix
-// sort on their bits (mapped so that unsigned order is float order); double uses
-// std::sort.
-//
 // The scratch of binAndSort and depthOrder, kept per thread between renders (no allocation
 // once grown). binAndSort waits in TBB, where its thread may run another render's binning
 // (a task nested in the wait); that one takes scratch of its own (`busy`).
@@ -217,7 +211,11 @@ struct BinScratch {
   bool busy = false;
 };
 
-// Fills `sc.order` with the Gaussians that have pairs, in rule 6's order.
+// Rule 6 for every tile at once: the Gaussians with pairs, by camera z, ties by index.
+// Binning them in this order (a stable counting sort by tile) leaves every tile sorted,
+// which costs far less than sorting each tile. Float depths go through a stable LSD radix
+// sort on their bits (mapped so that unsigned order is float order); double uses
+// std::sort. The order goes to `sc.order`.
 template <typename T>
 void depthOrder(const std::vector<Projected<T>>& proj, const std::vector<std::uint32_t>& count, BinScratch& sc) {
   std::vector<std::uint32_t>& order = sc.order;
