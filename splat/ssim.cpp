@@ -1,6 +1,7 @@
 // The fused SSIM (+ L1) kernel (splat/ssim.h).
 #include "splat/ssim.h"
 #include "geometry/float_env.h"
+#include "splat/kept_buffers.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -423,7 +424,6 @@ struct Job {
 struct CallBuffers {
   std::vector<float> zeros, wx, wy, partials;
   std::vector<double> row_om, row_l1;
-  bool busy = false;
 };
 
 // Per-thread scratch, kept between calls (the loss runs every training iteration). A
@@ -599,17 +599,9 @@ SsimL1Sums ssimL1(const float* x, const float* y, int w, int h, int channels, fl
   J.ssim_scale = static_cast<float>(ssim_scale);
   J.ssim_grad = grad != nullptr && ssim_scale != 0.0;
   J.k = &kernels();
-  // The call's buffers, kept per thread between calls (the loss runs every iteration: no
-  // allocation once they have grown). The calling thread waits in TBB below and may run
-  // another call meanwhile (one nested in a stolen task); that one gets buffers of its own.
-  thread_local CallBuffers kept;
-  CallBuffers fresh;
-  CallBuffers& B = kept.busy ? fresh : kept;
-  const struct Busy {
-    CallBuffers& b;
-    explicit Busy(CallBuffers& x) : b(x) { b.busy = true; }
-    ~Busy() { b.busy = false; }
-  } busy(B);
+  // The call's buffers, kept per thread between calls (splat/kept_buffers.h).
+  KeptBuffers<CallBuffers> kept;
+  CallBuffers& B = kept.get();
   B.zeros.assign(J.W, 0.0f);
   J.zeros = B.zeros.data();
   B.wx.resize(J.W);

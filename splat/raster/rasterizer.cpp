@@ -15,6 +15,7 @@
 #include <stdexcept>
 #include <type_traits>
 
+#include "splat/kept_buffers.h"
 #include "splat/raster/execution.h"
 #include "splat/raster/projection.h"
 #include "splat/raster/raster_kernels.h"
@@ -203,12 +204,10 @@ bool evalAlpha(const TileGaussian<T>& q, T px, T py, T& dx, T& dy, T& G, T& alph
   return alpha >= projection::Thresholds<T>::min_alpha;
 }
 
-// The scratch of binAndSort and depthOrder, kept per thread between renders (no allocation
-// once grown). binAndSort waits in TBB, where its thread may run another render's binning
-// (a task nested in the wait); that one takes scratch of its own (`busy`).
+// The scratch of binAndSort and depthOrder, kept per thread between renders
+// (splat/kept_buffers.h).
 struct BinScratch {
   std::vector<std::uint32_t> slot_tile, fill, order, key, key2, order2;
-  bool busy = false;
 };
 
 // Rule 6 for every tile at once: the Gaussians with pairs, by camera z, ties by index.
@@ -439,14 +438,8 @@ void binAndSort(const TileCover& cover, int W, int H, RasterStateT<T>& st) {
   st.gauss_start.assign(n + 1, 0);
   for (std::size_t i = 0; i < n; ++i) st.gauss_start[i + 1] = st.gauss_start[i] + cover.count[i];
   const std::uint32_t pairs = st.gauss_start[n];
-  thread_local BinScratch kept;
-  BinScratch fresh;
-  BinScratch& sc = kept.busy ? fresh : kept;
-  const struct Busy {
-    BinScratch& b;
-    explicit Busy(BinScratch& x) : b(x) { b.busy = true; }
-    ~Busy() { b.busy = false; }
-  } busy(sc);
+  KeptBuffers<BinScratch> kept;
+  BinScratch& sc = kept.get();
   std::vector<std::uint32_t>& slot_tile = sc.slot_tile;
   slot_tile.assign(pairs, 0);
   arena(st).execute([&] {
