@@ -13,13 +13,10 @@
 #include "geometry/scene/dataset_checks.h"
 #include "geometry/io/atomic_file.h"
 #include "geometry/io/json_file.h"
-#include "geometry/scene/cameras_json.h"
 #include "nbv/active_run.h"
-#include "nbv/eval/camera_plot.h"
+#include "nbv/eval/run_files.h"
 #include "nbv/preset.h"
 #include "nbv/run_report.h"
-#include "splat/model_frame.h"
-#include "splat/ply.h"
 #include "splat/raster_execution.h"
 #include "splat/train/test_renders.h"
 
@@ -160,11 +157,7 @@ int runActive(const ActiveArgs& a) {
   });
   const Trainer& t = run.trainer();
   writeTestRenders(t, r.test, a.out + "/test_renders");
-  writeGaussiansPly(a.out + "/point_cloud.ply", gaussiansToWorld(t.gaussians(), scene.frame));
-  writeCamerasJson(a.out + "/cameras.json", scene);  // beside the .ply files, for splat viewers
-  writeImage(a.out + "/cameras.png", plotCameras(scene, r.initial_views, r.selected_views));
-  if (const Trainer* f = run.finalFitTrainer()) writeGaussiansPly(a.out + "/final_fit.ply", gaussiansToWorld(f->gaussians(), scene.frame));
-  if (const Trainer* f = run.finalFitViewsTrainer()) writeGaussiansPly(a.out + "/final_fit_views.ply", gaussiansToWorld(f->gaussians(), scene.frame));
+  writeRunFiles(run, r, scene, a.out);
   const RunReport report =
       makeRunReport(scene, opt, r, {a.dataset, a.preset, a.replay, t.gaussians().size(), rasterThreadCount(opt.trainer.raster.execution)});
   writeFileAtomic(a.out + "/results.json", toJson(report).dump(2) + "\n");

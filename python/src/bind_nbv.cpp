@@ -7,17 +7,14 @@
 #include "geometry/synth/from_manifest.h"
 #include "nbv/active_run.h"
 #include "nbv/coverage_prefilter.h"
-#include "nbv/eval/camera_plot.h"
+#include "nbv/eval/run_files.h"
 #include "nbv/eval/coverage_report.h"
 #include "nbv/method.h"
 #include "nbv/preset.h"
 #include "nbv/run_report.h"
 #include "nbv/selectors.h"
 #include "geometry/io/atomic_file.h"
-#include "geometry/scene/cameras_json.h"
 #include "python/src/bindings.h"
-#include "splat/model_frame.h"
-#include "splat/ply.h"
 #include "splat/raster_execution.h"
 
 namespace saresgs::python {
@@ -382,11 +379,7 @@ void bindNbv(py::module_& m) {
             const std::string text = py::module_::import("json").attr("dumps")(report, py::arg("indent") = 2).cast<std::string>();
             py::gil_scoped_release nogil;
             std::filesystem::create_directories(out);
-            writeGaussiansPly(out + "/point_cloud.ply", gaussiansToWorld(r.run->trainer().gaussians(), r.dataset->frame));
-            if (const Trainer* f = r.run->finalFitTrainer()) writeGaussiansPly(out + "/final_fit.ply", gaussiansToWorld(f->gaussians(), r.dataset->frame));
-            if (const Trainer* f = r.run->finalFitViewsTrainer()) writeGaussiansPly(out + "/final_fit_views.ply", gaussiansToWorld(f->gaussians(), r.dataset->frame));
-            writeCamerasJson(out + "/cameras.json", *r.dataset);
-            writeImage(out + "/cameras.png", plotCameras(*r.dataset, r.result->initial_views, r.result->selected_views));
+            writeRunFiles(*r.run, *r.result, *r.dataset, out);
             writeFileAtomic(out + "/results.json", text + "\n");
           },
           py::arg("out"),
