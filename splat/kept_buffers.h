@@ -3,7 +3,21 @@
 // iteration allocates nothing once they have grown. A thread that waits in TBB runs other
 // tasks meanwhile, which may call the same function again (a call nested in the wait):
 // that call gets buffers of its own, so no two calls share them at once.
+#include <cstddef>
+
 namespace saresgs {
+
+// v.assign(n, x) for a kept buffer: when it must grow it takes half as much again, so a
+// size that creeps up from call to call (the tile pairs of a model in training) does not
+// reallocate at every call, as assign's exact growth would.
+template <class Vec, class X>
+void assignKept(Vec& v, std::size_t n, const X& x) {
+  if (n > v.capacity()) {
+    v.clear();
+    v.reserve(n + n / 2);
+  }
+  v.assign(n, x);
+}
 
 template <class Buffers>
 class KeptBuffers {

@@ -77,6 +77,12 @@ struct RenderResult {
 // without copying the model; empty renders all.
 RenderResult rasterize(const Gaussians& g, const Camera& cam, const RasterSettings& s,
                        std::span<const std::uint8_t> mask = {});
+// The same render into `into`, reusing its buffers (and its backward state, when no other
+// RenderResult shares it): bit for bit the result above, and no heap allocation once
+// `into` has held a render of at least this many Gaussians, pixels and tile pairs. A
+// trainer keeps one and renders into it every step.
+void rasterize(const Gaussians& g, const Camera& cam, const RasterSettings& s, std::span<const std::uint8_t> mask,
+               RenderResult& into);
 // Adds to `grad` the gradient of a loss whose gradient w.r.t. fwd.rgb is dL_drgb; adds
 // the 2D-mean gradient (pixels, 2 per Gaussian) to *grad_mean2d when given.
 void rasterizeBackward(const Gaussians& g, const Camera& cam, const RasterSettings& s,
@@ -102,6 +108,9 @@ struct RenderPair {
 // `mask` has one byte per Gaussian (1 = in the subset).
 RenderPair rasterizeWithSubset(const Gaussians& g, const Camera& cam, const RasterSettings& s,
                                std::span<const std::uint8_t> mask);
+// The same into `into`, reusing its buffers as rasterize(..., into) does.
+void rasterizeWithSubset(const Gaussians& g, const Camera& cam, const RasterSettings& s,
+                         std::span<const std::uint8_t> mask, RenderPair& into);
 // Both renders' backward passes in one walk: adds to `grad` and *grad_mean2d what
 // rasterizeBackward of the full render with dL_drgb_full followed by rasterizeBackward
 // of rasterize(g, cam, s, mask) with dL_drgb_subset add (each branch's weight folded into

@@ -151,6 +151,11 @@ bool tileMeets(const TileGaussian<T>& g, int x0, int y0, int x1, int y1) {
 template <typename T>
 void gatherTile(const RasterStateT<T>& st, int tile, std::vector<TileGaussian<T>>& out) {
   const std::uint32_t b = st.tile_start[tile], e = st.tile_start[tile + 1];
+  // Per-thread and kept: the longest list so far plus half, so it stops growing.
+  if (e - b > out.capacity()) {
+    out.clear();
+    out.reserve((e - b) + (e - b) / 2);
+  }
   out.resize(e - b);
   for (std::uint32_t k = b; k < e; ++k) out[k - b] = st.tile_data[st.entry_gauss[k]];
 }
@@ -388,16 +393,16 @@ void forEachTileMet(const TileGaussian<T>& g, const std::array<int, 4>& rect, in
 
 // Projects every unmasked Gaussian, culls, fills its tile data, radius and visibility,
 // and counts the tiles its pixel rectangle touches.
+// `cover` is the caller's (kept between renders: rasterizeIntoT).
 template <typename T>
-TileCover projectAll(const GaussiansT<T>& g, const CameraT<T>& camT, std::span<const std::uint8_t> mask,
-                     int W, int H, RasterStateT<T>& st, RenderOutputT<T>& out) {
+void projectAll(const GaussiansT<T>& g, const CameraT<T>& camT, std::span<const std::uint8_t> mask, int W,
+                int H, RasterStateT<T>& st, RenderOutputT<T>& out, TileCover& cover) {
   const std::size_t n = g.size();
   const RasterSettings& rs = st.settings;
   out.radii.assign(n, T(0));
   out.visible.assign(n, 0);
   st.proj.resize(n);
   st.tile_data.resize(n);
-  TileCover cover;
   cover.count.assign(n, 0);
   cover.rect.resize(n);
   arena(st).execute([&] {
@@ -425,7 +430,6 @@ TileCover projectAll(const GaussiansT<T>& g, const CameraT<T>& camT, std::span<c
       }
     });
   });
-  return cover;
 }
 
 // Builds the per-tile lists: pair slots, Gaussian-major, then a stable counting sort by
@@ -441,7 +445,7 @@ void binAndSort(const TileCover& cover, int W, int H, RasterStateT<T>& st) {
   KeptBuffers<BinScratch> kept;
   BinScratch& sc = kept.get();
   std::vector<std::uint32_t>& slot_tile = sc.slot_tile;
-  slot_tile.assign(pairs, 0);
+  assignKept(slot_tile, pairs, 0u);
   arena(st).execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& r) {
       const FloatEnvGuard fenv;  // geometry/float_env.h
@@ -507,25 +511,56 @@ void compositeTiles(int W, int H, RasterStateT<T>& st, RenderOutputT<T>& out) {
 
 }  // namespace
 
+namespace {
+
+// The state a render keeps for its backward pass, taken from `held` when nothing else
+// shares it (its buffers are then refilled without allocating), otherwise new. `held`
+// is left empty either way.
+template <typename S>
+std::shared_ptr<S> reuseOrMake(std::shared_ptr<const S>& held) {
+  std::shared_ptr<const S> h = std::move(held);
+  if (h && h.use_count() == 1) return std::const_pointer_cast<S>(std::move(h));
+  return std::make_shared<S>();
+}
+
+// Settings, kernels and tile grid of a render (the first lines of every forward pass).
+template <typename T>
+void beginState(RasterStateT<T>& st, const RasterSettings& s, int max_sh_degree, int W, int H) {
+  st.settings = s;
+  st.isa = raster_execution::kernelIndex(s.execution.kernels);
+  st.settings.sh_degree = std::clamp(s.sh_degree, 0, max_sh_degree);
+  st.tiles_x = (W + kTileSize - 1) / kTileSize;
+  st.tiles_y = (H + kTileSize - 1) / kTileSize;
+}
+
+}  // namespace
+
+// The forward pass into `out`, whose buffers (and state, when unshared) are reused: every
+// array is refilled with assign/resize, so the result is the same as into an empty
+// output, and no allocation happens once `out` has held a render at least this large.
+template <typename T>
+void rasterizeIntoT(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& s,
+                    std::span<const std::uint8_t> mask, RenderOutputT<T>& out) {
+  const int W = cam.K.width, H = cam.K.height;
+  std::shared_ptr<RasterStateT<T>> st = reuseOrMake(out.state);
+  beginState(*st, s, g.max_sh_degree, W, H);
+  const CameraT<T> camT(cam, T(s.guard_band));
+
+  out.width = W;
+  out.height = H;
+  KeptBuffers<TileCover> kept_cover;
+  TileCover& cover = kept_cover.get();
+  projectAll(g, camT, mask, W, H, *st, out, cover);
+  binAndSort(cover, W, H, *st);
+  compositeTiles(W, H, *st, out);
+  out.state = std::move(st);
+}
+
 template <typename T>
 RenderOutputT<T> rasterizeT(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& s,
                             std::span<const std::uint8_t> mask) {
-  const int W = cam.K.width, H = cam.K.height;
-  auto st = std::make_shared<RasterStateT<T>>();
-  st->settings = s;
-  st->isa = raster_execution::kernelIndex(s.execution.kernels);
-  st->settings.sh_degree = std::clamp(s.sh_degree, 0, g.max_sh_degree);
-  st->tiles_x = (W + kTileSize - 1) / kTileSize;
-  st->tiles_y = (H + kTileSize - 1) / kTileSize;
-  const CameraT<T> camT(cam, T(s.guard_band));
-
   RenderOutputT<T> out;
-  out.width = W;
-  out.height = H;
-  const TileCover cover = projectAll(g, camT, mask, W, H, *st, out);
-  binAndSort(cover, W, H, *st);
-  compositeTiles(W, H, *st, out);
-  out.state = st;
+  rasterizeIntoT(g, cam, s, mask, out);
   return out;
 }
 
@@ -553,9 +588,9 @@ constexpr PairKernelSet kPairKernelSets[] = {
     {raster_kernels::avx2::compositeTilePair, raster_kernels::avx2::backwardTilePair},
 };
 
-// The public result of a float render (rasterize() and rasterizeWithSubset()).
-RenderResult toRenderResult(RenderOutputT<float>&& o) {
-  RenderResult r;
+// The public result of a float render (rasterize() and rasterizeWithSubset()), moved
+// into `r` (no copy, no allocation).
+void toRenderResult(RenderOutputT<float>&& o, RenderResult& r) {
   r.rgb.width = r.alpha.width = r.depth.width = o.width;
   r.rgb.height = r.alpha.height = r.depth.height = o.height;
   r.rgb.channels = 3;
@@ -567,7 +602,27 @@ RenderResult toRenderResult(RenderOutputT<float>&& o) {
   r.radii = std::move(o.radii);
   r.visible = std::move(o.visible);
   r.state = std::move(o.state);
+}
+RenderResult toRenderResult(RenderOutputT<float>&& o) {
+  RenderResult r;
+  toRenderResult(std::move(o), r);
   return r;
+}
+
+// The buffers of a public result handed back to the templated passes (moved, so `r`'s
+// vectors keep their capacity for the next render).
+RenderOutputT<float> fromRenderResult(RenderResult& r) {
+  RenderOutputT<float> o;
+  o.width = r.rgb.width;
+  o.height = r.rgb.height;
+  o.rgb = std::move(r.rgb.data);
+  o.alpha = std::move(r.alpha.data);
+  o.depth = std::move(r.depth.data);
+  o.contributors = std::move(r.contributors);
+  o.radii = std::move(r.radii);
+  o.visible = std::move(r.visible);
+  o.state = std::move(r.state);
+  return o;
 }
 
 void allocateImages(int W, int H, RenderOutputT<float>& out) {
@@ -581,24 +636,23 @@ void allocateImages(int W, int H, RenderOutputT<float>& out) {
 
 }  // namespace
 
-RenderPair rasterizeWithSubset(const Gaussians& g, const Camera& cam, const RasterSettings& s,
-                               std::span<const std::uint8_t> mask) {
+void rasterizeWithSubset(const Gaussians& g, const Camera& cam, const RasterSettings& s,
+                         std::span<const std::uint8_t> mask, RenderPair& into) {
   if (mask.size() != g.size())
     throw std::invalid_argument("rasterizeWithSubset: the mask needs one byte per Gaussian");
   const int W = cam.K.width, H = cam.K.height;
-  auto st = std::make_shared<RasterStateT<float>>();
-  st->settings = s;
-  st->isa = raster_execution::kernelIndex(s.execution.kernels);
-  st->settings.sh_degree = std::clamp(s.sh_degree, 0, g.max_sh_degree);
-  st->tiles_x = (W + kTileSize - 1) / kTileSize;
-  st->tiles_y = (H + kTileSize - 1) / kTileSize;
+  RenderOutputT<float> full = fromRenderResult(into.full), sub = fromRenderResult(into.subset);
+  sub.state.reset();
+  std::shared_ptr<RasterStateT<float>> st = reuseOrMake(full.state);
+  beginState(*st, s, g.max_sh_degree, W, H);
   const CameraT<float> camT(cam, s.guard_band);
 
-  RenderOutputT<float> full, sub;
-  const TileCover cover = projectAll(g, camT, {}, W, H, *st, full);
+  KeptBuffers<TileCover> kept_cover;
+  TileCover& cover = kept_cover.get();
+  projectAll(g, camT, {}, W, H, *st, full, cover);
   binAndSort(cover, W, H, *st);
 
-  auto ss = std::make_shared<SubsetRasterState>();
+  std::shared_ptr<SubsetRasterState> ss = reuseOrMake(into.subset_state);
   ss->mask.assign(mask.begin(), mask.end());
   ss->entry_in_subset.resize(st->entry_gauss.size());
   for (std::size_t e = 0; e < st->entry_gauss.size(); ++e)
@@ -637,11 +691,16 @@ RenderPair rasterizeWithSubset(const Gaussians& g, const Camera& cam, const Rast
     });
   });
 
-  full.state = st;
+  full.state = std::move(st);
+  toRenderResult(std::move(full), into.full);
+  toRenderResult(std::move(sub), into.subset);
+  into.subset_state = std::move(ss);
+}
+
+RenderPair rasterizeWithSubset(const Gaussians& g, const Camera& cam, const RasterSettings& s,
+                               std::span<const std::uint8_t> mask) {
   RenderPair out;
-  out.full = toRenderResult(std::move(full));
-  out.subset = toRenderResult(std::move(sub));
-  out.subset_state = std::move(ss);
+  rasterizeWithSubset(g, cam, s, mask, out);
   return out;
 }
 
@@ -671,7 +730,7 @@ void rasterizeBackwardWithSubset(const Gaussians& g, const Camera& cam, const Ra
   // page faults per 512x384 step, more than the loss itself costs).
   thread_local std::vector<float> scratch;
   const std::size_t branch_size = static_cast<std::size_t>(pairs) * kSlot;
-  scratch.assign(2 * branch_size, 0.0f);
+  assignKept(scratch, 2 * branch_size, 0.0f);
   float* const slots_full_p = scratch.data();
   float* const slots_sub_p = scratch.data() + branch_size;
   const float bg[3] = {rs.background[0], rs.background[1], rs.background[2]};
@@ -1127,6 +1186,13 @@ void rasterizeSquaredGradientsT(const GaussiansT<T>& g, const Camera& cam, const
 RenderResult rasterize(const Gaussians& g, const Camera& cam, const RasterSettings& s,
                        std::span<const std::uint8_t> mask) {
   return toRenderResult(rasterizeT(g, cam, s, mask));
+}
+
+void rasterize(const Gaussians& g, const Camera& cam, const RasterSettings& s, std::span<const std::uint8_t> mask,
+               RenderResult& into) {
+  RenderOutputT<float> o = fromRenderResult(into);
+  rasterizeIntoT(g, cam, s, mask, o);
+  toRenderResult(std::move(o), into);
 }
 
 namespace {

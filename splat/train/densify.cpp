@@ -81,8 +81,8 @@ void keepLargestGradients(std::vector<int>& clone, std::vector<int>& split, cons
   std::sort(split.begin(), split.end());
 }
 
-void accumulateDensifyStats(DensifyStats& st, const std::vector<float>& grad_mean2d, const std::vector<float>& radii,
-                            const std::vector<std::uint8_t>& visible, int width, int height) {
+void accumulateDensifyStats(DensifyStats& st, const std::vector<float>& grad_mean2d, std::span<const float> radii,
+                            std::span<const std::uint8_t> visible, int width, int height) {
   const float sx = 0.5f * static_cast<float>(width), sy = 0.5f * static_cast<float>(height);
   for (std::size_t i = 0; i < st.count.size(); ++i) {
     if (!visible[i] || !(radii[i] > 0)) continue;

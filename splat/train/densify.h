@@ -6,6 +6,7 @@
 // active loop can restart it.
 #include <cstdint>
 #include <random>
+#include <span>
 #include <vector>
 
 #include "splat/gaussians.h"
@@ -51,7 +52,7 @@ struct DensifyStats {
 // Adds one iteration's statistics. grad_mean2d is in pixels (2 per Gaussian); the NDC
 // gradient is that times (W/2, H/2), the unit 3DGS's threshold is given in.
 void accumulateDensifyStats(DensifyStats& st, const std::vector<float>& grad_mean2d,
-                            const std::vector<float>& radii, const std::vector<std::uint8_t>& visible, int width,
+                            std::span<const float> radii, std::span<const std::uint8_t> visible, int width,
                             int height);
 
 // Under the cap (opt.max_gaussians, the model holding n): keeps, of the clone and split

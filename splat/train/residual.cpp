@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <iterator>
 #include <stdexcept>
+
+#include "splat/kept_buffers.h"
 
 namespace saresgs {
 
@@ -32,15 +35,23 @@ std::size_t countOf(double fraction, std::size_t n) {
   return std::min(n, static_cast<std::size_t>(std::llround(f * static_cast<double>(n))));
 }
 
-// The k smallest by (key, index), ascending by index. The order is total, so the set is
-// unique: keys are computed once (not per comparison) and the k-th element is found by
-// selection rather than by a partial sort, which runs every residual training step.
+// The ranking's and the draw's scratch, kept per thread between steps.
+struct SubsetScratch {
+  std::vector<float> keys;
+  std::vector<int> a, b;
+  std::vector<std::uint8_t> chosen;
+};
+
+// The k smallest by (key, index), ascending by index, into `out`. The order is total, so
+// the set is unique: keys are computed once (not per comparison) and the k-th element is
+// found by selection rather than by a partial sort, which runs every residual training step.
 template <typename Key>
-std::vector<int> topBy(std::size_t n, double fraction, Key key) {
+void topBy(std::size_t n, double fraction, Key key, std::vector<float>& keys, std::vector<int>& out) {
   const std::size_t k = countOf(fraction, n);
-  std::vector<float> keys(n);
+  keys.resize(n);
   for (std::size_t i = 0; i < n; ++i) keys[i] = key(static_cast<int>(i));
-  std::vector<int> idx(n);
+  std::vector<int>& idx = out;
+  idx.resize(n);
   std::iota(idx.begin(), idx.end(), 0);
   auto less = [&](int a, int b) {
     const float ka = keys[static_cast<std::size_t>(a)], kb = keys[static_cast<std::size_t>(b)];
@@ -49,65 +60,85 @@ std::vector<int> topBy(std::size_t n, double fraction, Key key) {
   if (k < n) std::nth_element(idx.begin(), idx.begin() + static_cast<std::ptrdiff_t>(k), idx.end(), less);
   idx.resize(k);
   std::sort(idx.begin(), idx.end());
-  return idx;
 }
 
-// k distinct indices of [0, n) (partial Fisher-Yates), ascending. They are listed by
-// marking and scanning rather than by sorting (same set, same order, O(n)).
-std::vector<int> sampleWithoutReplacement(std::size_t n, std::size_t k, std::mt19937_64& rng) {
-  std::vector<int> idx(n);
+// k distinct indices of [0, n) (partial Fisher-Yates), ascending, into `out`. They are
+// listed by marking and scanning rather than by sorting (same set, same order, O(n)).
+void sampleWithoutReplacement(std::size_t n, std::size_t k, std::mt19937_64& rng, std::vector<std::uint8_t>& chosen,
+                              std::vector<int>& out) {
+  std::vector<int>& idx = out;
+  idx.resize(n);
   std::iota(idx.begin(), idx.end(), 0);
   for (std::size_t i = 0; i < k; ++i) {
     std::uniform_int_distribution<std::size_t> pick(i, n - 1);
     std::swap(idx[i], idx[pick(rng)]);
   }
-  std::vector<std::uint8_t> chosen(n, 0);
+  chosen.assign(n, 0);
   for (std::size_t i = 0; i < k; ++i) chosen[static_cast<std::size_t>(idx[i])] = 1;
   idx.clear();
   for (std::size_t i = 0; i < n; ++i)
     if (chosen[i]) idx.push_back(static_cast<int>(i));
-  return idx;
+}
+
+float opacityKey(const Gaussians& g, int i) {
+  // NaN keys would break the ordering; they rank as most uncertain.
+  const float o = g.opacities[static_cast<std::size_t>(i)];
+  return std::isnan(o) ? -INFINITY : o;
+}
+float scaleKey(const Gaussians& g, int i) {
+  const std::size_t j = 3 * static_cast<std::size_t>(i);
+  const float s = std::max({g.log_scales[j], g.log_scales[j + 1], g.log_scales[j + 2]});
+  return std::isnan(s) ? -INFINITY : -s;
 }
 
 }  // namespace
 
 std::vector<int> lowestOpacity(const Gaussians& g, double fraction) {
-  // NaN keys would break the ordering; they rank as most uncertain.
-  return topBy(g.size(), fraction, [&](int i) {
-    const float o = g.opacities[static_cast<std::size_t>(i)];
-    return std::isnan(o) ? -INFINITY : o;
-  });
+  std::vector<float> keys;
+  std::vector<int> out;
+  topBy(g.size(), fraction, [&](int i) { return opacityKey(g, i); }, keys, out);
+  return out;
 }
 
 std::vector<int> largestScale(const Gaussians& g, double fraction) {
-  return topBy(g.size(), fraction, [&](int i) {
-    const std::size_t j = 3 * static_cast<std::size_t>(i);
-    const float s = std::max({g.log_scales[j], g.log_scales[j + 1], g.log_scales[j + 2]});
-    return std::isnan(s) ? -INFINITY : -s;
-  });
+  std::vector<float> keys;
+  std::vector<int> out;
+  topBy(g.size(), fraction, [&](int i) { return scaleKey(g, i); }, keys, out);
+  return out;
 }
 
 ResidualSubset selectResidualSubset(const Gaussians& g, const ResidualOptions& opt, std::mt19937_64& rng) {
-  const std::size_t n = g.size();
   ResidualSubset out;
+  selectResidualSubset(g, opt, rng, out);
+  return out;
+}
+
+void selectResidualSubset(const Gaussians& g, const ResidualOptions& opt, std::mt19937_64& rng,
+                          ResidualSubset& out) {
+  const std::size_t n = g.size();
   out.mask.assign(n, 0);
-  if (n == 0) return out;
-  out.random = sampleWithoutReplacement(n, countOf(opt.alpha, n), rng);
+  out.random.clear();
+  out.uncertain.clear();
+  if (n == 0) return;
+  KeptBuffers<SubsetScratch> kept;
+  SubsetScratch& sc = kept.get();
+  auto opacity = [&](int i) { return opacityKey(g, i); };
+  auto scale = [&](int i) { return scaleKey(g, i); };
+  sampleWithoutReplacement(n, countOf(opt.alpha, n), rng, sc.chosen, out.random);
   switch (opt.ranking) {
-    case UncertaintyRanking::kBoth: {
-      const auto a = lowestOpacity(g, opt.beta), b = largestScale(g, opt.beta);
-      std::set_union(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(out.uncertain));
+    case UncertaintyRanking::kBoth:
+      topBy(n, opt.beta, opacity, sc.keys, sc.a);
+      topBy(n, opt.beta, scale, sc.keys, sc.b);
+      std::set_union(sc.a.begin(), sc.a.end(), sc.b.begin(), sc.b.end(), std::back_inserter(out.uncertain));
       break;
-    }
-    case UncertaintyRanking::kOpacity: out.uncertain = lowestOpacity(g, 2 * opt.beta); break;
-    case UncertaintyRanking::kScale: out.uncertain = largestScale(g, 2 * opt.beta); break;
+    case UncertaintyRanking::kOpacity: topBy(n, 2 * opt.beta, opacity, sc.keys, out.uncertain); break;
+    case UncertaintyRanking::kScale: topBy(n, 2 * opt.beta, scale, sc.keys, out.uncertain); break;
     case UncertaintyRanking::kRandom:
-      out.uncertain = sampleWithoutReplacement(n, countOf(2 * opt.beta, n), rng);
+      sampleWithoutReplacement(n, countOf(2 * opt.beta, n), rng, sc.chosen, out.uncertain);
       break;
   }
   for (int i : out.random) out.mask[static_cast<std::size_t>(i)] = 1;
   for (int i : out.uncertain) out.mask[static_cast<std::size_t>(i)] = 1;
-  return out;
 }
 
 }  // namespace saresgs

@@ -36,6 +36,10 @@ struct ResidualSubset {
 // round(alpha n) Gaussians drawn without replacement, plus the uncertain set. Ties in a
 // ranking break by index, so the subset depends only on the model and the generator.
 ResidualSubset selectResidualSubset(const Gaussians& g, const ResidualOptions& opt, std::mt19937_64& rng);
+// The same into `into`, whose arrays are reused (the ranking's scratch is kept per
+// thread): no allocation once the model's size has been seen.
+void selectResidualSubset(const Gaussians& g, const ResidualOptions& opt, std::mt19937_64& rng,
+                          ResidualSubset& into);
 
 // The top round(fraction n) Gaussians of one ranking: lowest opacity logit, or largest
 // maximum log-scale.

@@ -137,30 +137,31 @@ std::optional<std::pair<const char*, std::size_t>> firstNonFinite(const Gaussian
 
 ViewLoss viewLossAndGradient(const Gaussians& g, const Camera& cam, const RasterSettings& s, const ImageF& target,
                              double lambda_ssim, const ResidualOptions& res, std::mt19937_64& rng, Gaussians& grad,
-                             std::vector<float>& grad_mean2d, StageSeconds& seconds) {
+                             std::vector<float>& grad_mean2d, StageSeconds& seconds, StepBuffers& buffers) {
   ViewLoss out;
   // One branch: render (optionally a subset), loss, backward scaled by `weight`.
   auto branch = [&](std::span<const std::uint8_t> mask, double weight) {
     auto t0 = Clock::now();
-    RenderResult fwd = rasterize(g, cam, s, mask);
+    RenderResult& fwd = buffers.render;
+    rasterize(g, cam, s, mask, fwd);
     seconds.render += since(t0);
     t0 = Clock::now();
-    LossResult L = photometricLoss(fwd.rgb, target, lambda_ssim, true);
+    LossResult& L = buffers.loss;
+    photometricLoss(fwd.rgb, target, lambda_ssim, true, L);
     scaleImage(L.grad, static_cast<float>(weight));
     seconds.loss += since(t0);
     t0 = Clock::now();
     rasterizeBackward(g, cam, s, fwd, L.grad, grad, &grad_mean2d);
     seconds.backward += since(t0);
     out.loss += weight * L.loss;
-    if (out.radii.empty()) {
-      out.radii = std::move(fwd.radii);
-      out.visible = std::move(fwd.visible);
-    }
+    out.radii = fwd.radii;
+    out.visible = fwd.visible;
   };
   if (!res.enabled) {
     branch({}, 1.0);
   } else if (res.sub_only) {
-    const ResidualSubset sub = selectResidualSubset(g, res, rng);
+    ResidualSubset& sub = buffers.subset;
+    selectResidualSubset(g, res, rng, sub);
     branch(sub.mask, 1.0);
   } else {
     // Both branches from one projection, sort and tile walk, forward and backward
@@ -168,14 +169,18 @@ ViewLoss viewLossAndGradient(const Gaussians& g, const Camera& cam, const Raster
     // the subset branch, and the same gradients up to float rounding (the branches'
     // projected gradients are summed before the chain rule). Drawing the subset first
     // draws the same numbers, as the full branch uses no randomness.
-    const ResidualSubset sub = selectResidualSubset(g, res, rng);
+    ResidualSubset& sub = buffers.subset;
+    selectResidualSubset(g, res, rng, sub);
     auto t0 = Clock::now();
-    RenderPair fwd = rasterizeWithSubset(g, cam, s, sub.mask);
+    RenderPair& fwd = buffers.pair;
+    rasterizeWithSubset(g, cam, s, sub.mask, fwd);
     seconds.render += since(t0);
     t0 = Clock::now();
-    LossResult Lf = photometricLoss(fwd.full.rgb, target, lambda_ssim, true);
+    LossResult& Lf = buffers.loss;
+    photometricLoss(fwd.full.rgb, target, lambda_ssim, true, Lf);
     scaleImage(Lf.grad, static_cast<float>(res.lambda_full));
-    LossResult Ls = photometricLoss(fwd.subset.rgb, target, lambda_ssim, true);
+    LossResult& Ls = buffers.loss_subset;
+    photometricLoss(fwd.subset.rgb, target, lambda_ssim, true, Ls);
     scaleImage(Ls.grad, static_cast<float>(res.lambda_sub));
     seconds.loss += since(t0);
     t0 = Clock::now();
@@ -183,8 +188,8 @@ ViewLoss viewLossAndGradient(const Gaussians& g, const Camera& cam, const Raster
     seconds.backward += since(t0);
     out.loss += res.lambda_full * Lf.loss;
     out.loss += res.lambda_sub * Ls.loss;
-    out.radii = std::move(fwd.full.radii);
-    out.visible = std::move(fwd.full.visible);
+    out.radii = fwd.full.radii;
+    out.visible = fwd.full.visible;
   }
   return out;
 }
@@ -282,13 +287,14 @@ double Trainer::step(int view) {
   else grad_.forEachArray([](std::vector<float>& a, std::size_t) { std::fill(a.begin(), a.end(), 0.0f); });
   grad2d_.assign(2 * g_.size(), 0.0f);
 
-  const ViewLoss vl = viewLossAndGradient(g_, cam, s, gt, opt_.lambda_ssim, opt_.residual, rng_, grad_, grad2d_, seconds_);
+  const ViewLoss vl =
+      viewLossAndGradient(g_, cam, s, gt, opt_.lambda_ssim, opt_.residual, rng_, grad_, grad2d_, seconds_, step_buffers_);
   const double loss = vl.loss;
   if (!std::isfinite(loss))
     throw TrainingDiverged(iteration_, view, scene_.views.at(static_cast<std::size_t>(view)).name, "loss",
                            "is " + std::to_string(loss));
-  const std::vector<float>& radii = vl.radii;
-  const std::vector<std::uint8_t>& visible = vl.visible;
+  const std::span<const float> radii = vl.radii;
+  const std::span<const std::uint8_t> visible = vl.visible;
 
   auto t0 = Clock::now();
   const DensifyOptions& d = opt_.densify;

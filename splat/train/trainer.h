@@ -16,6 +16,7 @@
 #include <functional>
 #include <map>
 #include <random>
+#include <span>
 #include <string>
 #include <stdexcept>
 #include <string>
@@ -23,6 +24,7 @@
 
 #include "geometry/scene/scene.h"
 #include "splat/gaussians.h"
+#include "splat/loss.h"
 #include "splat/rasterize.h"
 #include "splat/train/adam.h"
 #include "splat/train/densify.h"
@@ -92,19 +94,31 @@ struct Evaluation {
 // point, or random_init_points when the scene has none, capped by densify.max_gaussians.
 std::size_t initialModelSize(const Scene& scene, const TrainerOptions& opt);
 
+// What one training step renders and differentiates, kept from step to step so that a
+// step allocates nothing once the model's and the images' sizes have been seen (the
+// Trainer keeps one; any caller of viewLossAndGradient keeps its own).
+struct StepBuffers {
+  RenderResult render;  // the plain (or sub-only) branch
+  RenderPair pair;      // residual supervision's two branches
+  LossResult loss, loss_subset;
+  ResidualSubset subset;  // residual supervision's G_sub
+};
+
 // The loss and its gradient for one view: the full render's loss, or with residual
 // supervision lambda_full L(full) + lambda_sub L(G_sub) (sub-only: L(G_sub)). Gradients
 // are added to `grad` and `grad_mean2d` (2 per Gaussian, pixels); the radii and
 // visibility of the full render (of the subset in sub-only mode) come back for
-// densification. Stage times are added to `seconds`.
+// densification, as views into `buffers` (valid until its next use). Stage times are
+// added to `seconds`.
 struct ViewLoss {
   double loss = 0;
-  std::vector<float> radii;
-  std::vector<std::uint8_t> visible;
+  std::span<const float> radii;
+  std::span<const std::uint8_t> visible;
 };
 ViewLoss viewLossAndGradient(const Gaussians& g, const Camera& cam, const RasterSettings& s, const ImageF& target,
                              double lambda_ssim, const ResidualOptions& residual, std::mt19937_64& rng,
-                             Gaussians& grad, std::vector<float>& grad_mean2d, StageSeconds& seconds);
+                             Gaussians& grad, std::vector<float>& grad_mean2d, StageSeconds& seconds,
+                             StepBuffers& buffers);
 
 // 3DGS's position learning rate at `iteration`: log-linear from lr.means * extent to
 // means_lr_final * extent over means_lr_steps iterations, then constant.
@@ -178,6 +192,7 @@ class Trainer {
   std::vector<int> view_set_, view_stack_;
   std::map<int, ImageF> targets_;  // float images of the views trained on
   StageSeconds seconds_;
+  StepBuffers step_buffers_;  // a step's renders and loss images, reused
 };
 
 }  // namespace saresgs
