@@ -148,7 +148,17 @@ int runActive(const ActiveArgs& a) {
               << (kmedian ? "k-median gain (kmedian-fisher)" : "distance to the nearest held view (fvs-fisher)") << "\n";
   }
   Progress progress;
+  // Resident memory at the start of every phase (per number of views held): an active run
+  // holds its buffers from phase to phase, so this should grow only with the model.
+  nlohmann::json phase_memory = nlohmann::json::array();
+  std::string last_phase;
+  const auto note_memory = [&](const std::string& phase, int views, std::size_t gaussians) {
+    if (phase == last_phase) return;
+    last_phase = phase;
+    phase_memory.push_back({{"phase", phase}, {"views", views}, {"gaussians", gaussians}, {"rss_bytes", currentRssBytes()}});
+  };
   const ActiveResult r = run.run([&](const ActiveProgress& p) {
+    note_memory(std::string(toString(p.phase)) + " " + std::to_string(p.views), p.views, p.gaussians);
     char detail[200];
     std::snprintf(detail, sizeof detail, "%s %d/%d  views %d/%d  loss %.4f  PSNR %.2f  Gaussians %zu", toString(p.phase),
                   p.phase_done, p.phase_total, p.views, p.max_views, p.loss, p.psnr, p.gaussians);
@@ -160,8 +170,13 @@ int runActive(const ActiveArgs& a) {
   writeRunFiles(run, r, scene, a.out);
   const RunReport report =
       makeRunReport(scene, opt, r, {a.dataset, a.preset, a.replay, t.gaussians().size(), rasterThreadCount(opt.trainer.raster.execution)});
-  writeFileAtomic(a.out + "/results.json", toJson(report).dump(2) + "\n");
+  note_memory("end", static_cast<int>(r.selected_views.size()), t.gaussians().size());
+  nlohmann::json results = toJson(report);
+  // Machine state, like the timings: not part of what a resumed run must reproduce.
+  results["memory"] = {{"peak_rss_bytes", peakRssBytes()}, {"rss_at_phase_start_this_process", phase_memory}};
+  writeFileAtomic(a.out + "/results.json", results.dump(2) + "\n");
   printSummary(report, a.out);
+  std::printf("peak resident memory %.0f MB (this process)\n", peakRssBytes() / (1024.0 * 1024.0));
   return 0;
 }
 

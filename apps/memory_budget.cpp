@@ -1,6 +1,7 @@
 #include "apps/memory_budget.h"
 
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -46,6 +47,13 @@ double memoryBudgetBytes(std::optional<double> budget_gb) {
   const double limit = readNumber("/sys/fs/cgroup/memory.max"), used = readNumber("/sys/fs/cgroup/memory.current");
   if (limit > 0 && used >= 0 && (available < 0 || limit - used < available)) available = limit - used;
   return available > 0 ? available : 1e18;  // unknown: no limit
+}
+
+double currentRssBytes() {
+  std::ifstream in("/proc/self/statm");
+  double size = 0, resident = 0;
+  if (!(in >> size >> resident)) return 0;
+  return resident * static_cast<double>(::sysconf(_SC_PAGESIZE));
 }
 
 double peakRssBytes() {

@@ -23,5 +23,7 @@ std::string applyMemoryBudget(const MemoryEstimate& e, double budget, bool budge
 
 // This process's peak resident memory so far (getrusage), in bytes.
 double peakRssBytes();
+// This process's resident memory now (/proc/self/statm), in bytes; 0 where unknown.
+double currentRssBytes();
 
 }  // namespace saresgs::apps

@@ -23,7 +23,7 @@ trap cleanup EXIT
 fail() { echo "FAIL: $*" >&2; exit 1; }
 compared=0 lost=0
 # Same content, timing and machine-state fields aside (JSON files: seconds, threads used,
-# peak RSS and the memory budget, which without --memory-budget is the memory free at the
+# resident memory (peak and per phase) and the memory budget, which without --memory-budget is the memory free at the
 # start), or same bytes.
 same() {
   compared=$((compared + 1))
@@ -35,7 +35,7 @@ if not a.endswith(".json"):
 def strip(x):
     if isinstance(x, dict):
         return {k: strip(v) for k, v in x.items()
-                if "second" not in k and k not in ("threads_used", "peak_rss_bytes", "budget_bytes")}
+                if "second" not in k and "rss" not in k and k not in ("threads_used", "budget_bytes")}
     if isinstance(x, list):
         return [strip(v) for v in x]
     return x

@@ -119,6 +119,24 @@ TEST(Cli, TrainCoverageAndActiveOnASmallScene) {
   for (const char* key : {"\"psnr\"", "\"ssim\"", "\"ause\"", "\"selected_views\"", "\"seconds\""})
     EXPECT_NE(ar.find(key), std::string::npos) << key;
   EXPECT_TRUE(fs::exists(d.path() / "a" / "cameras.png"));
+  // Resident memory: the peak, and at the start of every phase, views never decreasing.
+  {
+    const auto mem = nlohmann::json::parse(ar).at("memory");
+    EXPECT_GT(mem.at("peak_rss_bytes").get<double>(), 1e6);
+    const auto& phases = mem.at("rss_at_phase_start_this_process");
+    ASSERT_GE(phases.size(), 3u) << mem.dump();  // training phases, the final evaluation, the end
+    int views = 0;
+    for (const auto& p : phases) {
+      EXPECT_GE(p.at("views").get<int>(), views) << mem.dump();
+      views = p.at("views").get<int>();
+      EXPECT_GT(p.at("rss_bytes").get<double>(), 1e6) << mem.dump();
+      // The same unit as the peak (statm and getrusage count a little apart).
+      EXPECT_LE(p.at("rss_bytes").get<double>(), 1.05 * mem.at("peak_rss_bytes").get<double>()) << mem.dump();
+    }
+    EXPECT_EQ(phases.back().at("phase"), "end");
+    EXPECT_EQ(views, 5);
+  }
+  EXPECT_NE(r.output.find("peak resident memory"), std::string::npos) << r.output;
   // Running again into the same folder without --resume is refused (nothing overwritten).
   r = run("active --dataset " + d.file("s") + " --method fvs --max-views 5 --interval 4 --min-iterations 40 --final-iterations 0 --out " +
           d.file("a"));
