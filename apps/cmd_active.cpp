@@ -30,7 +30,7 @@ namespace fs = std::filesystem;
 struct ActiveArgs {
   std::string dataset, out, method = "hybrid", preset = "quick", fvs_metric = "euclidean", ranking, replay;
   int downscale = 1, threads = 0;
-  bool resume = false, continue_training = false, sub_only = false, time_exhaustive_fisher = false;
+  bool resume = false, continue_training = false, sub_only = false, time_exhaustive_fisher = false, no_plain_refit = false;
   std::uint64_t seed = 0;
   double fisher_lambda = 1e-6;
   std::optional<int> max_views, interval, total, final_iterations, renamed_iterations;
@@ -54,6 +54,7 @@ ActiveOptions activeOptions(const ActiveArgs& a) {
   o.fisher_lambda = a.fisher_lambda;
   o.reset_after_add = !a.continue_training;
   o.time_exhaustive_fisher = a.time_exhaustive_fisher;
+  o.plain_refit = !a.no_plain_refit;
   o.fvs_metric = a.fvs_metric == "great-circle" ? ViewDistance::kGreatCircle : ViewDistance::kEuclidean;
   if (a.max_views) o.max_views = *a.max_views;
   if (a.interval) o.interval = *a.interval;
@@ -99,7 +100,7 @@ void printSummary(const RunReport& r, const std::string& out) {
       std::printf("%-44s %8.2f %8.4f\n", label, r.final_fit_views->psnr, r.final_fit_views->ssim);
     }
   }
-  const bool plain_file = r.final_fit && r.final_fit->residual;
+  const bool plain_file = r.final_fit && r.final_fit->residual && r.final_fit_views;
   std::printf("wrote %s/results.json, cameras.png, test_renders/, point_cloud.ply%s%s\n", out.c_str(),
               r.final_fit ? ", final_fit.ply" : "", plain_file ? ", final_fit_views.ply" : "");
 }
@@ -129,7 +130,8 @@ int runActive(const ActiveArgs& a) {
                              scene.train.begin() + std::min<std::ptrdiff_t>(static_cast<std::ptrdiff_t>(scene.train.size()),
                                                                             std::max(opt.max_views, 1)));
     const std::size_t initial = initialModelSize(scene, opt.trainer);
-    const int models = 1 + (opt.final_iterations > 0 ? (needsOf(opt.method).residual ? 2 : 1) : 0);
+    const int models =
+        1 + (opt.final_iterations > 0 ? (needsOf(opt.method).residual && opt.plain_refit ? 2 : 1) : 0);
     std::size_t cap = opt.trainer.densify.max_gaussians;
     std::cerr << applyMemoryBudget(estimateTrainingMemory(scene, trained, scene.test.empty() ? scene.train : scene.test,
                                                           initial, opt.trainer.max_sh_degree, models),
@@ -202,6 +204,9 @@ CLI::App* addActiveOptions(CLI::App& app, const std::shared_ptr<ActiveArgs>& a) 
   sub->add_option("--final-iterations", a->final_iterations,
                   "Final fit: a fresh model trained on the chosen views for N iterations (0: none; preset's by default)")
       ->check(wholeNumberAtLeast(0));
+  sub->add_flag("--no-plain-refit", a->no_plain_refit,
+                "Methods with their own training (sa-resgs, resgs): leave out the plain 3DGS refit of the chosen "
+                "views that judges selection apart from training (as long as the final fit itself)");
   sub->add_option("--memory-budget", a->memory_budget_gb,
                   "GB this run may use: refused before it starts if its images and initial models do not fit, the "
                   "models capped to fit (default: refused only beyond what the machine has available)")

@@ -370,11 +370,11 @@ ActiveResult ActiveRun::finish() {
     auto [model, f] = fit(true, ActivePhase::kFinalFit);
     final_fit_ = std::move(model);
     r.final_fit = f;
-    if (f.residual) {
+    if (f.residual && opt_.plain_refit) {
       auto [plain, g] = fit(false, ActivePhase::kFinalFitViews);
       final_fit_views_ = std::move(plain);
       r.final_fit_views = g;
-    } else {
+    } else if (!f.residual) {
       r.final_fit_views = f;
     }
   }

@@ -87,6 +87,10 @@ struct ActiveOptions {
   // second, plain 3DGS fit of the same views (ActiveResult::final_fit_views) judges the
   // selection apart from the training.
   int final_iterations = 0;
+  // The plain refit above, for methods whose own training is not plain 3DGS. A verdict
+  // needs it; a user who wants the reconstruction only may leave it out (it is as long
+  // as the final fit itself).
+  bool plain_refit = true;
   // Its trainer options: 3DGS's own schedule (a fit of a few thousand iterations on 20
   // views is 3DGS's first iterations, not a quarter-speed loop phase), with the preset's
   // model cap and SH degree; residual supervision and the seed are set by finalFitOptions.

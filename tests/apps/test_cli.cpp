@@ -213,6 +213,18 @@ TEST(Cli, FinalFitEqualsTrainOnTheChosenViews) {
   EXPECT_EQ(f["final_fit"]["residual"], false);
   EXPECT_EQ(f["final_fit_views"], f["final_fit"]);
   EXPECT_FALSE(std::filesystem::exists(d.file("f/final_fit_views.ply")));
+  // --no-plain-refit leaves the plain refit out (results.json, the table, the .ply) and
+  // changes nothing else: the same views and the same final fit.
+  r = run("active --dataset " + d.file("s") + " --method sa-resgs --max-views 5 --interval 4 --min-iterations 40 " +
+          "--final-iterations 150 --seed 3 --threads 2 --no-plain-refit --out " + d.file("n"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(r.output.find("plain refit"), std::string::npos) << r.output;
+  const nlohmann::json n = nlohmann::json::parse(saresgs::test::readBytes(d.file("n/results.json")));
+  EXPECT_FALSE(n.contains("final_fit_views")) << n.dump();
+  EXPECT_EQ(n["selected_views"], a["selected_views"]);
+  EXPECT_EQ(n["final_fit"], a["final_fit"]);
+  EXPECT_EQ(saresgs::test::readBytes(d.file("n/final_fit.ply")), saresgs::test::readBytes(d.file("a/final_fit.ply")));
+  EXPECT_FALSE(std::filesystem::exists(d.file("n/final_fit_views.ply")));
   // A view listed twice, or not a train view, is refused by name.
   r = run("train --dataset " + d.file("s") + " --views 0,0 --iterations 5 --out " + d.file("t2"));
   EXPECT_NE(r.code, 0);
