@@ -36,6 +36,7 @@
 #include <vector>
 
 #include "geometry/image/image.h"
+#include "nbv/eval/paired_stats.h"
 #include "nbv/eval/prefilter_sweep.h"
 #include "nbv/run_report.h"
 
@@ -138,6 +139,18 @@ Table sweepTable(const std::vector<JobResult>& results);
 // columns scene, method, baseline, metric, mean_diff, ci_low, ci_high, n, win_rate; an
 // interval over a single seed is "undefined".
 Table pairedTable(const AblationGrid& g, const std::vector<JobResult>& results);
+// The question a selector has to answer: on each scene, its final-fit PSNR against the
+// better of fisher and fvs there (fisher when fisher - fvs, paired over their common
+// seeds, is >= 0 on average), paired by seed. Empty unless the grid has both baselines.
+struct BetterBaselineDifference {
+  std::string scene, baseline, method;  // method: runLabel (variants are their own rows)
+  PairedDifference d;
+};
+std::vector<BetterBaselineDifference> againstBetterBaseline(const AblationGrid& g,
+                                                            const std::vector<JobResult>& results);
+// Its table: scene, baseline, method, mean_diff, ci_low, ci_high, n, verdict (above or
+// below the baseline, "interval clear of 0" when it is).
+Table betterBaselineTable(const AblationGrid& g, const std::vector<JobResult>& results);
 
 struct NamedPlot {
   std::string name;  // file stem

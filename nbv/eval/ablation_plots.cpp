@@ -57,6 +57,37 @@ void addPerViewPlot(const AblationGrid& g, const std::vector<JobResult>& results
   if (!panels.empty()) plots.push_back({"final_fit_per_view", drawPlot(panels, 720, 420)});
 }
 
+// againstBetterBaseline as a picture: per scene, each method's mean paired difference
+// with its 95 % t interval (no bar for one seed; the seeds beside each point) and a line at
+// zero. A method above the line with its bar clear of it beats both simple selectors there.
+void addBetterBaselinePlot(const AblationGrid& g, const std::vector<JobResult>& results,
+                           std::vector<NamedPlot>& plots) {
+  const std::vector<BetterBaselineDifference> rows = againstBetterBaseline(g, results);
+  std::vector<PlotPanel> panels;
+  for (const AblationScene& sc : g.scenes) {
+    std::vector<std::string> labels;
+    std::string baseline;
+    PlotSeries diff{"mean, 95% t interval; seeds beside", {}, {}, {}, {}, false};
+    for (const BetterBaselineDifference& r : rows) {
+      if (r.scene != sc.name) continue;
+      baseline = r.baseline;
+      diff.x.push_back(static_cast<double>(labels.size()));
+      diff.y.push_back(r.d.mean);
+      diff.err.push_back(r.d.ci_low ? 0.5 * (*r.d.ci_high - *r.d.ci_low) : std::nan(""));
+      diff.point_labels.push_back(std::to_string(r.d.n));
+      labels.push_back(r.method);
+    }
+    if (labels.empty()) continue;
+    PlotPanel p{sc.name + ": final-fit PSNR minus " + baseline + "'s (the better baseline)", "method", "dB", false,
+                labels, {}};
+    // The zero line first, so that the points are drawn over it.
+    p.series.push_back({"0", {0.0, static_cast<double>(labels.size() - 1)}, {0.0, 0.0}, {}, {}, true});
+    p.series.push_back(diff);
+    panels.push_back(p);
+  }
+  if (!panels.empty()) plots.push_back({"final_fit_vs_better_baseline", drawPlot(panels)});
+}
+
 // In-loop PSNR per method, final-fit PSNR per method, PSNR against views (bands over
 // seeds) and PSNR against selection time: one panel per scene in each.
 void addActivePlots(const AblationGrid& g, const std::vector<JobResult>& results, std::vector<NamedPlot>& plots) {
@@ -112,6 +143,7 @@ void addActivePlots(const AblationGrid& g, const std::vector<JobResult>& results
   plots.push_back({"psnr", drawPlot(psnr)});
   addPerViewPlot(g, results, plots);
   if (!final_fit.empty()) plots.push_back({"final_fit_psnr", drawPlot(final_fit)});
+  addBetterBaselinePlot(g, results, plots);
   plots.push_back({"psnr_vs_views", drawPlot(views)});
   plots.push_back({"psnr_vs_selection_time", drawPlot(time)});
 }

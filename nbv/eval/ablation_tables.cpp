@@ -386,6 +386,58 @@ Table pairedTable(const AblationGrid& g, const std::vector<JobResult>& results) 
   return t;
 }
 
+std::vector<BetterBaselineDifference> againstBetterBaseline(const AblationGrid& g,
+                                                            const std::vector<JobResult>& results) {
+  std::vector<BetterBaselineDifference> out;
+  auto has = [&](const char* m) { return std::find(g.methods.begin(), g.methods.end(), m) != g.methods.end(); };
+  if (!has("fisher") || !has("fvs")) return out;
+  // Final-fit PSNR of (scene, method label) per seed.
+  std::map<std::pair<std::string, std::string>, std::map<std::uint64_t, double>> fit;
+  for (const JobResult& r : results)
+    if (isActive(r))
+      if (const auto p = finalPsnrOf(r.run)) fit[{r.job.scene, runLabel(r.job.method, r.job.variant)}][r.job.seed] = *p;
+  auto paired = [&](const std::string& scene, const std::string& a, const std::string& b) {
+    std::vector<double> x, y;
+    const auto& fa = fit[{scene, a}];
+    const auto& fb = fit[{scene, b}];
+    for (const auto& [seed, v] : fa)
+      if (const auto it = fb.find(seed); it != fb.end()) {
+        x.push_back(v);
+        y.push_back(it->second);
+      }
+    return x.empty() ? std::optional<PairedDifference>() : std::optional<PairedDifference>(pairedDifference(x, y));
+  };
+  for (const AblationScene& sc : g.scenes) {
+    const auto baselines = paired(sc.name, "fisher", "fvs");
+    if (!baselines) continue;
+    const std::string better = baselines->mean >= 0 ? "fisher" : "fvs";
+    forEachCombo(g, [&](const std::string& scene, const std::string& m, const std::string& v) {
+      const std::string label = runLabel(m, v);
+      if (scene != sc.name || label == better) return;
+      if (const auto d = paired(scene, label, better)) out.push_back({scene, better, label, *d});
+    });
+  }
+  return out;
+}
+
+Table betterBaselineTable(const AblationGrid& g, const std::vector<JobResult>& results) {
+  Table t{"vs_better_baseline",
+          "Final-fit PSNR against the better of fisher and fvs on each scene (the one ahead when the two are paired "
+          "over their common seeds), paired by seed: mean difference, 95 % Student-t interval (undefined for one "
+          "seed), seeds. A selector that beats both simple ones is above on every scene",
+          {"scene", "baseline", "method", "mean_diff", "ci_low", "ci_high", "n", "verdict"},
+          {}};
+  for (const BetterBaselineDifference& r : againstBetterBaseline(g, results)) {
+    auto opt = [](const std::optional<double>& x) { return x ? fmt(*x, 3) : std::string("undefined"); };
+    const bool clear = r.d.ci_low && (*r.d.ci_low > 0 || *r.d.ci_high < 0);
+    const std::string verdict =
+        std::string(r.d.mean >= 0 ? "at or above" : "below") + (clear ? ", interval clear of 0" : "");
+    t.rows.push_back({r.scene, r.baseline, r.method, fmt(r.d.mean, 3), opt(r.d.ci_low), opt(r.d.ci_high),
+                      std::to_string(r.d.n), verdict});
+  }
+  return t;
+}
+
 std::vector<Table> ablationTables(const AblationGrid& g, const std::vector<JobResult>& results) {
   std::vector<Table> tables{resultsTable(g, results)};
   for (const AblationTableSpec& spec : g.tables) tables.push_back(namedTable(g, spec, results));
@@ -394,6 +446,7 @@ std::vector<Table> ablationTables(const AblationGrid& g, const std::vector<JobRe
   if (Table t = timeTable(g, results); !t.rows.empty()) tables.push_back(std::move(t));
   if (Table t = sweepTable(results); !t.rows.empty()) tables.push_back(std::move(t));
   if (Table t = pairedTable(g, results); !t.rows.empty()) tables.push_back(std::move(t));
+  if (Table t = betterBaselineTable(g, results); !t.rows.empty()) tables.push_back(std::move(t));
   if (Table t = finalFitPerViewTable(g, results); !t.rows.empty()) tables.push_back(std::move(t));
   return tables;
 }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <map>
 #include <set>
 
 #include "common/test_support.h"
@@ -265,6 +266,73 @@ TEST(Ablation, FinalFitPerViewTableAveragesEachTestViewOverSeeds) {
   EXPECT_EQ(t.rows[1], (std::vector<std::string>{"a", "sa-resgs", "1", "25.00", "26.50"}));
   const std::vector<NamedPlot> plots = ablationPlots(g, results);
   EXPECT_TRUE(std::any_of(plots.begin(), plots.end(), [](const NamedPlot& p) { return p.name == "final_fit_per_view"; }));
+}
+
+// Against the better baseline: fisher ahead of fvs on scene a, fvs ahead on scene b; each
+// other method paired with that one by seed (hand-computed means and t intervals).
+TEST(Ablation, BetterBaselineIsChosenPerSceneAndPairedBySeed) {
+  TempDir d;
+  writeBytes(d.file("g.json"), R"({
+    "preset": "quick",
+    "scenes": [{"name": "a", "dataset": "data/a"}, {"name": "b", "dataset": "data/b"}],
+    "methods": ["fvs", "fisher", "adaptive"],
+    "seeds": [0, 1, 2]
+  })");
+  const AblationGrid g = readAblationGrid(d.file("g.json"));
+  // Final-fit PSNR per (scene, method) and seed; adaptive on b has no seed 2.
+  const std::map<std::pair<std::string, std::string>, std::vector<double>> psnr = {
+      {{"a", "fisher"}, {30.0, 31.0, 32.0}},   {{"a", "fvs"}, {29.0, 30.5, 31.0}},
+      {{"a", "adaptive"}, {30.5, 31.2, 32.9}}, {{"b", "fisher"}, {20.0, 20.0, 20.0}},
+      {{"b", "fvs"}, {21.0, 20.5, 21.5}},      {{"b", "adaptive"}, {22.0, 21.5}}};
+  std::vector<JobResult> results;
+  for (const AblationJob& j : expandGrid(g)) {
+    const std::vector<double>& v = psnr.at({j.scene, j.method});
+    if (j.seed >= v.size()) continue;
+    RunReport r;
+    FinalFitReport f;
+    f.psnr = v[j.seed];
+    r.final_fit = f;
+    results.push_back({j, r, {}});
+  }
+  const std::vector<BetterBaselineDifference> rows = againstBetterBaseline(g, results);
+  ASSERT_EQ(rows.size(), 4u);
+  auto row = [&](const std::string& scene, const std::string& method) {
+    for (const auto& r : rows)
+      if (r.scene == scene && r.method == method) return r;
+    ADD_FAILURE() << "no row " << scene << " " << method;
+    return BetterBaselineDifference{};
+  };
+  // a: fisher - fvs = 1, 0.5, 1, so fisher; adaptive - fisher = 0.5, 0.2, 0.9: mean 0.5333,
+  // sd 0.35119, t(2) 4.3027, half width 0.8724.
+  const auto aa = row("a", "adaptive");
+  EXPECT_EQ(aa.baseline, "fisher");
+  EXPECT_EQ(aa.d.n, 3);
+  EXPECT_NEAR(aa.d.mean, 0.53333, 1e-4);
+  ASSERT_TRUE(aa.d.ci_low && aa.d.ci_high);
+  EXPECT_NEAR(*aa.d.ci_low, 0.53333 - 0.8724, 1e-3);
+  EXPECT_NEAR(*aa.d.ci_high, 0.53333 + 0.8724, 1e-3);
+  EXPECT_NEAR(row("a", "fvs").d.mean, -0.83333, 1e-4);
+  // b: fisher - fvs = -1, -0.5, -1.5, so fvs; adaptive - fvs over seeds 0 and 1 only.
+  const auto ba = row("b", "adaptive");
+  EXPECT_EQ(ba.baseline, "fvs");
+  EXPECT_EQ(ba.d.n, 2);
+  EXPECT_NEAR(ba.d.mean, 1.0, 1e-9);
+  EXPECT_NEAR(row("b", "fisher").d.mean, -1.0, 1e-9);
+  // The table says which side of the baseline each method is, and whether its interval
+  // excludes 0 (b's fisher: -1, -0.5, -1.5, sd 0.5, half width 1.242: it does not).
+  const Table t = betterBaselineTable(g, results);
+  ASSERT_EQ(t.rows.size(), 4u);
+  for (const auto& r : t.rows) {
+    if (r[0] == "b" && r[2] == "adaptive") EXPECT_EQ(r[7], "at or above, interval clear of 0");
+    if (r[0] == "b" && r[2] == "fisher") EXPECT_EQ(r[7], "below");
+  }
+  const std::vector<NamedPlot> plots = ablationPlots(g, results);
+  EXPECT_TRUE(std::any_of(plots.begin(), plots.end(),
+                          [](const NamedPlot& p) { return p.name == "final_fit_vs_better_baseline" && p.image.width > 100; }));
+  // Without fvs in the grid there is no such comparison.
+  writeBytes(d.file("g2.json"), R"({"preset": "quick", "scenes": [{"name": "a", "dataset": "data/a"}],
+                                     "methods": ["fisher", "adaptive"], "seeds": [0]})");
+  EXPECT_TRUE(againstBetterBaseline(readAblationGrid(d.file("g2.json")), results).empty());
 }
 
 TEST(Ablation, PrefilterSweepReferenceIsExactAndACollisionFreeHashMatchesIt) {
