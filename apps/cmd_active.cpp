@@ -28,7 +28,7 @@ namespace fs = std::filesystem;
 
 // Options as typed; the preset's values apply where an override is not given.
 struct ActiveArgs {
-  std::string dataset, out, method = "hybrid", preset = "quick", fvs_metric = "euclidean", ranking, replay;
+  std::string dataset, out, method = "adaptive", preset = "quick", fvs_metric = "euclidean", ranking, replay;
   int downscale = 1, threads = 0;
   bool resume = false, continue_training = false, sub_only = false, time_exhaustive_fisher = false, no_plain_refit = false;
   std::uint64_t seed = 0;

@@ -298,7 +298,7 @@ void bindNbv(py::module_& m) {
              r->run = std::make_unique<ActiveRun>(*dataset, o, checkpoint);
              return r;
            }),
-           py::arg("dataset"), py::arg("method") = "hybrid", py::arg("selector") = py::none(), py::arg("seed") = 0,
+           py::arg("dataset"), py::arg("method") = "adaptive", py::arg("selector") = py::none(), py::arg("seed") = 0,
            py::arg("preset") = "quick", py::arg("threads") = 0, py::arg("max_views") = py::none(),
            py::arg("interval") = py::none(), py::arg("min_iterations") = py::none(), py::arg("final_iterations") = py::none(),
            py::arg("max_gaussians") = py::none(), py::arg("prefilter_scene") = "auto", py::arg("checkpoint") = "",
