@@ -134,8 +134,9 @@ fi
 t_par=$((SECONDS - t_par))
 nice -n 5 "$bin" ablate merge --config "$grid" --out "$out_par"
 
-# 5. Same tables (tables/*.csv) and same results.json per job. Wall-clock seconds differ
-# from run to run: the `seconds` objects of results.json are left out, and of time.csv
+# 5. Same tables (tables/*.csv) and same results.json per job. Wall-clock seconds and
+# resident memory differ from run to run: the `seconds` and `memory` objects of
+# results.json are left out, and of time.csv
 # (every column but method and runs is a time or a ratio of times) only those two columns
 # are compared. Everything else must match exactly, floats included.
 if ! python3 - "$out_slurm" "$out_par" <<'EOF'
@@ -170,7 +171,7 @@ for name in sorted(set(ta) & set(tb)):
 
 def strip(o):
     if isinstance(o, dict):
-        return {k: strip(v) for k, v in o.items() if k != "seconds"}
+        return {k: strip(v) for k, v in o.items() if k not in ("seconds", "memory")}
     if isinstance(o, list):
         return [strip(v) for v in o]
     return o
