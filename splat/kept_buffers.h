@@ -7,15 +7,22 @@
 
 namespace saresgs {
 
-// v.assign(n, x) for a kept buffer: when it must grow it takes half as much again, so a
-// size that creeps up from call to call (the tile pairs of a model in training) does not
-// reallocate at every call, as assign's exact growth would.
-template <class Vec, class X>
-void assignKept(Vec& v, std::size_t n, const X& x) {
+// Room for n in a kept buffer: when it must grow it takes half as much again (its old
+// contents dropped), so a size that creeps up from call to call (the tile pairs of a
+// model in training) does not reallocate at every call, as assign's exact growth, or
+// resize's after a shrink, would.
+template <class Vec>
+void reserveKept(Vec& v, std::size_t n) {
   if (n > v.capacity()) {
     v.clear();
     v.reserve(n + n / 2);
   }
+}
+
+// v.assign(n, x) for a kept buffer (reserveKept's growth).
+template <class Vec, class X>
+void assignKept(Vec& v, std::size_t n, const X& x) {
+  reserveKept(v, n);
   v.assign(n, x);
 }
 

@@ -151,11 +151,7 @@ bool tileMeets(const TileGaussian<T>& g, int x0, int y0, int x1, int y1) {
 template <typename T>
 void gatherTile(const RasterStateT<T>& st, int tile, std::vector<TileGaussian<T>>& out) {
   const std::uint32_t b = st.tile_start[tile], e = st.tile_start[tile + 1];
-  // Per-thread and kept: the longest list so far plus half, so it stops growing.
-  if (e - b > out.capacity()) {
-    out.clear();
-    out.reserve((e - b) + (e - b) / 2);
-  }
+  reserveKept(out, e - b);  // per thread and kept (splat/kept_buffers.h)
   out.resize(e - b);
   for (std::uint32_t k = b; k < e; ++k) out[k - b] = st.tile_data[st.entry_gauss[k]];
 }
