@@ -127,7 +127,8 @@ w("*pairs/px* contributing Gaussians per pixel; *expected x* / *measured x* the 
 w("reference row's; *render ns/pair·core* the forward pass's time times its threads over the")
 w("contributing pairs; *floor* the forward arithmetic alone on one core with no memory traffic")
 w("(`rasterForwardFloorNsPerPair`); *fraction of floor* floor / render (1 would be the floor).")
-w("The raw lines: results/perf/table.jsonl.")
+w("The raw lines: results/perf/table.jsonl. Kernel changes tried and not kept, with their numbers:")
+w("docs/PERFORMANCE_TRIED.md.")
 open("docs/PERFORMANCE.md.tmp", "w").write("\n".join(out) + "\n")
 EOF
 mv docs/PERFORMANCE.md.tmp docs/PERFORMANCE.md
