@@ -9,7 +9,8 @@ training: the cameras come from the datasets (through the saresgs Python module)
 
   PYTHONPATH=build/python python3 scripts/nearest_view_analysis.py results/verdict2 GRID.json
 
-Writes OUT/tables/nearest_view.md and prints it. Per scene it also compares fvs's held views
+Writes OUT/tables/nearest_view.md and prints it. Per scene it also measures how much of a
+spread selection's result is its phase against the test views (phaseComparison), and compares fvs's held views
 (seed 0) with greedy k-median on camera positions from the same initial views (the views that
 minimise the mean distance of every train view to its nearest held one): its objective on the
 train views and the test views' mean distance, for each. The test views are used here to
@@ -50,6 +51,50 @@ def kmedianComparison(out, scene, ds, centres):
             f"| greedy k-median on positions | {mean_nearest(train, kmed):.3f} | {mean_nearest(test, kmed):.3f} |"]
 
 
+def phaseComparison(out, scene, ds, centres, fit):
+    """How much of a spread selection's score is its phase against the test views.
+
+    Each held view of the run is moved k places along the capture path's train views (the
+    same spacing, another phase; the path closes on itself when its ends are as near as two
+    neighbouring views, else the moved views stop at its ends), and the test views' mean
+    distance to the moved set is taken for k = -4..4. With the scene's fit of final-fit PSNR
+    on that distance over all its runs, the spread of those distances is the spread of
+    final-fit PSNR that phase alone would give. No training, no selector sees the test views.
+    """
+    train, test = np.array(ds.train), np.array(ds.test)
+    steps = np.linalg.norm(np.diff(centres[train], axis=0), axis=1)
+    closed = np.linalg.norm(centres[train[0]] - centres[train[-1]]) <= 2.0 * np.median(steps)
+    pos = {int(v): i for i, v in enumerate(train)}
+    lines = []
+    for method in ("fvs", "adaptive"):
+        files = sorted(glob.glob(f"{out}/runs/{scene}__{method}__default__s*/results.json"))
+        rows = []
+        for f in files:
+            r = json.load(open(f))
+            held = [pos[v] for v in r["selected_view_indices"] if v in pos]
+            dists = []
+            for k in range(-4, 5):
+                moved = [(h + k) % len(train) if closed else min(max(h + k, 0), len(train) - 1) for h in held]
+                sel = train[moved]
+                dists.append(np.linalg.norm(centres[test][:, None] - centres[sel][None], axis=2).min(1).mean())
+            rows.append(dists)
+            if method == "fvs":
+                break  # fvs holds the same views in every seed
+        if not rows:
+            continue
+        d = np.array(rows)
+        actual, shifted = d[:, 4].mean(), d.mean()
+        rank = float((d < d[:, 4:5]).sum(axis=1).mean())
+        lines.append(f"| {method} ({len(rows)} run{'s' if len(rows) > 1 else ''}) | {actual:.3f} | {shifted:.3f} | "
+                     f"{d.min(axis=1).mean():.3f} - {d.max(axis=1).mean():.3f} | {rank:.1f} of 8 | "
+                     f"{fit[0] * (actual - shifted):+.2f} |")
+    if not lines:
+        return []
+    return ["", f"Phase ({'closed' if closed else 'open'} path): the held views moved k = -4..4 train views along it.",
+            "", "| held views | test distance, as held | mean over k | range over k | shifts nearer than as held | "
+            "PSNR from phase (fit) |", "|---|---:|---:|---:|---:|---:|"] + lines
+
+
 def main():
     out, grid = sys.argv[1], sys.argv[2]
     datasets = {s["name"]: s["dataset"] for s in json.load(open(grid))["scenes"]}
@@ -80,6 +125,9 @@ def main():
             c = np.corrcoef(a.T)
             lines += ["", f"r(PSNR, distance) = {c[0, 1]:+.2f}, r(PSNR, angle) = {c[0, 2]:+.2f} over {len(rows)} runs"]
         lines += kmedianComparison(out, scene, ds, centres)
+        if len(rows) > 2:
+            fit = np.polyfit(a[:, 1], a[:, 0], 1)  # PSNR = fit[0] distance + fit[1]
+            lines += phaseComparison(out, scene, ds, centres, fit)
         lines.append("")
     text = "\n".join(lines)
     os.makedirs(f"{out}/tables", exist_ok=True)

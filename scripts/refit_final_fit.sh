@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# Rebuild the final-fit model (final_fit.ply) of finished active runs whose folder lacks it
+# (the models are not committed: results/ keeps each run's results.json and cameras.png).
+# For each RUN folder: `saresgs train` on exactly the run's views (initial, then selected)
+# with the final fit's options (the quick preset's: its iterations, the run's Gaussian cap,
+# SH degree 0, the run's seed, one thread), kept only when its test PSNR is the run's final fit's. A run made
+# by the binary of 864af66 or later refits byte for byte; runs made before it refit to
+# within a few thousandths of a dB (their final fit ran inside the active process), so
+# those within 0.02 dB are kept with final_fit.refit.json beside them naming both PSNRs.
+# Plain-training methods only (fisher, fvs, random, adaptive, ...): a residual method's
+# final fit would need --residual and the binary of its grid.
+#
+#   BIN=path/to/saresgs bash scripts/refit_final_fit.sh results/verdict2/runs/JOB ...
+#
+# BIN: the binary that ran the runs (default ./build/apps/saresgs). Used by
+# scripts/path_psnr.py, which renders these models along the whole capture path.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+bin=${BIN:-./build/apps/saresgs}
+[ -x "$bin" ] || { echo "refit_final_fit: no binary $bin" >&2; exit 2; }
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+status=0
+for run in "$@"; do
+  run=${run%/}
+  job=$(basename "$run")
+  [ -f "$run/results.json" ] || { echo "skip $job: no results.json"; continue; }
+  [ -f "$run/final_fit.ply" ] && { echo "skip $job: has final_fit.ply"; continue; }
+  read -r ds views seed psnr residual iters preset cap < <(/usr/bin/python3 -c "
+import json, sys
+r = json.load(open(sys.argv[1]))
+f = r['final_fit']
+print(r['dataset'], ','.join(r['initial_views'] + r['selected_views']), r['seed'], repr(f['psnr']), f['residual'],
+      f['iterations'], r['preset'], r['options']['max_gaussians'])" \
+    "$run/results.json") || { echo "FAIL $job: results.json has no final fit"; status=1; continue; }
+  [ "$residual" = False ] || { echo "skip $job: its final fit trains with residual supervision"; continue; }
+  [ "$preset" = quick ] || { echo "skip $job: preset $preset (only the quick preset's final fit is rebuilt here)"; continue; }
+  out=$tmp/$job
+  if ! "$bin" train --dataset "$ds" --views "$views" --iterations "$iters" --max-gaussians "$cap" --sh-degree 0 \
+       --seed "$seed" --threads 1 --out "$out" > "$tmp/$job.log" 2>&1; then
+    echo "FAIL $job: saresgs train failed:"; tail -3 "$tmp/$job.log"; status=1; continue
+  fi
+  got=$(/usr/bin/python3 -c "import json, sys; print(repr(json.load(open(sys.argv[1]))['psnr']))" "$out/results.json")
+  if /usr/bin/python3 -c "import sys; sys.exit(0 if abs(float(sys.argv[1]) - float(sys.argv[2])) < 0.02 else 1)" "$got" "$psnr"; then
+    cp "$out/point_cloud.ply" "$run/final_fit.ply.tmp" && mv "$run/final_fit.ply.tmp" "$run/final_fit.ply"
+    if [ "$got" != "$psnr" ]; then
+      printf '{"run_psnr": %s, "refit_psnr": %s}\n' "$psnr" "$got" > "$run/final_fit.refit.json.tmp"
+      mv "$run/final_fit.refit.json.tmp" "$run/final_fit.refit.json"
+    fi
+    echo "ok $job: run $psnr, refit $got"
+  else
+    echo "MISMATCH $job: refit $got, run $psnr (not kept)"; status=1
+  fi
+  rm -rf "$out"
+done
+exit $status
