@@ -44,8 +44,10 @@ subset("f_stage4_plain", 4, ["fisher", "resgs", "fisher-logdet"], [0, 1, 2, 3],
 subset("g_stage4_sahash", 4, ["sa-hash"], [0, 1, 2, 3])
 subset("h_hybrid_s47", 5, ["hybrid"], [4, 5, 6, 7])
 EOF
-run() {  # binary, config
-  nice -n 19 "$1" ablate --config "$2" --out results/verdict2 --shard "$me/2" >> "$work/shard$me.log" 2>&1
+run() {  # binary, config; a failed job is reported and left for the next start
+  if ! nice -n 19 "$1" ablate --config "$2" --out results/verdict2 --shard "$me/2" >> "$work/shard$me.log" 2>&1; then
+    echo "verdict2_remaining: $(basename "$2") had a failed job (see above); going on" >> "$work/shard$me.log"
+  fi
   touch "$work/done_$(basename "$2" .json)_$me"
 }
 # Waits until the other shard has finished config $1 in this run: its mark is there and no
