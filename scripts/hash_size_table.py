@@ -10,12 +10,10 @@ Writes OUT/tables/hash_size_psnr.md and prints it. Only finished runs count; a s
 missing a seed that its reference has is paired over the seeds both have.
 """
 import json
-import math
 import os
 import sys
 
-T95 = {1: 12.706, 2: 4.303, 3: 3.182, 4: 2.776, 5: 2.571, 6: 2.447, 7: 2.365}
-
+from table_io import interval95, writeTable
 
 def load(path):
     try:
@@ -49,24 +47,13 @@ def main():
                          for s in sorted(runs) if ref.get(s) and ref[s].get("final_fit")]
                 cell = ""
                 if diffs and v != "default":
-                    m = sum(diffs) / len(diffs)
-                    if len(diffs) > 1:
-                        sd = math.sqrt(sum((d - m) ** 2 for d in diffs) / (len(diffs) - 1))
-                        h = T95.get(len(diffs) - 1, 1.96) * sd / math.sqrt(len(diffs))
-                        cell = f"{m:+.2f} [{m - h:+.2f}, {m + h:+.2f}]"
-                    else:
-                        cell = f"{m:+.2f}"
+                    m, lo, hi = interval95(diffs)
+                    cell = f"{m:+.2f}" if len(diffs) == 1 else f"{m:+.2f} [{lo:+.2f}, {hi:+.2f}]"
                 lines.append(f"| {scene} | {v} | {regime.get('encoding', '')} | "
                              f"{'' if load_factor is None else f'{load_factor:.2f}'} | {len(runs)} | "
                              f"{sum(psnr) / len(psnr):.2f} | {cell} | "
                              f"{' '.join(f'{d:+.2f}' for d in diffs) if v != 'default' else ''} |")
-    text = "\n".join(lines)
-    os.makedirs(f"{out}/tables", exist_ok=True)
-    with open(f"{out}/tables/hash_size_psnr.md.tmp", "w") as fh:
-        fh.write(text + "\n")
-    os.replace(f"{out}/tables/hash_size_psnr.md.tmp", f"{out}/tables/hash_size_psnr.md")
-    print(text)
-
+    writeTable(out, "hash_size_psnr.md", lines)
 
 if __name__ == "__main__":
     main()

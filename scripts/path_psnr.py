@@ -18,26 +18,13 @@ OUT/tables/path_psnr.md and prints it. No selector and no training sees these vi
 """
 import glob
 import json
-import math
 import os
 import sys
 
 import numpy as np
 
 import saresgs
-
-# Two-sided 95 % Student-t quantiles by degrees of freedom.
-T95 = {1: 12.706, 2: 4.303, 3: 3.182, 4: 2.776, 5: 2.571, 6: 2.447, 7: 2.365, 8: 2.306, 9: 2.262, 10: 2.228}
-
-
-def interval(d):
-    d = np.asarray(d, dtype=float)
-    m = d.mean()
-    if len(d) < 2:
-        return m, float("nan"), float("nan")
-    h = T95.get(len(d) - 1, 1.96) * d.std(ddof=1) / math.sqrt(len(d))
-    return m, m - h, m + h
-
+from table_io import interval95, writeTable
 
 def viewPsnr(run, ds):
     """PSNR of the run's final-fit model at every view of the dataset, cached in the run folder."""
@@ -101,16 +88,10 @@ def main():
                 d_test.append(float(np.mean(pa[sorted(test)]) - np.mean(pb[sorted(test)])))
                 d_path.append(float(np.mean(pa[views]) - np.mean(pb[views])))
                 n_path.append(len(views))
-            t, p = interval(d_test), interval(d_path)
+            t, p = interval95(d_test), interval95(d_path)
             lines.append(f"| {scene} | {a} | {b} | {','.join(map(str, seeds))} | {t[0]:+.2f} [{t[1]:+.2f}, {t[2]:+.2f}] | "
                          f"{p[0]:+.2f} [{p[1]:+.2f}, {p[2]:+.2f}] | {min(n_path)}-{max(n_path)} |")
-    text = "\n".join(lines)
-    os.makedirs(f"{out}/tables", exist_ok=True)
-    with open(f"{out}/tables/path_psnr.md.tmp", "w") as fh:
-        fh.write(text + "\n")
-    os.replace(f"{out}/tables/path_psnr.md.tmp", f"{out}/tables/path_psnr.md")
-    print(text)
-
+    writeTable(out, "path_psnr.md", lines)
 
 if __name__ == "__main__":
     main()
