@@ -15,6 +15,7 @@ import sys
 
 from table_io import interval95, writeTable
 
+
 def load(path):
     try:
         return json.load(open(path))
@@ -36,7 +37,8 @@ def main():
         for method in grid["methods"]:
             ref = {s: load(f"{out}/runs/{scene}__{method}__default__s{s}/results.json") for s in grid["seeds"]}
             for v in variants:
-                runs = {s: load(f"{out}/runs/{scene}__{method}__{v}__s{s}/results.json") for s in grid["seeds"]}
+                runs = ref if v == "default" else {
+                    s: load(f"{out}/runs/{scene}__{method}__{v}__s{s}/results.json") for s in grid["seeds"]}
                 runs = {s: r for s, r in runs.items() if r and r.get("final_fit")}
                 if not runs:
                     continue
@@ -54,6 +56,7 @@ def main():
                              f"{sum(psnr) / len(psnr):.2f} | {cell} | "
                              f"{' '.join(f'{d:+.2f}' for d in diffs) if v != 'default' else ''} |")
     writeTable(out, "hash_size_psnr.md", lines)
+
 
 if __name__ == "__main__":
     main()

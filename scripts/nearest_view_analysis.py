@@ -24,6 +24,7 @@ import sys
 import numpy as np
 
 import saresgs
+from table_io import writeTable
 
 
 def kmedianComparison(out, scene, ds, centres):
@@ -129,11 +130,7 @@ def main():
             fit = np.polyfit(a[:, 1], a[:, 0], 1)  # PSNR = fit[0] distance + fit[1]
             lines += phaseComparison(out, scene, ds, centres, fit)
         lines.append("")
-    text = "\n".join(lines)
-    os.makedirs(f"{out}/tables", exist_ok=True)
-    with open(f"{out}/tables/nearest_view.md", "w") as fh:
-        fh.write(text + "\n")
-    print(text)
+    writeTable(out, "nearest_view.md", lines)
 
 
 if __name__ == "__main__":

@@ -26,6 +26,7 @@ import numpy as np
 import saresgs
 from table_io import interval95, writeTable
 
+
 def viewPsnr(run, ds):
     """PSNR of the run's final-fit model at every view of the dataset, cached in the run folder."""
     ply = f"{run}/final_fit.ply"
@@ -61,7 +62,7 @@ def main():
              "|---|---|---|---:|---:|---:|---:|"]
     for scene, path in scenes.items():
         ds = saresgs.load_dataset(path)
-        test = set(int(i) for i in ds.test)
+        test = sorted(int(i) for i in ds.test)
         runs = {}
         for f in sorted(glob.glob(f"{out}/runs/{scene}__*__default__s*/final_fit.ply")):
             run = os.path.dirname(f)
@@ -71,27 +72,28 @@ def main():
             r = json.load(open(res))
             _, method, _, seed = os.path.basename(run).split("__")
             p = viewPsnr(run, ds)
-            at_test = float(np.mean(p[sorted(test)]))
+            at_test = float(np.mean(p[test]))
             if abs(at_test - r["final_fit"]["psnr"]) > 1e-3:
                 sys.exit(f"path_psnr: {run}: PSNR at the test views {at_test:.4f} is not results.json's "
                          f"{r['final_fit']['psnr']:.4f}: this model or render is not the run's")
-            runs[(method, int(seed[1:]))] = (p, set(r["selected_view_indices"]))
+            runs[(method, int(seed[1:]))] = (p, set(r["selected_view_indices"]), at_test)
         for a, b in pairs:
             seeds = sorted(s for (m, s) in runs if m == a and (b, s) in runs)
             if not seeds:
                 continue
             d_test, d_path, n_path = [], [], []
             for s in seeds:
-                pa, ha = runs[(a, s)]
-                pb, hb = runs[(b, s)]
+                pa, ha, ta = runs[(a, s)]
+                pb, hb, tb = runs[(b, s)]
                 views = [v for v in range(len(pa)) if v not in ha and v not in hb]
-                d_test.append(float(np.mean(pa[sorted(test)]) - np.mean(pb[sorted(test)])))
+                d_test.append(ta - tb)
                 d_path.append(float(np.mean(pa[views]) - np.mean(pb[views])))
                 n_path.append(len(views))
             t, p = interval95(d_test), interval95(d_path)
             lines.append(f"| {scene} | {a} | {b} | {','.join(map(str, seeds))} | {t[0]:+.2f} [{t[1]:+.2f}, {t[2]:+.2f}] | "
                          f"{p[0]:+.2f} [{p[1]:+.2f}, {p[2]:+.2f}] | {min(n_path)}-{max(n_path)} |")
     writeTable(out, "path_psnr.md", lines)
+
 
 if __name__ == "__main__":
     main()
