@@ -23,7 +23,7 @@ work=${WORK:-/tmp/verdict2_remaining}
 mkdir -p "$work"
 # The subset configs: a stage file with its methods, seeds and variants narrowed.
 /usr/bin/python3 - "$work" <<'EOF'
-import json, sys
+import json, os, sys
 work = sys.argv[1]
 def subset(name, stage, methods, seeds, variants=None):
     c = json.load(open(f"results/grid_verdict2_stage{stage}.json"))
@@ -31,7 +31,6 @@ def subset(name, stage, methods, seeds, variants=None):
              variants=variants or [{"name": "default"}])
     with open(f"{work}/{name}.json.tmp", "w") as fh:
         json.dump(c, fh, indent=2)
-    import os
     os.replace(f"{work}/{name}.json.tmp", f"{work}/{name}.json")
 subset("a_fisher_fvs_s47", 5, ["fisher", "fvs"], [4, 5, 6, 7])
 subset("b_random_s03", 3, ["random"], [0, 1, 2, 3])
