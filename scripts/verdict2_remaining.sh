@@ -41,7 +41,6 @@ subset("f_stage4_plain", 4, ["fisher", "resgs", "fisher-logdet"], [0, 1, 2, 3],
        [{"name": "default", "methods": ["resgs", "fisher-logdet", "fisher"]},
         {"name": "replay-fisher", "methods": ["resgs"], "replay": "fisher"}])
 subset("g_stage4_sahash", 4, ["sa-hash"], [0, 1, 2, 3])
-subset("h_hybrid_s47", 5, ["hybrid"], [4, 5, 6, 7])
 EOF
 run() {  # binary, config; a failed job is reported and left for the next start
   if ! nice -n 19 "$1" ablate --config "$2" --out results/verdict2 --shard "$me/2" >> "$work/shard$me.log" 2>&1; then
@@ -76,5 +75,4 @@ run "$old" "$work/e_random_s47.json"
 run "$old" "$work/f_stage4_plain.json"
 barrier f_stage4_plain grid_hash c_hybrid_s03 d_saresgs_s47 e_random_s47
 run "$emb" "$work/g_stage4_sahash.json"
-run "$emb" "$work/h_hybrid_s47.json"
 echo "verdict2_remaining: shard $me done" >> "$work/shard$me.log"
