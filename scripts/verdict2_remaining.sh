@@ -7,7 +7,12 @@
 # finished every config before it (no lock would stop the two shards from running one job
 # twice otherwise).
 #
-#   OLD=/path/to/864af66/saresgs EMB=/path/to/2aceba9/saresgs bash scripts/verdict2_remaining.sh SHARD
+#   OLD=/path/to/864af66/saresgs EMB=/path/to/2aceba9/saresgs [PAPER=/path/to/saresgs] \
+#     bash scripts/verdict2_remaining.sh SHARD
+#
+# PAPER (optional): the binary of 5b76fc9, which ran the landed jobs of
+# results/grid_paper_preset.json (it takes a lock per job): runs what is left of that grid into
+# results/paper_preset first (about 50 minutes a job).
 #
 # Build the two binaries as results/README.md says (a git worktree per commit, Release).
 # Subset configs and the shards' progress marks go to $WORK (default /tmp/verdict2_remaining);
@@ -65,6 +70,10 @@ barrier() {
   done
 }
 rm -f "$work"/done_*_"$me"
+if [ -n "${PAPER:-}" ]; then
+  nice -n 19 "$PAPER" ablate --config results/grid_paper_preset.json --out results/paper_preset --shard "$me/2" \
+    >> "$work/shard$me.log" 2>&1 || echo "verdict2_remaining: the paper preset had a failed job (see above); going on" >> "$work/shard$me.log"
+fi
 run "$old" "$work/a_fisher_fvs_s47.json"
 run "$old" "$work/b_random_s03.json"
 barrier b_random_s03 a_fisher_fvs_s47
