@@ -58,8 +58,22 @@ TEST(RunReport, EveryCommittedResultFileReadsBackUnchanged) {
   int files = 0;
   for (const auto& e : std::filesystem::recursive_directory_iterator(std::string(SARESGS_SOURCE_DIR) + "/results")) {
     if (e.path().filename() != "results.json") continue;
-    const nlohmann::json j = readJsonFile(e.path().string());
+    nlohmann::json j = readJsonFile(e.path().string());
     nlohmann::json back = toJson(runReportFromJson(j, e.path().string()));
+    // `saresgs active` writes its process's memory beside the report (apps/cmd_active.cpp,
+    // files from e7c6934 on); the report does not carry it, so it is checked for its shape
+    // here and left out of the comparison.
+    if (j.contains("memory")) {
+      const nlohmann::json& m = j["memory"];
+      EXPECT_TRUE(m.contains("peak_rss_bytes") && m["peak_rss_bytes"].is_number()) << e.path();
+      ASSERT_TRUE(m.contains("rss_at_phase_start_this_process")) << e.path();
+      EXPECT_TRUE(m["rss_at_phase_start_this_process"].is_array()) << e.path();
+      for (const auto& p : m["rss_at_phase_start_this_process"])
+        EXPECT_TRUE(p.contains("phase") && p.contains("rss_bytes") && p.contains("views") && p.contains("gaussians"))
+            << e.path();
+      EXPECT_FALSE(back.contains("memory")) << e.path();
+      j.erase("memory");
+    }
     // Files written before these fields were recorded get them on reading (a plain final
     // fit is its own plain refit; no hybrid, no coverage time); nothing else may change.
     if (j.contains("final_fit") && !j["final_fit"].contains("residual")) {
