@@ -47,8 +47,8 @@ subset("f_stage4_plain", 4, ["fisher", "resgs", "fisher-logdet"], [0, 1, 2, 3],
         {"name": "replay-fisher", "methods": ["resgs"], "replay": "fisher"}])
 subset("g_stage4_sahash", 4, ["sa-hash"], [0, 1, 2, 3])
 EOF
-run() {  # binary, config; a failed job is reported and left for the next start
-  if ! nice -n 19 "$1" ablate --config "$2" --out results/verdict2 --shard "$me/2" >> "$work/shard$me.log" 2>&1; then
+run() {  # binary, config[, out folder]; a failed job is reported and left for the next start
+  if ! nice -n 19 "$1" ablate --config "$2" --out "${3:-results/verdict2}" --shard "$me/2" >> "$work/shard$me.log" 2>&1; then
     echo "verdict2_remaining: $(basename "$2") had a failed job (see above); going on" >> "$work/shard$me.log"
   fi
   touch "$work/done_$(basename "$2" .json)_$me"
@@ -70,10 +70,7 @@ barrier() {
   done
 }
 rm -f "$work"/done_*_"$me"
-if [ -n "${PAPER:-}" ]; then
-  nice -n 19 "$PAPER" ablate --config results/grid_paper_preset.json --out results/paper_preset --shard "$me/2" \
-    >> "$work/shard$me.log" 2>&1 || echo "verdict2_remaining: the paper preset had a failed job (see above); going on" >> "$work/shard$me.log"
-fi
+if [ -n "${PAPER:-}" ]; then run "$PAPER" results/grid_paper_preset.json results/paper_preset; fi
 run "$old" "$work/a_fisher_fvs_s47.json"
 run "$old" "$work/b_random_s03.json"
 barrier b_random_s03 a_fisher_fvs_s47
