@@ -16,13 +16,15 @@ namespace saresgs {
 
 namespace {
 
-// The best kernels this CPU runs, unless SARESGS_RASTER_ISA=baseline asks otherwise; read
-// once, at the first render, like the process's other defaults.
+// The best kernels this CPU runs, unless SARESGS_RASTER_ISA=baseline (or avx2) asks for
+// less; read once, at the first render, like the process's other defaults.
 int defaultKernelIndex() {
   static const int index = [] {
     const char* env = std::getenv("SARESGS_RASTER_ISA");
     if (env && std::strcmp(env, "baseline") == 0) return 0;
-    return rasterCpuHasAvx2() ? 1 : 0;
+    if (!rasterCpuHasAvx2()) return 0;
+    if (env && std::strcmp(env, "avx2") == 0) return 1;
+    return rasterCpuHasAvx512() ? 2 : 1;
   }();
   return index;
 }
@@ -47,6 +49,10 @@ int kernelIndex(RasterKernels kernels) {
     case RasterKernels::kAvx2:
       if (!rasterCpuHasAvx2()) throw std::invalid_argument("raster kernels avx2: this CPU or build has no AVX2 and FMA");
       return 1;
+    case RasterKernels::kAvx512:
+      if (!rasterCpuHasAvx512())
+        throw std::invalid_argument("raster kernels avx512: this CPU or build has no AVX-512F and AVX-512VL");
+      return 2;
     case RasterKernels::kDefault: break;
   }
   return defaultKernelIndex();
@@ -58,6 +64,7 @@ std::optional<RasterKernels> parseRasterKernels(std::string_view name) {
   if (name == "default") return RasterKernels::kDefault;
   if (name == "baseline") return RasterKernels::kBaseline;
   if (name == "avx2") return RasterKernels::kAvx2;
+  if (name == "avx512") return RasterKernels::kAvx512;
   return std::nullopt;
 }
 
@@ -71,12 +78,23 @@ bool rasterCpuHasAvx2() {
 #endif
 }
 
+bool rasterCpuHasAvx512() {
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+  static const bool has = rasterCpuHasAvx2() && raster_kernels::avx512::compiled() &&
+                          __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl");
+  return has;
+#else
+  return false;
+#endif
+}
+
 double rasterForwardFloorNsPerPair(const RasterExecution& e, double seconds) {
   const int isa = raster_execution::kernelIndex(e.kernels);
   auto run = [isa](long n) {
-    return isa == 1 ? raster_kernels::avx2::compositeFloor(n) : raster_kernels::base4::compositeFloor(n);
+    // avx512's forward kernel is avx2's.
+    return isa >= 1 ? raster_kernels::avx2::compositeFloor(n) : raster_kernels::base4::compositeFloor(n);
   };
-  const int lanes = isa == 1 ? 8 : 4;
+  const int lanes = isa >= 1 ? 8 : 4;
   volatile float sink = run(1000);  // warm up
   // Doubles the rounds until one timing lasts `seconds`, then takes the best of three.
   long n = 1 << 14;

@@ -99,6 +99,15 @@ void fisherTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, in
                 const FisherIn& in, const std::uint32_t* entry_slot, float* slots);
 }  // namespace avx2
 
+// The AVX2 Fisher kernel's arithmetic on AVX-512VL's 32 registers, its moments summed in
+// one pass (splat/raster/raster_kernels_avx512.cpp): bit-identical to avx2::fisherTile.
+namespace avx512 {
+// False when this build has no AVX-512 kernel (not x86-64, or not GCC/Clang).
+bool compiled();
+void fisherTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
+                const FisherIn& in, const std::uint32_t* entry_slot, float* slots);
+}  // namespace avx512
+
 // compositeTile's per-lane arithmetic for n rounds of two blocks in registers (no memory
 // traffic): the floor a tile kernel could reach (raster_kernels_impl.h). Returns a checksum.
 namespace base4 {

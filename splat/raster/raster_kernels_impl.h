@@ -19,6 +19,15 @@
 #ifndef SARESGS_KERNEL_FMA
 #define SARESGS_KERNEL_FMA 0
 #endif
+// SARESGS_KERNEL_FISHER_ONE_PASS: the Fisher walk sums its 19 moments as it goes (for a
+// target with 32 vector registers; with 16 they spill and the three-pass form is faster).
+// SARESGS_KERNEL_FISHER_ONLY: only fisherTile is defined (raster_kernels_avx512.cpp).
+#ifndef SARESGS_KERNEL_FISHER_ONE_PASS
+#define SARESGS_KERNEL_FISHER_ONE_PASS 0
+#endif
+#ifndef SARESGS_KERNEL_FISHER_ONLY
+#define SARESGS_KERNEL_FISHER_ONLY 0
+#endif
 #if !defined(SARESGS_KERNEL_NS) || !defined(SARESGS_KERNEL_LANES)
 #error "define SARESGS_KERNEL_NS and SARESGS_KERNEL_LANES before including raster_kernels_impl.h"
 #endif
@@ -326,6 +335,7 @@ struct ForwardColour {
 
 }  // namespace
 
+#if !SARESGS_KERNEL_FISHER_ONLY
 // Front-to-back compositing, Gaussian by Gaussian over the blocks it may touch, so the
 // inner loop is branch-free vector code; each pixel sees exactly the per-pixel sequence
 // of rule 7.
@@ -369,6 +379,7 @@ float compositeFloor(long n) {
   }
   return hsum(b[0].C0 + b[1].C0 + b[0].D + b[1].D + b[0].contrib + b[1].walked);
 }
+#endif  // !SARESGS_KERNEL_FISHER_ONLY
 
 namespace {
 
@@ -514,6 +525,7 @@ inline GradSums zeroSums() {
   return GradSums{z, z, z, z, z, z, z, z, z};
 }
 
+#if !SARESGS_KERNEL_FISHER_ONLY
 // The back-to-front walk (the scalar walkBack of rasterizer.cpp, per lane), Gaussian by
 // Gaussian. Entries beyond the longest walk get zero slots, so the caller needs no
 // cleared buffer.
@@ -537,9 +549,11 @@ void backwardTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int 
     writeSums(g, s, &slots[static_cast<std::size_t>(entry_slot[jj]) * kSlot]);
   }
 }
+#endif  // !SARESGS_KERNEL_FISHER_ONLY
 
 }  // namespace
 
+#if !SARESGS_KERNEL_FISHER_ONLY
 void backwardTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
                   const BackwardIn& in, const std::uint32_t* entry_slot, float* slots) {
   if (nq == 0) return;
@@ -548,6 +562,7 @@ void backwardTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, 
   else
     backwardTileImpl<false>(q, nq, x0, y0, x1, y1, bg, in, entry_slot, slots);
 }
+#endif  // !SARESGS_KERNEL_FISHER_ONLY
 
 // FisherRF's squared-gradient pass (FisherMoment in raster_kernels.h): the backward walk
 // for the fixed objective C_r + C_g + C_b, accumulating moments instead of gradients.
@@ -563,8 +578,11 @@ void fisherTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1
   constexpr int M = kFisherSlot;
   const int w = x1 - x0, h = y1 - y0;
   alignas(64) float Tr[P], finalT[P], walked[P], acc[P];
+#if !SARESGS_KERNEL_FISHER_ONE_PASS
   alignas(64) float eb[P], wb[P];  // per block of the current Gaussian: e and wc
   int block[P / L];                // and the block's storage index
+  const vf lane_x = laneColCentres(), lane_y = laneRowCentres();
+#endif
   std::uint32_t jmax = 0;
   for (int k = 0; k < P; ++k) {
     const int r = blockRow(k), c = blockCol(k);
@@ -580,12 +598,62 @@ void fisherTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1
   // same, so that the caller needs no cleared buffer.
   for (int jj = static_cast<int>(jmax); jj < nq; ++jj)
     std::memset(&slots[static_cast<std::size_t>(entry_slot[jj]) * M], 0, sizeof(float) * M);
-  const vf lane_x = laneColCentres(), lane_y = laneRowCentres();
   const vf zero = vs(0.0f), one = vs(1.0f), bgs = vs(bg_sum);
   for (std::uint32_t jj = jmax; jj-- > 0;) {
     const TileGaussian<float>& g = q[jj];
     const vf jv = vs(static_cast<float>(jj));
     const vf colsum = vs(g.col[0] + g.col[1] + g.col[2]);
+#if SARESGS_KERNEL_FISHER_ONE_PASS
+    // One pass: the walk's e and wc go straight into the 19 accumulators, each summed
+    // with the same operations, in the same block order, as in the three passes below.
+    vf e00 = zero, e20 = zero, e11 = zero, e02 = zero, f10 = zero, f01 = zero, ww = zero;
+    vf e30 = zero, e21 = zero, e12 = zero, e03 = zero, f20 = zero, f11 = zero, f02 = zero;
+    vf e40 = zero, e31 = zero, e22 = zero, e13 = zero, e04 = zero;
+    forEachBlock(g, x0, y0, x1, y1, [&](int blk, const Lanes& Ln, vf dy) {
+      const int k = blk * L;
+      const vf alpha = Ln.alpha;
+      const vi valid = (jv < load(walked + k)) & Ln.touches;
+      const vf a_eff = valid ? alpha : zero;
+      const vf t = load(Tr + k) / (one - a_eff);  // transmittance in front of jj
+      store(Tr + k, t);
+      const vf a = load(acc + k), d = colsum - a;
+      vf dLda = d * t;
+      if constexpr (kBg) dLda = dLda - load(finalT + k) / (one - alpha) * bgs;
+      store(acc + k, fma(a_eff, d, a));
+      const vi gm = valid & (Ln.oG < vs(kMaxA));
+      const vf e = gm ? Ln.G * dLda : zero;
+      const vf wc = a_eff * t;  // 0 where not valid
+      const vf dx = Ln.dx;
+      const vf e2 = e * e, ew = e * wc;
+      const vf xx = dx * dx, xy = dx * dy, yy = dy * dy;
+      const vf e2xx = e2 * xx, e2yy = e2 * yy;
+      e00 += e2;
+      e20 += e2xx;
+      e11 = fma(e2 * dx, dy, e11);
+      e02 += e2yy;
+      f10 = fma(ew, dx, f10);
+      f01 = fma(ew, dy, f01);
+      ww = fma(wc, wc, ww);
+      e30 = fma(e2xx, dx, e30);
+      e21 = fma(e2xx, dy, e21);
+      e12 = fma(e2yy, dx, e12);
+      e03 = fma(e2yy, dy, e03);
+      f20 = fma(ew, xx, f20);
+      f11 = fma(ew, xy, f11);
+      f02 = fma(ew, yy, f02);
+      e40 = fma(e2xx, xx, e40);
+      e31 = fma(e2xx, xy, e31);
+      e22 = fma(e2xx, yy, e22);
+      e13 = fma(e2yy, xy, e13);
+      e04 = fma(e2yy, yy, e04);
+    });
+    constexpr int kPadded = (M + L - 1) / L * L;
+    vf m[kPadded];
+    for (int k = M; k < kPadded; ++k) m[k] = zero;
+    m[kE00] = e00, m[kE20] = e20, m[kE11] = e11, m[kE02] = e02, m[kF10] = f10, m[kF01] = f01, m[kW] = ww;
+    m[kE30] = e30, m[kE21] = e21, m[kE12] = e12, m[kE03] = e03, m[kF20] = f20, m[kF11] = f11, m[kF02] = f02;
+    m[kE40] = e40, m[kE31] = e31, m[kE22] = e22, m[kE13] = e13, m[kE04] = e04;
+#else
     const vf mx = vs(g.mx), my = vs(g.my);
     // Two passes over the Gaussian's blocks. The walk keeps each block's e and wc in
     // scratch; the moments are then summed in three groups small enough to stay in
@@ -668,6 +736,7 @@ void fisherTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1
       }
       m[kE40] = e40, m[kE31] = e31, m[kE22] = e22, m[kE13] = e13, m[kE04] = e04;
     }
+#endif
     float* sl = &slots[static_cast<std::size_t>(entry_slot[jj]) * M];
     alignas(64) float sums[kPadded];
     for (int k = 0; k < kPadded; k += L) store(sums + k, transposeSums(m + k));

@@ -69,6 +69,7 @@ struct KernelSet {
 constexpr KernelSet kKernelSets[] = {
     {"baseline", raster_kernels::base4::compositeTile, raster_kernels::base4::backwardTile},
     {"avx2", raster_kernels::avx2::compositeTile, raster_kernels::avx2::backwardTile},
+    {"avx512", raster_kernels::avx2::compositeTile, raster_kernels::avx2::backwardTile},  // its Fisher walk differs
 };
 static_assert(raster_kernels::base4::kTile == kTileSize && raster_kernels::base4::kMinA == kMinAlpha &&
               raster_kernels::base4::kMaxA == kMaxAlpha && raster_kernels::base4::kMinT == kMinTransmittance);
@@ -582,6 +583,7 @@ struct PairKernelSet {
 constexpr PairKernelSet kPairKernelSets[] = {
     {raster_kernels::base4::compositeTilePair, raster_kernels::base4::backwardTilePair},
     {raster_kernels::avx2::compositeTilePair, raster_kernels::avx2::backwardTilePair},
+    {raster_kernels::avx2::compositeTilePair, raster_kernels::avx2::backwardTilePair},
 };
 
 // The public result of a float render (rasterize() and rasterizeWithSubset()), moved
@@ -955,8 +957,8 @@ namespace {
 // (raster_kernels::FisherMoment), reduced per Gaussian in slot order, in double, and
 // turned into squared parameter gradients with the Gaussian's Jacobian. Indexed like
 // kKernelSets (raster_execution::kernelIndex).
-constexpr raster_kernels::FisherFn kFisherKernels[] = {raster_kernels::base4::fisherTile,
-                                                       raster_kernels::avx2::fisherTile};
+constexpr raster_kernels::FisherFn kFisherKernels[] = {
+    raster_kernels::base4::fisherTile, raster_kernels::avx2::fisherTile, raster_kernels::avx512::fisherTile};
 
 // A slot buffer of at least `size` floats, not cleared, taken from a process-wide pool
 // and given back when the lease ends. A fresh buffer per view (the selector runs one per

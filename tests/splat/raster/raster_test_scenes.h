@@ -20,6 +20,7 @@ namespace saresgs::test {
 inline std::vector<std::pair<const char*, RasterKernels>> runnableKernels() {
   std::vector<std::pair<const char*, RasterKernels>> k{{"baseline", RasterKernels::kBaseline}};
   if (rasterCpuHasAvx2()) k.emplace_back("avx2", RasterKernels::kAvx2);
+  if (rasterCpuHasAvx512()) k.emplace_back("avx512", RasterKernels::kAvx512);
   return k;
 }
 

@@ -187,6 +187,28 @@ TEST(Fisher, FloatPassEqualsTheDoubleReferenceOnEveryKernelSet) {
   }
 }
 
+// The avx512 kernel set's Fisher walk (one pass over 32 registers) gives the avx2
+// walk's information bit for bit, on every case above (backgrounds, stiff scales, the
+// near plane, large offsets), with and without threads.
+TEST(Fisher, Avx512WalkEqualsAvx2BitForBit) {
+  if (!rasterCpuHasAvx512()) GTEST_SKIP() << "no AVX-512F and AVX-512VL on this CPU (the avx512 set cannot run here)";
+  auto arrays = [](const Gaussians& H) { return std::make_tuple(H.means, H.log_scales, H.rotations, H.opacities, H.sh); };
+  int nonzero = 0;
+  for (const FisherCase& fc : fisherCases()) {
+    SCOPED_TRACE(fc.name);
+    RasterSettings s;
+    s.sh_degree = fc.sh_degree;
+    s.background = fc.background;
+    for (int threads : {1, 0}) {
+      const Gaussians a = floatInformation(fc.g, fc.cam, s, RasterKernels::kAvx2, threads);
+      const Gaussians b = floatInformation(fc.g, fc.cam, s, RasterKernels::kAvx512, threads);
+      EXPECT_TRUE(arrays(a) == arrays(b));
+      for (float v : a.means) nonzero += v != 0.0f;
+    }
+  }
+  EXPECT_GT(nonzero, 1000);  // the cases carry information to compare
+}
+
 TEST(Fisher, JacobianEqualsProjectBackwardWithUnitInputs) {
   // projectJacobian's rows (the conic ones in closed form) against projectBackward run
   // once per input, in double, on anisotropic rotated Gaussians at every SH degree.

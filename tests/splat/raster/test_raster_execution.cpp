@@ -17,6 +17,7 @@ TEST(RasterExecution, ParsesKernelNames) {
   EXPECT_EQ(parseRasterKernels("default"), RasterKernels::kDefault);
   EXPECT_EQ(parseRasterKernels("baseline"), RasterKernels::kBaseline);
   EXPECT_EQ(parseRasterKernels("avx2"), RasterKernels::kAvx2);
+  EXPECT_EQ(parseRasterKernels("avx512"), RasterKernels::kAvx512);
   EXPECT_FALSE(parseRasterKernels("AVX2").has_value());
   EXPECT_FALSE(parseRasterKernels("sse").has_value());
   EXPECT_FALSE(parseRasterKernels("").has_value());
@@ -33,11 +34,19 @@ TEST(RasterExecution, ReportsTheKernelsItUses) {
   EXPECT_STREQ(rasterKernelName(RasterExecution{.kernels = RasterKernels::kBaseline}), "baseline");
   const char* env = std::getenv("SARESGS_RASTER_ISA");
   const bool opt_out = env && std::strcmp(env, "baseline") == 0;
-  EXPECT_STREQ(rasterKernelName(RasterExecution{}), rasterCpuHasAvx2() && !opt_out ? "avx2" : "baseline");
+  const bool only_avx2 = env && std::strcmp(env, "avx2") == 0;
+  const char* best = rasterCpuHasAvx512() && !only_avx2 ? "avx512" : rasterCpuHasAvx2() ? "avx2" : "baseline";
+  EXPECT_STREQ(rasterKernelName(RasterExecution{}), opt_out ? "baseline" : best);
   if (rasterCpuHasAvx2())
     EXPECT_STREQ(rasterKernelName(RasterExecution{.kernels = RasterKernels::kAvx2}), "avx2");
   else
     EXPECT_THROW(rasterKernelName(RasterExecution{.kernels = RasterKernels::kAvx2}), std::invalid_argument);
+  if (rasterCpuHasAvx512())
+    EXPECT_STREQ(rasterKernelName(RasterExecution{.kernels = RasterKernels::kAvx512}), "avx512");
+  else
+    EXPECT_THROW(rasterKernelName(RasterExecution{.kernels = RasterKernels::kAvx512}), std::invalid_argument);
+  // avx512 needs avx2 (its forward and backward are avx2's).
+  if (rasterCpuHasAvx512()) EXPECT_TRUE(rasterCpuHasAvx2());
 }
 
 // A render with the default kernels is, bit for bit, the render with the kernels they
@@ -54,6 +63,10 @@ TEST(RasterExecution, RenderRunsWithTheGivenKernels) {
   EXPECT_EQ(by_default.contributors, resolved.contributors);
   if (!rasterCpuHasAvx2()) {
     s.execution.kernels = RasterKernels::kAvx2;
+    EXPECT_THROW(rasterize(g, cam, s), std::invalid_argument);
+  }
+  if (!rasterCpuHasAvx512()) {
+    s.execution.kernels = RasterKernels::kAvx512;
     EXPECT_THROW(rasterize(g, cam, s), std::invalid_argument);
   }
 }
