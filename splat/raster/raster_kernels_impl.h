@@ -599,6 +599,23 @@ void fisherTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1
   for (int jj = static_cast<int>(jmax); jj < nq; ++jj)
     std::memset(&slots[static_cast<std::size_t>(entry_slot[jj]) * M], 0, sizeof(float) * M);
   const vf zero = vs(0.0f), one = vs(1.0f), bgs = vs(bg_sum);
+  // The walk's step at block k (pixel storage index): updates the block's transmittance
+  // and colour sum, and gives e = G dL/dalpha (0 where alpha is clamped or the entry does
+  // not touch the pixel) and the colour weight wc = alpha T (0 where not valid).
+  auto step = [&](int k, const Lanes& Ln, vf jv, vf colsum, vf& e, vf& wc) __attribute__((always_inline)) {
+    const vf alpha = Ln.alpha;
+    const vi valid = (jv < load(walked + k)) & Ln.touches;
+    const vf a_eff = valid ? alpha : zero;
+    const vf t = load(Tr + k) / (one - a_eff);  // transmittance in front of jj
+    store(Tr + k, t);
+    const vf a = load(acc + k), d = colsum - a;
+    vf dLda = d * t;
+    if constexpr (kBg) dLda = dLda - load(finalT + k) / (one - alpha) * bgs;
+    store(acc + k, fma(a_eff, d, a));
+    const vi gm = valid & (Ln.oG < vs(kMaxA));
+    e = gm ? Ln.G * dLda : zero;
+    wc = a_eff * t;
+  };
   for (std::uint32_t jj = jmax; jj-- > 0;) {
     const TileGaussian<float>& g = q[jj];
     const vf jv = vs(static_cast<float>(jj));
@@ -610,19 +627,8 @@ void fisherTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1
     vf e30 = zero, e21 = zero, e12 = zero, e03 = zero, f20 = zero, f11 = zero, f02 = zero;
     vf e40 = zero, e31 = zero, e22 = zero, e13 = zero, e04 = zero;
     forEachBlock(g, x0, y0, x1, y1, [&](int blk, const Lanes& Ln, vf dy) {
-      const int k = blk * L;
-      const vf alpha = Ln.alpha;
-      const vi valid = (jv < load(walked + k)) & Ln.touches;
-      const vf a_eff = valid ? alpha : zero;
-      const vf t = load(Tr + k) / (one - a_eff);  // transmittance in front of jj
-      store(Tr + k, t);
-      const vf a = load(acc + k), d = colsum - a;
-      vf dLda = d * t;
-      if constexpr (kBg) dLda = dLda - load(finalT + k) / (one - alpha) * bgs;
-      store(acc + k, fma(a_eff, d, a));
-      const vi gm = valid & (Ln.oG < vs(kMaxA));
-      const vf e = gm ? Ln.G * dLda : zero;
-      const vf wc = a_eff * t;  // 0 where not valid
+      vf e, wc;
+      step(blk * L, Ln, jv, colsum, e, wc);
       const vf dx = Ln.dx;
       const vf e2 = e * e, ew = e * wc;
       const vf xx = dx * dx, xy = dx * dy, yy = dy * dy;
@@ -661,20 +667,11 @@ void fisherTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1
     // nineteen stores, which bound the kernel).
     int nb = 0;
     forEachBlock(g, x0, y0, x1, y1, [&](int blk, const Lanes& Ln, vf) {
-      const int k = blk * L;
-      const vf alpha = Ln.alpha;
-      const vi valid = (jv < load(walked + k)) & Ln.touches;
-      const vf a_eff = valid ? alpha : zero;
-      const vf t = load(Tr + k) / (one - a_eff);  // transmittance in front of jj
-      store(Tr + k, t);
-      const vf a = load(acc + k), d = colsum - a;
-      vf dLda = d * t;
-      if constexpr (kBg) dLda = dLda - load(finalT + k) / (one - alpha) * bgs;
-      store(acc + k, fma(a_eff, d, a));
-      const vi gm = valid & (Ln.oG < vs(kMaxA));
-      store(eb + nb * L, gm ? Ln.G * dLda : zero);
-      store(wb + nb * L, a_eff * t);  // 0 where not valid
-      block[nb++] = k;
+      vf e, wc;
+      step(blk * L, Ln, jv, colsum, e, wc);
+      store(eb + nb * L, e);
+      store(wb + nb * L, wc);
+      block[nb++] = blk * L;
     });
     // The offsets of block n's pixels, as the walk computed them.
     auto offsets = [&](int n, vf& dx, vf& dy) {
