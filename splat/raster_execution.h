@@ -11,7 +11,9 @@
 namespace saresgs {
 
 // kDefault: avx512 when the CPU has AVX-512F and VL, else avx2 when it has AVX2 and FMA,
-// unless SARESGS_RASTER_ISA=baseline (or avx2) is set in the environment; kBaseline: four
+// unless SARESGS_RASTER_ISA (baseline, avx2, avx512 or default) names the kernels in the
+// environment (kernels the CPU lacks, or another value: std::invalid_argument at the first
+// render); kBaseline: four
 // lanes, any target; kAvx2: eight lanes; kAvx512: the avx2 kernels, bit for bit the same
 // results, with the Fisher pass's walk on AVX-512VL's 32 registers (one pass instead of
 // three over each Gaussian's blocks; the forward and backward are avx2's).

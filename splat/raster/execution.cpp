@@ -9,27 +9,11 @@
 #include <memory>
 #include <mutex>
 #include <stdexcept>
+#include <string>
 
 #include "splat/raster/raster_kernels.h"
 
 namespace saresgs {
-
-namespace {
-
-// The best kernels this CPU runs, unless SARESGS_RASTER_ISA=baseline (or avx2) asks for
-// less; read once, at the first render, like the process's other defaults.
-int defaultKernelIndex() {
-  static const int index = [] {
-    const char* env = std::getenv("SARESGS_RASTER_ISA");
-    if (env && std::strcmp(env, "baseline") == 0) return 0;
-    if (!rasterCpuHasAvx2()) return 0;
-    if (env && std::strcmp(env, "avx2") == 0) return 1;
-    return rasterCpuHasAvx512() ? 2 : 1;
-  }();
-  return index;
-}
-
-}  // namespace
 
 namespace raster_execution {
 
@@ -55,7 +39,25 @@ int kernelIndex(RasterKernels kernels) {
       return 2;
     case RasterKernels::kDefault: break;
   }
-  return defaultKernelIndex();
+  // The best kernels this CPU runs, unless SARESGS_RASTER_ISA names others ("baseline",
+  // "avx2", "avx512" or "default"): read at the first render, like the process's other
+  // defaults. A name this CPU cannot run, or no kernels' name, throws, and is read again
+  // at the next render.
+  static const int index = [] {
+    const char* env = std::getenv("SARESGS_RASTER_ISA");
+    if (!env) return rasterCpuHasAvx512() ? 2 : rasterCpuHasAvx2() ? 1 : 0;
+    const std::optional<RasterKernels> k = parseRasterKernels(env);
+    if (!k)
+      throw std::invalid_argument(std::string("environment SARESGS_RASTER_ISA='") + env +
+                                  "': expected baseline, avx2, avx512 or default");
+    if (*k == RasterKernels::kDefault) return rasterCpuHasAvx512() ? 2 : rasterCpuHasAvx2() ? 1 : 0;
+    try {
+      return kernelIndex(*k);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string("environment SARESGS_RASTER_ISA: ") + e.what());
+    }
+  }();
+  return index;
 }
 
 }  // namespace raster_execution

@@ -12,7 +12,8 @@ namespace saresgs::raster_execution {
 tbb::task_arena& arena(int threads);
 
 // The float kernels `kernels` resolves to, an index into the rasterizer's kernel table:
-// 0 baseline, 1 avx2. Throws std::invalid_argument for kAvx2 on a CPU without AVX2.
+// 0 baseline, 1 avx2, 2 avx512. Throws std::invalid_argument for kernels the CPU lacks,
+// and for kDefault when SARESGS_RASTER_ISA names no kernels this CPU runs.
 int kernelIndex(RasterKernels kernels);
 
 }  // namespace saresgs::raster_execution

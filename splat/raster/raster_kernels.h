@@ -1,13 +1,16 @@
 #pragma once
-// The float tile kernels of the fast rasterizer (internal). They are compiled twice from
-// splat/raster/raster_kernels_impl.h: four lanes for the baseline target (in rasterizer.cpp) and
-// eight lanes with AVX2 (splat/raster/raster_kernels_avx2.cpp, its own compile flags), chosen
-// at run time. Each compilation lives in its own namespace and shares no code with the
-// other, so no function compiled for AVX2 can be picked by the linker for the baseline
-// path. No implicit FMA contraction in either; the AVX2 build fuses the multiply-adds
-// written as fma() and the baseline rounds them twice, so the two paths agree to float
-// rounding (FloatPath.KernelSetsAgree), while each is bit-identical across runs and
-// thread counts.
+// The float tile kernels of the fast rasterizer (internal). They are compiled from
+// splat/raster/raster_kernels_impl.h with four lanes for the baseline target (in
+// rasterizer.cpp) and eight lanes with AVX2 (splat/raster/raster_kernels_avx2.cpp, its own
+// compile flags), chosen at run time; a third compilation, of the Fisher kernel alone, has
+// AVX2's eight lanes and arithmetic on AVX-512VL's 32 registers
+// (splat/raster/raster_kernels_avx512.cpp), bit-identical to the AVX2 one. Each
+// compilation lives in its own namespace and shares no code with the others, so no
+// function compiled for AVX2 or AVX-512 can be picked by the linker for the baseline
+// path. No implicit FMA contraction in any; the AVX2 build fuses the multiply-adds
+// written as fma() and the baseline rounds them twice, so the baseline and AVX2 paths
+// agree to float rounding (FloatPath.KernelSetsAgree), while each is bit-identical
+// across runs and thread counts.
 #include <cstdint>
 
 namespace saresgs {

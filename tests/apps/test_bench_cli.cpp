@@ -103,6 +103,34 @@ TEST(BenchCli, FisherPrintsOneJsonLineWithTheRatioToTheBackwardPass) {
   EXPECT_GT(j.at("peak_rss_mb").get<double>(), 0.0);
 }
 
+// SARESGS_RASTER_ISA picks the kernels a process's default resolves to: the avx512 set's
+// information equals the avx2 set's to the last printed digit (the two are bit-identical),
+// and a name that is no kernel set's is an error that names the variable.
+TEST(BenchCli, FisherKernelsFromTheEnvironment) {
+  const std::string args = " bench fisher --width 40 --height 32 --gaussians 300 --threads 1 --steps 1 --warmup 0";
+  auto withIsa = [&](const std::string& isa) {
+    return saresgs::test::runCommand("SARESGS_RASTER_ISA=" + isa + " " + std::string(SARESGS_CLI) + args);
+  };
+  nlohmann::json base, by_default;
+  ASSERT_TRUE(oneJsonLine(withIsa("baseline"), base));
+  EXPECT_EQ(base.at("kernels"), "baseline");
+  ASSERT_TRUE(oneJsonLine(run(args), by_default));
+  const std::string best = by_default.at("kernels");
+  if (best != "baseline") {
+    nlohmann::json avx2;
+    ASSERT_TRUE(oneJsonLine(withIsa("avx2"), avx2));
+    EXPECT_EQ(avx2.at("kernels"), "avx2");
+    EXPECT_EQ(avx2.at("information_sum").get<double>(), by_default.at("information_sum").get<double>());
+    // The baseline's four lanes round differently, to float precision.
+    EXPECT_NEAR(base.at("information_sum").get<double>(), avx2.at("information_sum").get<double>(),
+                1e-4 * avx2.at("information_sum").get<double>());
+  }
+  const Result bad = withIsa("sse4");
+  EXPECT_NE(bad.code, 0) << bad.output;
+  EXPECT_NE(bad.output.find("SARESGS_RASTER_ISA='sse4'"), std::string::npos) << bad.output;
+  EXPECT_NE(bad.output.find("expected baseline, avx2, avx512 or default"), std::string::npos) << bad.output;
+}
+
 TEST(BenchCli, StepReportsAllocationsPageFaultsAndTheFloor) {
   nlohmann::json j;
   ASSERT_TRUE(oneJsonLine(run("bench step --width 40 --height 32 --gaussians 300 --threads 1 --steps 3 --warmup 1"), j));

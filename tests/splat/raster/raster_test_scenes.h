@@ -20,6 +20,13 @@ namespace saresgs::test {
 inline std::vector<std::pair<const char*, RasterKernels>> runnableKernels() {
   std::vector<std::pair<const char*, RasterKernels>> k{{"baseline", RasterKernels::kBaseline}};
   if (rasterCpuHasAvx2()) k.emplace_back("avx2", RasterKernels::kAvx2);
+  return k;
+}
+
+// runnableKernels() and, where the CPU has it, avx512, whose forward and backward are
+// avx2's: only the Fisher pass differs.
+inline std::vector<std::pair<const char*, RasterKernels>> runnableFisherKernels() {
+  auto k = runnableKernels();
   if (rasterCpuHasAvx512()) k.emplace_back("avx512", RasterKernels::kAvx512);
   return k;
 }

@@ -37,16 +37,17 @@ TEST(RasterExecution, ReportsTheKernelsItUses) {
   const bool only_avx2 = env && std::strcmp(env, "avx2") == 0;
   const char* best = rasterCpuHasAvx512() && !only_avx2 ? "avx512" : rasterCpuHasAvx2() ? "avx2" : "baseline";
   EXPECT_STREQ(rasterKernelName(RasterExecution{}), opt_out ? "baseline" : best);
-  if (rasterCpuHasAvx2())
+  if (rasterCpuHasAvx2()) {
     EXPECT_STREQ(rasterKernelName(RasterExecution{.kernels = RasterKernels::kAvx2}), "avx2");
-  else
+  } else {
     EXPECT_THROW(rasterKernelName(RasterExecution{.kernels = RasterKernels::kAvx2}), std::invalid_argument);
-  if (rasterCpuHasAvx512())
+  }
+  if (rasterCpuHasAvx512()) {
     EXPECT_STREQ(rasterKernelName(RasterExecution{.kernels = RasterKernels::kAvx512}), "avx512");
-  else
+    EXPECT_TRUE(rasterCpuHasAvx2());  // avx512's forward and backward are avx2's
+  } else {
     EXPECT_THROW(rasterKernelName(RasterExecution{.kernels = RasterKernels::kAvx512}), std::invalid_argument);
-  // avx512 needs avx2 (its forward and backward are avx2's).
-  if (rasterCpuHasAvx512()) EXPECT_TRUE(rasterCpuHasAvx2());
+  }
 }
 
 // A render with the default kernels is, bit for bit, the render with the kernels they

@@ -109,7 +109,8 @@ TEST_P(FloatPath, MatchesDoublePath) {
   }
 }
 
-// The two kernel sets differ only in rounding (FMA, the order lanes are summed).
+// The baseline and avx2 kernel sets differ only in rounding (FMA, the order lanes are
+// summed); avx512 is avx2 bit for bit (Fisher.Avx512WalkEqualsAvx2BitForBit).
 TEST(FloatPath, KernelSetsAgree) {
   const Camera cam = test::smallCamera(72, 56);
   const Gaussians g = test::randomScene<double>(300, 2, 9, 1.2).cast<float>();
