@@ -3,7 +3,6 @@
 
 #include <chrono>
 #include <cstdlib>
-#include <cstring>
 #include <algorithm>
 #include <map>
 #include <memory>
@@ -45,8 +44,7 @@ int kernelIndex(RasterKernels kernels) {
   // at the next render.
   static const int index = [] {
     const char* env = std::getenv("SARESGS_RASTER_ISA");
-    if (!env) return rasterCpuHasAvx512() ? 2 : rasterCpuHasAvx2() ? 1 : 0;
-    const std::optional<RasterKernels> k = parseRasterKernels(env);
+    const std::optional<RasterKernels> k = env ? parseRasterKernels(env) : RasterKernels::kDefault;
     if (!k)
       throw std::invalid_argument(std::string("environment SARESGS_RASTER_ISA='") + env +
                                   "': expected baseline, avx2, avx512 or default");

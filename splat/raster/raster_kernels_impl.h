@@ -620,6 +620,10 @@ void fisherTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1
     const TileGaussian<float>& g = q[jj];
     const vf jv = vs(static_cast<float>(jj));
     const vf colsum = vs(g.col[0] + g.col[1] + g.col[2]);
+    // The 19 moment sums, lanes not yet added, padded to whole vectors.
+    constexpr int kPadded = (M + L - 1) / L * L;
+    vf m[kPadded];
+    for (int k = M; k < kPadded; ++k) m[k] = zero;
 #if SARESGS_KERNEL_FISHER_ONE_PASS
     // One pass: the walk's e and wc go straight into the 19 accumulators, each summed
     // with the same operations, in the same block order, as in the three passes below.
@@ -653,9 +657,6 @@ void fisherTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1
       e13 = fma(e2yy, xy, e13);
       e04 = fma(e2yy, yy, e04);
     });
-    constexpr int kPadded = (M + L - 1) / L * L;
-    vf m[kPadded];
-    for (int k = M; k < kPadded; ++k) m[k] = zero;
     m[kE00] = e00, m[kE20] = e20, m[kE11] = e11, m[kE02] = e02, m[kF10] = f10, m[kF01] = f01, m[kW] = ww;
     m[kE30] = e30, m[kE21] = e21, m[kE12] = e12, m[kE03] = e03, m[kF20] = f20, m[kF11] = f11, m[kF02] = f02;
     m[kE40] = e40, m[kE31] = e31, m[kE22] = e22, m[kE13] = e13, m[kE04] = e04;
@@ -679,9 +680,6 @@ void fisherTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1
       dx = (vs(static_cast<float>(x0 + b % kBX * kBW)) + lane_x) - mx;
       dy = (vs(static_cast<float>(y0 + b / kBX * kBH)) + lane_y) - my;
     };
-    constexpr int kPadded = (M + L - 1) / L * L;
-    vf m[kPadded];
-    for (int k = M; k < kPadded; ++k) m[k] = zero;
     {
       vf e00 = zero, e20 = zero, e11 = zero, e02 = zero, f10 = zero, f01 = zero, ww = zero;
       for (int n = 0; n < nb; ++n) {
