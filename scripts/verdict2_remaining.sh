@@ -46,6 +46,7 @@ subset("f_stage4_plain", 4, ["fisher", "resgs", "fisher-logdet"], [0, 1, 2, 3],
        [{"name": "default", "methods": ["resgs", "fisher-logdet", "fisher"]},
         {"name": "replay-fisher", "methods": ["resgs"], "replay": "fisher"}])
 subset("g_stage4_sahash", 4, ["sa-hash"], [0, 1, 2, 3])
+subset("b2_logdet_s03", 4, ["fisher-logdet"], [0, 1, 2, 3])
 EOF
 run() {  # binary, config[, out folder]; a failed job is reported and left for the next start
   if ! nice -n 19 "$1" ablate --config "$2" --out "${3:-results/verdict2}" --shard "$me/2" >> "$work/shard$me.log" 2>&1; then
@@ -73,7 +74,10 @@ rm -f "$work"/done_*_"$me"
 if [ -n "${PAPER:-}" ]; then run "$PAPER" results/grid_paper_preset.json results/paper_preset; fi
 run "$old" "$work/a_fisher_fvs_s47.json"
 run "$old" "$work/b_random_s03.json"
-barrier b_random_s03 a_fisher_fvs_s47
+# fisher-logdet (the D-optimal selector, the one stage-4 method that could change the
+# target's answer) before the rest, so that neither shard waits idle at the barrier
+run "$old" "$work/b2_logdet_s03.json"
+barrier b2_logdet_s03 a_fisher_fvs_s47 b_random_s03
 run "$emb" results/grid_hash.json
 run "$emb" "$work/c_hybrid_s03.json"
 run "$emb" "$work/d_saresgs_s47.json"
