@@ -48,10 +48,22 @@ subset("f_stage4_plain", 4, ["fisher", "resgs", "fisher-logdet"], [0, 1, 2, 3],
 subset("g_stage4_sahash", 4, ["sa-hash"], [0, 1, 2, 3])
 subset("b2_logdet_s03", 4, ["fisher-logdet"], [0, 1, 2, 3])
 EOF
-run() {  # binary, config[, out folder]; a failed job is reported and left for the next start
-  if ! nice -n 19 "$1" ablate --config "$2" --out "${3:-results/verdict2}" --shard "$me/2" >> "$work/shard$me.log" 2>&1; then
-    echo "verdict2_remaining: $(basename "$2") had a failed job (see above); going on" >> "$work/shard$me.log"
+ablate_share() {  # binary, config, out folder, shard; a failed job is reported and left for the next start
+  if ! nice -n 19 "$1" ablate --config "$2" --out "$3" --shard "$4/2" >> "$work/shard$me.log" 2>&1; then
+    echo "verdict2_remaining: $(basename "$2") (shard $4/2) had a failed job (see above); going on" >> "$work/shard$me.log"
   fi
+}
+run() {  # binary, config[, out folder]: this shard's share of the config
+  ablate_share "$1" "$2" "${3:-results/verdict2}" "$me"
+  touch "$work/done_$(basename "$2" .json)_$me"
+}
+# For binaries that take a lock per job (864af66, 5b76fc9): this shard's share, then the
+# other shard's, so that the shard that finishes first takes the other's pending jobs instead
+# of waiting idle at the next barrier (a job runs once whichever shard reaches it; a shard
+# that meets a job held by the other waits for it to finish there).
+run_locked() {
+  ablate_share "$1" "$2" "${3:-results/verdict2}" "$me"
+  ablate_share "$1" "$2" "${3:-results/verdict2}" "$other"
   touch "$work/done_$(basename "$2" .json)_$me"
 }
 # Waits until the other shard has finished config $1 in this run: its mark is there and no
@@ -71,18 +83,18 @@ barrier() {
   done
 }
 rm -f "$work"/done_*_"$me"
-if [ -n "${PAPER:-}" ]; then run "$PAPER" results/grid_paper_preset.json results/paper_preset; fi
-run "$old" "$work/a_fisher_fvs_s47.json"
-run "$old" "$work/b_random_s03.json"
+if [ -n "${PAPER:-}" ]; then run_locked "$PAPER" results/grid_paper_preset.json results/paper_preset; fi
+run_locked "$old" "$work/a_fisher_fvs_s47.json"
+run_locked "$old" "$work/b_random_s03.json"
 # fisher-logdet (the D-optimal selector, the one stage-4 method that could change the
 # target's answer) before the rest, so that neither shard waits idle at the barrier
-run "$old" "$work/b2_logdet_s03.json"
+run_locked "$old" "$work/b2_logdet_s03.json"
 barrier b2_logdet_s03 a_fisher_fvs_s47 b_random_s03
 run "$emb" results/grid_hash.json
 run "$emb" "$work/c_hybrid_s03.json"
 run "$emb" "$work/d_saresgs_s47.json"
-run "$old" "$work/e_random_s47.json"
-run "$old" "$work/f_stage4_plain.json"
+run_locked "$old" "$work/e_random_s47.json"
+run_locked "$old" "$work/f_stage4_plain.json"
 barrier f_stage4_plain grid_hash c_hybrid_s03 d_saresgs_s47 e_random_s47
 run "$emb" "$work/g_stage4_sahash.json"
 echo "verdict2_remaining: shard $me done" >> "$work/shard$me.log"
