@@ -138,24 +138,24 @@ void backwardTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, 
 
 // A full render and the render of a subset of its Gaussians in one walk of the full tile
 // lists (splat/raster/raster_kernels_pair_impl.h): in_subset[j] (per tile entry) says
-// whether entry j is in the subset. Each output is bit-identical to the single-render
+// whether entry j is in the subset. Each render is bit-identical to the single-render
 // kernel's, run on that render's own tile lists, except that the subset's n_walked counts
-// full-list entries. The backward writes each branch's sums to its own slot array at the
-// full render's pair slots (an entry outside the subset leaves its subset slot alone).
+// full-list entries. The backward writes the sum of the two branches' sums at the full
+// render's pair slots (every entry's slot, zeros where neither branch walks it): equal to
+// the two single backward passes' slots added, up to float rounding.
 using CompositePairFn = void (*)(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0,
                                  int y0, int x1, int y1, const float bg[3], const ForwardOut& full,
                                  const ForwardOut& subset);
 using BackwardPairFn = void (*)(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0,
                                 int y0, int x1, int y1, const float bg[3], const BackwardIn& full,
-                                const BackwardIn& subset, const std::uint32_t* entry_slot, float* slots_full,
-                                float* slots_subset);
+                                const BackwardIn& subset, const std::uint32_t* entry_slot, float* slots);
 
 namespace base4 {
 void compositeTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0,
                        int x1, int y1, const float bg[3], const ForwardOut& full, const ForwardOut& subset);
 void backwardTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0, int x1,
                       int y1, const float bg[3], const BackwardIn& full, const BackwardIn& subset,
-                      const std::uint32_t* entry_slot, float* slots_full, float* slots_subset);
+                      const std::uint32_t* entry_slot, float* slots);
 }  // namespace base4
 
 namespace avx2 {
@@ -163,7 +163,7 @@ void compositeTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subs
                        int x1, int y1, const float bg[3], const ForwardOut& full, const ForwardOut& subset);
 void backwardTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0, int x1,
                       int y1, const float bg[3], const BackwardIn& full, const BackwardIn& subset,
-                      const std::uint32_t* entry_slot, float* slots_full, float* slots_subset);
+                      const std::uint32_t* entry_slot, float* slots);
 }  // namespace avx2
 
 }  // namespace raster_kernels

@@ -719,18 +719,17 @@ void rasterizeBackwardWithSubset(const Gaussians& g, const Camera& cam, const Ra
   const std::size_t n = g.size();
   const std::uint32_t pairs = st.gauss_start[n];
   constexpr int kSlot = 9;  // opacity, mean2d (2), conic (3), colour (3), as rasterizeBackwardT
-  // Both branches' slots at the full render's pair slots: for a Gaussian in the subset
-  // these are the subset render's own tiles in the same order, so each branch's sums are
-  // those of its own backward pass, bit for bit, up to the chain rule below.
-  // Per-thread scratch kept between calls, like the loss's: the two branches' slots are
-  // the largest buffers of a residual step, and allocating them afresh every step made
-  // the allocator hand the memory back and fault it in again each time (about 13 MB of
-  // page faults per 512x384 step, more than the loss itself costs).
+  // One slot per (tile, Gaussian) pair of the full render, holding the sum of both
+  // branches' sums (the kernel adds them as it walks; for a Gaussian in the subset its
+  // subset entries are the subset render's own, in the same order).
+  // Per-thread scratch kept between calls, like the loss's: the slots are the largest
+  // buffer of a residual step, and allocating it afresh every step made the allocator
+  // hand the memory back and fault it in again each time (about 13 MB of page faults per
+  // 512x384 step, more than the loss itself costs). The kernel writes every slot.
   thread_local std::vector<float> scratch;
-  const std::size_t branch_size = static_cast<std::size_t>(pairs) * kSlot;
-  assignKept(scratch, 2 * branch_size, 0.0f);
-  float* const slots_full_p = scratch.data();
-  float* const slots_sub_p = scratch.data() + branch_size;
+  reserveKept(scratch, static_cast<std::size_t>(pairs) * kSlot);
+  scratch.resize(static_cast<std::size_t>(pairs) * kSlot);
+  float* const slots_p = scratch.data();
   const float bg[3] = {rs.background[0], rs.background[1], rs.background[2]};
   const raster_kernels::BackwardIn in_full{W, st.final_T.data(), st.n_walked.data(), dL_drgb_full.data.data()};
   const raster_kernels::BackwardIn in_sub{W, ss.final_T.data(), ss.n_walked.data(), dL_drgb_subset.data.data()};
@@ -745,7 +744,7 @@ void rasterizeBackwardWithSubset(const Gaussians& g, const Camera& cam, const Ra
       tilePixels(st, tile, W, H, x0, y0, x1, y1);
       const std::uint32_t b = st.tile_start[tile];
       kernel(q.data(), ss.entry_in_subset.data() + b, static_cast<int>(q.size()), x0, y0, x1, y1, bg, in_full,
-             in_sub, &st.entry_slot[b], slots_full_p, slots_sub_p);
+             in_sub, &st.entry_slot[b], slots_p);
     });
   });
 
@@ -755,36 +754,27 @@ void rasterizeBackwardWithSubset(const Gaussians& g, const Camera& cam, const Ra
       const FloatEnvGuard fenv;  // geometry/float_env.h
       for (std::size_t i = r.begin(); i < r.end(); ++i) {
         if (st.gauss_start[i] == st.gauss_start[i + 1]) continue;
-        // Each branch's slots are reduced in slot order, as the single backward does; the
-        // two projected gradients are then added and chained once. The chain rule
-        // (projectBackward) is linear in them and costs about as much per Gaussian as
-        // its whole walk, so one call instead of two saves ~7 ms of a 256x192, 40k
-        // step; the price is rounding: the parameters get chain(full + subset) instead
-        // of chain(full) + chain(subset).
-        ProjectedGrad<float> dP[2];
-        for (int b = 0; b < 2; ++b) {
-          if (b == 1 && !ss.mask[i]) break;
-          const float* slots = b == 0 ? slots_full_p : slots_sub_p;
-          for (std::uint32_t k = st.gauss_start[i]; k < st.gauss_start[i + 1]; ++k) {
-            const float* sl = &slots[static_cast<std::size_t>(k) * kSlot];
-            dP[b].opacity += sl[0];
-            dP[b].mean2d[0] += sl[1];
-            dP[b].mean2d[1] += sl[2];
-            for (int c = 0; c < 3; ++c) dP[b].conic[c] += sl[3 + c];
-            for (int c = 0; c < 3; ++c) dP[b].color[c] += sl[6 + c];
-          }
+        // The slots are reduced in slot order, as the single backward does, and chained
+        // once. The chain rule (projectBackward) is linear in the projected gradients and
+        // costs about as much per Gaussian as its whole walk, so one call instead of one
+        // per branch saves ~7 ms of a 256x192, 40k step; the price is rounding: the
+        // parameters get chain(full + subset) instead of chain(full) + chain(subset).
+        ProjectedGrad<float> dP;
+        for (std::uint32_t k = st.gauss_start[i]; k < st.gauss_start[i + 1]; ++k) {
+          const float* sl = &slots_p[static_cast<std::size_t>(k) * kSlot];
+          dP.opacity += sl[0];
+          dP.mean2d[0] += sl[1];
+          dP.mean2d[1] += sl[2];
+          for (int c = 0; c < 3; ++c) dP.conic[c] += sl[3 + c];
+          for (int c = 0; c < 3; ++c) dP.color[c] += sl[6 + c];
         }
-        dP[0].opacity += dP[1].opacity;
-        for (int c = 0; c < 2; ++c) dP[0].mean2d[c] += dP[1].mean2d[c];
-        for (int c = 0; c < 3; ++c) dP[0].conic[c] += dP[1].conic[c];
-        for (int c = 0; c < 3; ++c) dP[0].color[c] += dP[1].color[c];
         // Both branches' 2D-mean gradients, as the two separate passes would add them
         // (densification's statistics read their sum).
         if (grad_mean2d) {
-          (*grad_mean2d)[2 * i] += dP[0].mean2d[0];
-          (*grad_mean2d)[2 * i + 1] += dP[0].mean2d[1];
+          (*grad_mean2d)[2 * i] += dP.mean2d[0];
+          (*grad_mean2d)[2 * i + 1] += dP.mean2d[1];
         }
-        projection::projectBackward(g, i, camT, rs, st.proj[i], dP[0], projection::ParamGradRef<float>::of(grad, i));
+        projection::projectBackward(g, i, camT, rs, st.proj[i], dP, projection::ParamGradRef<float>::of(grad, i));
       }
     });
   });
