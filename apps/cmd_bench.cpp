@@ -323,6 +323,9 @@ struct TrainBenchArgs {
   int threads = 0;
   int compare_steps = 21;
   std::uint64_t seed = 0;
+  // Residual supervision (the main job's training): times it against a plain trainer from
+  // the same start, the two alternated in chunks so that the machine's drift hits both.
+  bool residual = false;
 };
 
 // The dataset to train on: the given folder, or the built-in room360 scene at the
@@ -353,33 +356,61 @@ int runTrainBench(const TrainBenchArgs& a) {
   TrainerOptions opt;
   opt.seed = a.seed;
   opt.raster.execution.threads = a.threads;
+  TrainerOptions plain_opt = opt;
+  opt.residual.enabled = a.residual;
   Trainer trainer(scene, opt);
+  // With --residual: a plain trainer from the same start, timed in alternation.
+  std::optional<Trainer> plain;
+  if (a.residual) plain.emplace(scene, plain_opt);
   // Decoding the images is paid once per view in a real run; timed apart here.
   auto t0 = std::chrono::steady_clock::now();
   for (int v : scene.train) (void)scene.image(v);
   const double decode_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const std::size_t gaussians_start = trainer.gaussians().size();
   trainer.train(scene.train, a.warmup);
+  if (plain) plain->train(scene.train, a.warmup);
   const StageSeconds s0 = trainer.seconds();
+  const StageSeconds p0 = plain ? plain->seconds() : StageSeconds{};
   const std::uint64_t allocs0 = heapAllocations(), faults0 = pageFaults();
-  std::vector<double> it_ms;
-  auto last = std::chrono::steady_clock::now();
-  t0 = last;
-  trainer.train(scene.train, a.iterations, [&](const TrainProgress&) {
-    const auto now = std::chrono::steady_clock::now();
-    it_ms.push_back(std::chrono::duration<double, std::milli>(now - last).count());
-    last = now;
-  });
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const double allocs = static_cast<double>(heapAllocations() - allocs0) / a.iterations;
-  const double faults = static_cast<double>(pageFaults() - faults0) / a.iterations;
-  const StageSeconds& s1 = trainer.seconds();
+  std::vector<double> it_ms, plain_it_ms;
+  double wall = 0, plain_wall = 0;
+  // Runs n iterations of t, appending each one's time; returns the chunk's wall seconds.
+  auto timeChunk = [&](Trainer& t, int n, std::vector<double>& ms) {
+    auto last = std::chrono::steady_clock::now();
+    const auto start = last;
+    t.train(scene.train, n, [&](const TrainProgress&) {
+      const auto now = std::chrono::steady_clock::now();
+      ms.push_back(std::chrono::duration<double, std::milli>(now - last).count());
+      last = now;
+    });
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  constexpr int kChunk = 10;
+  for (int done = 0; done < a.iterations;) {
+    const int n = plain ? std::min(kChunk, a.iterations - done) : a.iterations;
+    wall += timeChunk(trainer, n, it_ms);
+    if (plain) plain_wall += timeChunk(*plain, n, plain_it_ms);
+    done += n;
+  }
+  // Allocations and faults per iteration of either trainer (they share the process).
+  const int timed = a.iterations * (plain ? 2 : 1);
+  const double allocs = static_cast<double>(heapAllocations() - allocs0) / timed;
+  const double faults = static_cast<double>(pageFaults() - faults0) / timed;
   const double k = 1e3 / a.iterations;
+  auto stages = [&](const StageSeconds& s1, const StageSeconds& b, double per) {
+    const double render = (s1.render - b.render) * k, loss = (s1.loss - b.loss) * k,
+                 backward = (s1.backward - b.backward) * k, adam = (s1.optimizer - b.optimizer) * k,
+                 densify = (s1.densify - b.densify) * k;
+    return nlohmann::json{{"render", render}, {"loss", loss}, {"backward", backward}, {"adam", adam},
+                          {"densify", densify}, {"other", per - (render + loss + backward + adam + densify)}};
+  };
+  const StageSeconds& s1 = trainer.seconds();
   const double render = (s1.render - s0.render) * k, loss = (s1.loss - s0.loss) * k,
                backward = (s1.backward - s0.backward) * k, adam = (s1.optimizer - s0.optimizer) * k,
                densify = (s1.densify - s0.densify) * k;
   const double per_it = 1e3 * wall / a.iterations;
   std::sort(it_ms.begin(), it_ms.end());
+  std::sort(plain_it_ms.begin(), plain_it_ms.end());
 
   // The trained model's footprint, on the first train view.
   const Camera& cam = scene.views[scene.train.front()].camera;
@@ -401,11 +432,12 @@ int runTrainBench(const TrainBenchArgs& a) {
   rs.sh_degree = b.sh_degree;
   rs.execution.threads = b.threads;
   const ImageF target = rasterize(benchScene(b, b.seed + 1000, bcam), bcam, rs).rgb;
-  const StepTimes st = timeSteps(b, bcam, target, false);
+  const StepTimes st = timeSteps(b, bcam, target, a.residual);
   const double sk = 1e3 / b.steps;
 
   nlohmann::json j;
   j["benchmark"] = "train";
+  j["residual"] = a.residual;
   j["dataset"] = path;
   j["width"] = cam.K.width;
   j["height"] = cam.K.height;
@@ -420,8 +452,16 @@ int runTrainBench(const TrainBenchArgs& a) {
   j["iterations_per_second"] = a.iterations / wall;
   j["mean_iteration_ms"] = per_it;
   j["median_iteration_ms"] = it_ms[it_ms.size() / 2];
-  j["stage_ms"] = {{"render", render}, {"loss", loss}, {"backward", backward}, {"adam", adam},
-                   {"densify", densify}, {"other", per_it - (render + loss + backward + adam + densify)}};
+  j["stage_ms"] = stages(s1, s0, per_it);
+  if (plain) {
+    const double plain_per_it = 1e3 * plain_wall / a.iterations;
+    j["plain"] = {{"iterations_per_second", a.iterations / plain_wall},
+                  {"mean_iteration_ms", plain_per_it},
+                  {"median_iteration_ms", plain_it_ms[plain_it_ms.size() / 2]},
+                  {"gaussians_end", plain->gaussians().size()},
+                  {"stage_ms", stages(plain->seconds(), p0, plain_per_it)}};
+    j["residual_to_plain_ratio"] = per_it / plain_per_it;
+  }
   j["image_decode_ms_per_view"] = 1e3 * decode_s / static_cast<double>(std::max<std::size_t>(1, scene.train.size()));
   j["mean_contributors_per_pixel"] = contrib;
   j["allocations_per_iteration"] = allocs;
@@ -625,6 +665,8 @@ void addBenchCommand(CLI::App& app, Action& action) {
   train->add_option("--compare-steps", tr->compare_steps, "Timed steps of the same-size `bench step`")->check(CLI::Range(1, 100000))->capture_default_str();
   train->add_option("--threads", tr->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
   train->add_option("--seed", tr->seed, "Trainer seed")->check(wholeNumberAtLeast(0))->capture_default_str();
+  train->add_flag("--residual", tr->residual,
+                  "Train with residual supervision, alternated in chunks of 10 iterations with a plain trainer from the same start; reports both and their ratio");
   train->callback([&action, tr] { action = [tr] { return runTrainBench(*tr); }; });
 
   auto o = std::make_shared<OccupancyBenchArgs>();

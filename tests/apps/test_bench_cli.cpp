@@ -174,6 +174,25 @@ TEST(BenchCli, TrainTimesRealIterationsByStageBesideTheSameSizeStep) {
   EXPECT_EQ(j.at("bench_step_same_size").at("mean_contributors_per_pixel").is_number(), true);
   EXPECT_GE(j.at("allocations_per_iteration").get<double>(), 0.0);
 
+  EXPECT_EQ(j.at("residual"), false);
+  EXPECT_FALSE(j.contains("plain"));
+
+  // --residual: the residual trainer beside a plain one from the same start, each by stage.
+  r = saresgs::test::runCommand(std::string(SARESGS_CLI) + " bench train --dataset " + data +
+                                " --residual --iterations 13 --warmup 1 --compare-steps 2 --threads 1 2>/dev/null");
+  ASSERT_TRUE(oneJsonLine(r, j));
+  EXPECT_EQ(j.at("residual"), true);
+  ASSERT_TRUE(j.contains("plain"));
+  const nlohmann::json& p = j["plain"];
+  for (const nlohmann::json* t : std::initializer_list<const nlohmann::json*>{&j, &p}) {
+    double total = 0;
+    for (const char* k : {"render", "loss", "backward", "adam", "densify", "other"}) total += t->at("stage_ms").at(k).get<double>();
+    EXPECT_NEAR(total, t->at("mean_iteration_ms").get<double>(), 1e-6 * (1 + total));
+    EXPECT_GT(t->at("mean_iteration_ms").get<double>(), 0.0);
+  }
+  EXPECT_NEAR(j.at("residual_to_plain_ratio").get<double>(),
+              j["mean_iteration_ms"].get<double>() / p["mean_iteration_ms"].get<double>(), 1e-9);
+
   r = run("bench train --dataset " + d.file("missing") + " --iterations 2");
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.output.find("missing"), std::string::npos) << r.output;
