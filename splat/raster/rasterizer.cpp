@@ -575,6 +575,41 @@ struct SubsetRasterState {
 
 namespace {
 
+// The backward's last stage, shared by the single and the pair backward: each Gaussian's
+// (tile, Gaussian) pair slots (opacity, mean2d (2), conic (3), colour (3)) reduced in slot
+// order, its 2D-mean gradient added to grad_mean2d (densification's statistic), and the
+// sum chained to its parameters (projectBackward).
+template <typename T>
+void chainSlots(const GaussiansT<T>& g, const Camera& cam, const RasterStateT<T>& st, const T* slots,
+                GaussiansT<T>& grad, std::vector<T>* grad_mean2d) {
+  constexpr int kSlot = 9;
+  const RasterSettings& rs = st.settings;
+  const std::size_t n = g.size();
+  arena(st).execute([&] {
+    const CameraT<T> camT(cam, T(rs.guard_band));
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& r) {
+      const FloatEnvGuard fenv;  // geometry/float_env.h
+      for (std::size_t i = r.begin(); i < r.end(); ++i) {
+        if (st.gauss_start[i] == st.gauss_start[i + 1]) continue;
+        ProjectedGrad<T> dP;
+        for (std::uint32_t k = st.gauss_start[i]; k < st.gauss_start[i + 1]; ++k) {
+          const T* sl = &slots[static_cast<std::size_t>(k) * kSlot];
+          dP.opacity += sl[0];
+          dP.mean2d[0] += sl[1];
+          dP.mean2d[1] += sl[2];
+          for (int c = 0; c < 3; ++c) dP.conic[c] += sl[3 + c];
+          for (int c = 0; c < 3; ++c) dP.color[c] += sl[6 + c];
+        }
+        if (grad_mean2d) {
+          (*grad_mean2d)[2 * i] += dP.mean2d[0];
+          (*grad_mean2d)[2 * i + 1] += dP.mean2d[1];
+        }
+        projection::projectBackward(g, i, camT, rs, st.proj[i], dP, projection::ParamGradRef<T>::of(grad, i));
+      }
+    });
+  });
+}
+
 struct PairKernelSet {
   raster_kernels::CompositePairFn composite;
   raster_kernels::BackwardPairFn backward;
@@ -748,36 +783,13 @@ void rasterizeBackwardWithSubset(const Gaussians& g, const Camera& cam, const Ra
     });
   });
 
-  arena(st).execute([&] {
-    const CameraT<float> camT(cam, rs.guard_band);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& r) {
-      const FloatEnvGuard fenv;  // geometry/float_env.h
-      for (std::size_t i = r.begin(); i < r.end(); ++i) {
-        if (st.gauss_start[i] == st.gauss_start[i + 1]) continue;
-        // The slots are reduced in slot order, as the single backward does, and chained
-        // once. The chain rule (projectBackward) is linear in the projected gradients and
-        // costs about as much per Gaussian as its whole walk, so one call instead of one
-        // per branch saves ~7 ms of a 256x192, 40k step; the price is rounding: the
-        // parameters get chain(full + subset) instead of chain(full) + chain(subset).
-        ProjectedGrad<float> dP;
-        for (std::uint32_t k = st.gauss_start[i]; k < st.gauss_start[i + 1]; ++k) {
-          const float* sl = &slots_p[static_cast<std::size_t>(k) * kSlot];
-          dP.opacity += sl[0];
-          dP.mean2d[0] += sl[1];
-          dP.mean2d[1] += sl[2];
-          for (int c = 0; c < 3; ++c) dP.conic[c] += sl[3 + c];
-          for (int c = 0; c < 3; ++c) dP.color[c] += sl[6 + c];
-        }
-        // Both branches' 2D-mean gradients, as the two separate passes would add them
-        // (densification's statistics read their sum).
-        if (grad_mean2d) {
-          (*grad_mean2d)[2 * i] += dP.mean2d[0];
-          (*grad_mean2d)[2 * i + 1] += dP.mean2d[1];
-        }
-        projection::projectBackward(g, i, camT, rs, st.proj[i], dP, projection::ParamGradRef<float>::of(grad, i));
-      }
-    });
-  });
+  // The slots hold both branches' sums, so each Gaussian is chained once. The chain rule
+  // (projectBackward) is linear in the projected gradients and costs about as much per
+  // Gaussian as its whole walk, so one call instead of one per branch saves ~7 ms of a
+  // 256x192, 40k step; the price is rounding: the parameters get chain(full + subset)
+  // instead of chain(full) + chain(subset). grad_mean2d gets both branches' 2D-mean
+  // gradients, as the two separate passes would add them.
+  chainSlots(g, cam, st, slots_p, grad, grad_mean2d);
 }
 
 namespace {
@@ -894,7 +906,6 @@ void rasterizeBackwardT(const GaussiansT<T>& g, const Camera& cam, const RasterS
                         const RenderOutputT<T>& fwd, const T* dL_drgb, GaussiansT<T>& grad,
                         std::vector<T>* grad_mean2d) {
   const RasterStateT<T>& st = *fwd.state;
-  const RasterSettings& rs = st.settings;
   const int W = fwd.width, H = fwd.height;
   const std::size_t n = g.size();
   const std::uint32_t pairs = st.gauss_start[n];
@@ -913,32 +924,7 @@ void rasterizeBackwardT(const GaussiansT<T>& g, const Camera& cam, const RasterS
   }
   T* const slots = std::is_same_v<T, float> ? scratch.data() : cleared.data();
   backwardSlots(st, W, H, dL_drgb, slots);
-
-  arena(st).execute([&] {
-    // Reduce each Gaussian's slots in slot order, then chain to its parameters.
-    const CameraT<T> camT(cam, T(rs.guard_band));
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& r) {
-      const FloatEnvGuard fenv;  // geometry/float_env.h
-      for (std::size_t i = r.begin(); i < r.end(); ++i) {
-        if (st.gauss_start[i] == st.gauss_start[i + 1]) continue;
-        ProjectedGrad<T> dP;
-        for (std::uint32_t k = st.gauss_start[i]; k < st.gauss_start[i + 1]; ++k) {
-          const T* sl = &slots[static_cast<std::size_t>(k) * kSlot];
-          dP.opacity += sl[0];
-          dP.mean2d[0] += sl[1];
-          dP.mean2d[1] += sl[2];
-          for (int c = 0; c < 3; ++c) dP.conic[c] += sl[3 + c];
-          for (int c = 0; c < 3; ++c) dP.color[c] += sl[6 + c];
-        }
-        if (grad_mean2d) {
-          (*grad_mean2d)[2 * i] += dP.mean2d[0];
-          (*grad_mean2d)[2 * i + 1] += dP.mean2d[1];
-        }
-        projection::projectBackward(g, i, camT, rs, st.proj[i], dP,
-                                    projection::ParamGradRef<T>::of(grad, i));
-      }
-    });
-  });
+  chainSlots(g, cam, st, slots, grad, grad_mean2d);
 }
 
 namespace {
