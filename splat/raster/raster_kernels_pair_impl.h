@@ -17,6 +17,11 @@
 #if !defined(SARESGS_KERNEL_NS) || !defined(SARESGS_KERNEL_LANES)
 #error "include raster_kernels_impl.h (with its macros) before raster_kernels_pair_impl.h"
 #endif
+// SARESGS_KERNEL_PAIR_COMPOSITE_ONLY: only compositeTilePair is defined
+// (raster_kernels_avx512.cpp).
+#ifndef SARESGS_KERNEL_PAIR_COMPOSITE_ONLY
+#define SARESGS_KERNEL_PAIR_COMPOSITE_ONLY 0
+#endif
 
 namespace saresgs::raster_kernels::SARESGS_KERNEL_NS {
 
@@ -46,6 +51,7 @@ void compositeTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subs
   S.write(x0, y0, w, h, bg, subset);
 }
 
+#if !SARESGS_KERNEL_PAIR_COMPOSITE_ONLY
 namespace {
 
 template <bool kBg>
@@ -113,5 +119,6 @@ void backwardTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subse
   else
     backwardTilePairImpl<false>(q, in_subset, nq, x0, y0, x1, y1, bg, full, subset, entry_slot, slots);
 }
+#endif  // !SARESGS_KERNEL_PAIR_COMPOSITE_ONLY
 
 }  // namespace saresgs::raster_kernels::SARESGS_KERNEL_NS
