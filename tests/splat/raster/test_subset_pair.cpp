@@ -200,7 +200,9 @@ TEST(SubsetPair, BackwardEqualsTwoSeparateBackwardPasses) {
           scale = std::max(scale, static_cast<double>(std::abs(a[k])));
           diff = std::max(diff, static_cast<double>(std::abs(a[k] - b[k])));
         }
-        if (compare) EXPECT_LE(diff, 1e-4 * scale) << name;
+        if (compare) {
+          EXPECT_LE(diff, 1e-4 * scale) << name;
+        }
       };
       close(ref.grad.means, got.grad.means, "means");
       close(ref.grad.log_scales, got.grad.log_scales, "log_scales");
