@@ -525,6 +525,12 @@ struct BackwardColour {
       : col0(vs(g.col[0])), col1(vs(g.col[1])), col2(vs(g.col[2])), jv(vs(static_cast<float>(jj))) {}
 };
 
+// A pair slot no walk reaches (the kernels write every slot, so callers need no cleared
+// buffer).
+inline void zeroSlot(float* slots, std::uint32_t slot) {
+  std::memset(&slots[static_cast<std::size_t>(slot) * kSlot], 0, sizeof(float) * kSlot);
+}
+
 inline GradSums zeroSums() {
   const vf z = vs(0.0f);
   return GradSums{z, z, z, z, z, z, z, z, z};
@@ -539,8 +545,7 @@ void backwardTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int 
                       const BackwardIn& in, const std::uint32_t* entry_slot, float* slots) {
   BackwardState B;
   B.init(x0, y0, x1 - x0, y1 - y0, bg, in);
-  for (int jj = static_cast<int>(B.jmax); jj < nq; ++jj)
-    std::memset(&slots[static_cast<std::size_t>(entry_slot[jj]) * kSlot], 0, sizeof(float) * kSlot);
+  for (int jj = static_cast<int>(B.jmax); jj < nq; ++jj) zeroSlot(slots, entry_slot[jj]);
   for (std::uint32_t jj = B.jmax; jj-- > 0;) {
     const TileGaussian<float>& g = q[jj];
     const BackwardColour bc(g, jj);

@@ -65,14 +65,13 @@ void backwardTilePairImpl(const TileGaussian<float>* q, const std::uint8_t* in_s
   const std::uint32_t jmax = F.jmax > S.jmax ? F.jmax : S.jmax;
   // Every entry's slot is written (zeros where neither branch walks it), so the caller
   // needs no cleared buffer.
-  for (int jj = static_cast<int>(jmax); jj < nq; ++jj)
-    std::memset(&slots[static_cast<std::size_t>(entry_slot[jj]) * kSlot], 0, sizeof(float) * kSlot);
+  for (int jj = static_cast<int>(jmax); jj < nq; ++jj) zeroSlot(slots, entry_slot[jj]);
   for (std::uint32_t jj = jmax; jj-- > 0;) {
     // Beyond a branch's walk, or outside the subset, its single-render kernel adds nothing
     // for this entry and its state does not change.
     const bool do_full = jj < F.jmax, do_sub = jj < S.jmax && in_subset[jj] != 0;
     if (!do_full && !do_sub) {
-      std::memset(&slots[static_cast<std::size_t>(entry_slot[jj]) * kSlot], 0, sizeof(float) * kSlot);
+      zeroSlot(slots, entry_slot[jj]);
       continue;
     }
     const TileGaussian<float>& g = q[jj];

@@ -575,14 +575,33 @@ struct SubsetRasterState {
 
 namespace {
 
+// The backward's slot per (tile, Gaussian) pair: opacity, mean2d (2), conic (3), colour (3).
+constexpr int kGradSlot = 9;
+
+// The float backward kernels' slots, kept per thread between calls (splat/kept_buffers.h:
+// a call nested in a TBB wait gets its own) and shared by the single and the pair
+// backward. They are the largest buffer of a step: allocating them afresh every step made
+// the allocator hand the memory back and fault it in again each time (about 13 MB of page
+// faults per 512x384 residual step, more than the loss itself costs). Not cleared: the
+// kernels write every slot.
+struct GradSlots {
+  std::vector<float> v;
+};
+
+float* keptGradSlots(KeptBuffers<GradSlots>& kept, std::uint32_t pairs) {
+  std::vector<float>& v = kept.get().v;
+  reserveKept(v, static_cast<std::size_t>(pairs) * kGradSlot);
+  v.resize(static_cast<std::size_t>(pairs) * kGradSlot);
+  return v.data();
+}
+
 // The backward's last stage, shared by the single and the pair backward: each Gaussian's
-// (tile, Gaussian) pair slots (opacity, mean2d (2), conic (3), colour (3)) reduced in slot
-// order, its 2D-mean gradient added to grad_mean2d (densification's statistic), and the
-// sum chained to its parameters (projectBackward).
+// pair slots reduced in slot order, its 2D-mean gradient added to grad_mean2d
+// (densification's statistic), and the sum chained to its parameters (projectBackward).
 template <typename T>
 void chainSlots(const GaussiansT<T>& g, const Camera& cam, const RasterStateT<T>& st, const T* slots,
                 GaussiansT<T>& grad, std::vector<T>* grad_mean2d) {
-  constexpr int kSlot = 9;
+  constexpr int kSlot = kGradSlot;
   const RasterSettings& rs = st.settings;
   const std::size_t n = g.size();
   arena(st).execute([&] {
@@ -754,18 +773,11 @@ void rasterizeBackwardWithSubset(const Gaussians& g, const Camera& cam, const Ra
   const RasterSettings& rs = st.settings;
   const std::size_t n = g.size();
   const std::uint32_t pairs = st.gauss_start[n];
-  constexpr int kSlot = 9;  // opacity, mean2d (2), conic (3), colour (3), as rasterizeBackwardT
   // One slot per (tile, Gaussian) pair of the full render, holding the sum of both
   // branches' sums (the kernel adds them as it walks; for a Gaussian in the subset its
   // subset entries are the subset render's own, in the same order).
-  // Per-thread scratch kept between calls, like the loss's: the slots are the largest
-  // buffer of a residual step, and allocating it afresh every step made the allocator
-  // hand the memory back and fault it in again each time (about 13 MB of page faults per
-  // 512x384 step, more than the loss itself costs). The kernel writes every slot.
-  thread_local std::vector<float> scratch;
-  reserveKept(scratch, static_cast<std::size_t>(pairs) * kSlot);
-  scratch.resize(static_cast<std::size_t>(pairs) * kSlot);
-  float* const slots_p = scratch.data();
+  KeptBuffers<GradSlots> kept;
+  float* const slots_p = keptGradSlots(kept, pairs);
   const float bg[3] = {rs.background[0], rs.background[1], rs.background[2]};
   const raster_kernels::BackwardIn in_full{W, st.final_T.data(), st.n_walked.data(), dL_drgb_full.data.data()};
   const raster_kernels::BackwardIn in_sub{W, ss.final_T.data(), ss.n_walked.data(), dL_drgb_subset.data.data()};
@@ -870,7 +882,7 @@ void walkAllPixels(const RasterStateT<T>& st, int W, int H, Weights&& weights, V
 // float version below is the SIMD kernel with the same arithmetic per contribution.
 template <typename T>
 void backwardSlots(const RasterStateT<T>& st, int W, int H, const T* dL_drgb, T* slots) {
-  constexpr int kSlot = 9;
+  constexpr int kSlot = kGradSlot;
   walkAllPixels(
       st, W, H, [&](std::size_t pix) { return &dL_drgb[pix * 3]; },
       [&](std::uint32_t e, const TileGaussian<T>& q, T dx, T dy, T G, bool unclamped, T dL_dalpha, T wcol,
@@ -910,20 +922,17 @@ void rasterizeBackwardT(const GaussiansT<T>& g, const Camera& cam, const RasterS
   const int W = fwd.width, H = fwd.height;
   const std::size_t n = g.size();
   const std::uint32_t pairs = st.gauss_start[n];
-  // Per pair slot: opacity, mean2d (2), conic (3), colour (3). The float kernels write
-  // every slot, so their buffer is per-thread scratch kept between calls (not cleared,
-  // and not handed back to the allocator and faulted in again each step); the generic
-  // walk adds into cleared slots.
-  constexpr int kSlot = 9;
-  const std::size_t slot_count = static_cast<std::size_t>(pairs) * kSlot;
-  thread_local std::vector<T> scratch;
+  // The float kernels write every slot, so they take the kept slots (keptGradSlots); the
+  // generic walk adds into cleared slots.
+  KeptBuffers<GradSlots> kept;
   std::vector<T> cleared;
+  T* slots;
   if constexpr (std::is_same_v<T, float>) {
-    if (scratch.size() < slot_count) scratch.resize(slot_count);
+    slots = keptGradSlots(kept, pairs);
   } else {
-    cleared.assign(slot_count, T(0));
+    cleared.assign(static_cast<std::size_t>(pairs) * kGradSlot, T(0));
+    slots = cleared.data();
   }
-  T* const slots = std::is_same_v<T, float> ? scratch.data() : cleared.data();
   backwardSlots(st, W, H, dL_drgb, slots);
   chainSlots(g, cam, st, slots, grad, grad_mean2d);
 }
