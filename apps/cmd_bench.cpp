@@ -396,18 +396,19 @@ int runTrainBench(const TrainBenchArgs& a) {
   const int timed = a.iterations * (plain ? 2 : 1);
   const double allocs = static_cast<double>(heapAllocations() - allocs0) / timed;
   const double faults = static_cast<double>(pageFaults() - faults0) / timed;
+  // A trainer's stages over the timed iterations, in ms per iteration, and as JSON with
+  // what they leave of the mean iteration ("other").
   const double k = 1e3 / a.iterations;
-  auto stages = [&](const StageSeconds& s1, const StageSeconds& b, double per) {
-    const double render = (s1.render - b.render) * k, loss = (s1.loss - b.loss) * k,
-                 backward = (s1.backward - b.backward) * k, adam = (s1.optimizer - b.optimizer) * k,
-                 densify = (s1.densify - b.densify) * k;
-    return nlohmann::json{{"render", render}, {"loss", loss}, {"backward", backward}, {"adam", adam},
-                          {"densify", densify}, {"other", per - (render + loss + backward + adam + densify)}};
+  auto msPerIteration = [&](const StageSeconds& end, const StageSeconds& start) {
+    return StageSeconds{(end.render - start.render) * k, (end.loss - start.loss) * k,
+                        (end.backward - start.backward) * k, (end.optimizer - start.optimizer) * k,
+                        (end.densify - start.densify) * k};
   };
-  const StageSeconds& s1 = trainer.seconds();
-  const double render = (s1.render - s0.render) * k, loss = (s1.loss - s0.loss) * k,
-               backward = (s1.backward - s0.backward) * k, adam = (s1.optimizer - s0.optimizer) * k,
-               densify = (s1.densify - s0.densify) * k;
+  auto stages = [](const StageSeconds& ms, double per) {
+    return nlohmann::json{{"render", ms.render},   {"loss", ms.loss},       {"backward", ms.backward},
+                          {"adam", ms.optimizer}, {"densify", ms.densify}, {"other", per - ms.total()}};
+  };
+  const StageSeconds ms = msPerIteration(trainer.seconds(), s0);
   const double per_it = 1e3 * wall / a.iterations;
   std::sort(it_ms.begin(), it_ms.end());
   std::sort(plain_it_ms.begin(), plain_it_ms.end());
@@ -452,14 +453,14 @@ int runTrainBench(const TrainBenchArgs& a) {
   j["iterations_per_second"] = a.iterations / wall;
   j["mean_iteration_ms"] = per_it;
   j["median_iteration_ms"] = it_ms[it_ms.size() / 2];
-  j["stage_ms"] = stages(s1, s0, per_it);
+  j["stage_ms"] = stages(ms, per_it);
   if (plain) {
     const double plain_per_it = 1e3 * plain_wall / a.iterations;
     j["plain"] = {{"iterations_per_second", a.iterations / plain_wall},
                   {"mean_iteration_ms", plain_per_it},
                   {"median_iteration_ms", plain_it_ms[plain_it_ms.size() / 2]},
                   {"gaussians_end", plain->gaussians().size()},
-                  {"stage_ms", stages(plain->seconds(), p0, plain_per_it)}};
+                  {"stage_ms", stages(msPerIteration(plain->seconds(), p0), plain_per_it)}};
     j["residual_to_plain_ratio"] = per_it / plain_per_it;
   }
   j["image_decode_ms_per_view"] = 1e3 * decode_s / static_cast<double>(std::max<std::size_t>(1, scene.train.size()));
@@ -470,11 +471,11 @@ int runTrainBench(const TrainBenchArgs& a) {
                                {"mean_contributors_per_pixel", st.mean_contributors},
                                {"stage_ms", stageJson(st.stages, b.steps)},
                                {"allocations_per_step", st.allocations_per_step}};
-  j["train_minus_step_ms"] = {{"render", render - st.stages.render * sk},
-                              {"loss", loss - st.stages.loss * sk},
-                              {"backward", backward - st.stages.backward * sk},
-                              {"adam", adam - st.stages.optimizer * sk},
-                              {"densify", densify},
+  j["train_minus_step_ms"] = {{"render", ms.render - st.stages.render * sk},
+                              {"loss", ms.loss - st.stages.loss * sk},
+                              {"backward", ms.backward - st.stages.backward * sk},
+                              {"adam", ms.optimizer - st.stages.optimizer * sk},
+                              {"densify", ms.densify},
                               {"total", per_it - st.median_ms}};
   j["peak_rss_mb"] = peakRssMb();
   j["cpu"] = cpuName();
