@@ -7,8 +7,14 @@
 #   bash scripts/perf.sh regress [BASE]   bench step 512x384/20k, this tree and BASE
 #                                         alternated (5 rounds); exits 1, loudly, when
 #                                         this tree is more than 10% slower
+#   bash scripts/perf.sh accept  [BASE]   issue 26's acceptance measures, this tree and BASE
+#                                         alternated: bench step 20k and 100k, the residual
+#                                         ratio and bench fisher (3 rounds), saresgs train on
+#                                         room360 512x384 (2 rounds), the main job's command
+#                                         (1 round); writes results/perf/accept.jsonl and
+#                                         prints a table (about 15 minutes)
 #
-# BASE defaults to b0ae65c for `table` (the code issue 26 is judged against) and to
+# BASE defaults to b0ae65c for `table` and `accept` (the code issue 26 is judged against) and to
 # HEAD~1 for `regress`. It is built once into build-perf/<sha> (Release, the CLI only;
 # a few minutes on two cores; PERF_BASE_BIN=path uses a binary built before). This tree
 # must already be built (scripts/build.sh).
@@ -18,9 +24,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 mode=${1:-}
 case "$mode" in
-  table) base_ref=${2:-b0ae65c} ;;
+  table|accept) base_ref=${2:-b0ae65c} ;;
   regress) base_ref=${2:-HEAD~1} ;;
-  *) echo "usage: bash scripts/perf.sh table|regress [BASE-COMMIT]" >&2; exit 2 ;;
+  *) echo "usage: bash scripts/perf.sh table|regress|accept [BASE-COMMIT]" >&2; exit 2 ;;
 esac
 new=./build/apps/saresgs
 [ -x "$new" ] || { echo "perf.sh: $new is missing: run bash scripts/build.sh first" >&2; exit 2; }
@@ -62,6 +68,79 @@ if n > 1.10 * b:
     sys.exit(1)
 EOF
   echo "load after: $(load)" >&2
+  exit 0
+fi
+
+if [ "$mode" = accept ]; then
+  # The main job's command for each binary (the base may predate --no-plain-refit, which
+  # scripts/main.sh passes), on the built-in scene; the train bench's scene at 512x384.
+  [ -f out/builtin/manifest.json ] || $new scene --layout room360 --out out/builtin >/dev/null
+  [ -f out/bench_room360_512x384/manifest.json ] || $new bench train --width 512 --height 384 --iterations 1 >/dev/null
+  work=$(mktemp -d)
+  trap 'rm -rf "$work"' EXIT
+  mkdir -p results/perf
+  tmp=results/perf/accept.jsonl.tmp
+  : > "$tmp"
+  echo "accept: this tree ($(git rev-parse --short=7 HEAD)$(git diff --quiet || echo '+changes')) vs $sha; $machine; load $(load)" >&2
+  rec() { echo "{\"who\": \"$1\", \"what\": \"$2\", \"load\": \"$(load)\", \"result\": $3}" >> "$tmp"; echo "  $1 $2" >&2; }
+  timed() {  # the wall time of a command in seconds (its output to $work/log)
+    local t0 t1
+    t0=$(date +%s.%N)
+    "$@" > "$work/log" 2>&1
+    t1=$(date +%s.%N)
+    /usr/bin/python3 -c "import sys; print(float(sys.argv[2]) - float(sys.argv[1]))" "$t0" "$t1"
+  }
+  for r in 1 2 3; do
+    for who in new base; do
+      bin=$new; [ $who = base ] && bin=$base
+      rec $who step20k "$($bin bench step --width 512 --height 384 --gaussians 20000 --steps 21 | tail -1)"
+      rec $who step100k "$($bin bench step --width 512 --height 384 --gaussians 100000 --steps 11 | tail -1)"
+      rec $who residual "$($bin bench step --width 512 --height 384 --gaussians 20000 --steps 21 --residual | tail -1)"
+      rec $who fisher "$($bin bench fisher | tail -1)"
+    done
+  done
+  for r in 1 2; do
+    for who in new base; do
+      bin=$new; [ $who = base ] && bin=$base
+      sec=$(timed $bin train --dataset out/bench_room360_512x384 --iterations 300 --threads 2 --out "$work/train_$who")
+      rec $who train "{\"seconds\": $sec, \"iterations\": 300}"
+    done
+  done
+  for who in new base; do
+    bin=$new; [ $who = base ] && bin=$base
+    extra=""
+    if $bin active --help | grep -q -- --no-plain-refit; then extra=--no-plain-refit; fi
+    sec=$(timed $bin active --dataset out/builtin --method sa-resgs --preset quick --seed 0 $extra --out "$work/main_$who")
+    psnr=$(/usr/bin/python3 -c "import json, sys; print(json.load(open(sys.argv[1]))['final_fit']['psnr'])" "$work/main_$who/results.json")
+    rec $who main "{\"seconds\": $sec, \"final_fit_psnr\": $psnr, \"lines\": $(wc -l < "$work/log"), \"args\": \"$extra\"}"
+  done
+  mv "$tmp" results/perf/accept.jsonl
+  /usr/bin/python3 - "$sha" "$(git rev-parse --short=7 HEAD)" "$machine" <<'EOF'
+import json, sys
+base_sha, head, machine = sys.argv[1:4]
+rows = [json.loads(l) for l in open("results/perf/accept.jsonl")]
+def vals(who, what, f):
+    return [f(r["result"]) for r in rows if r["who"] == who and r["what"] == what]
+nan = float("nan")
+measures = [
+    ("bench step 512x384/20k, median ms", "step20k", lambda d: d["median_ms"], "<= 0.6x"),
+    ("bench step 100k, median ms", "step100k", lambda d: d["median_ms"], "<= 0.62x"),
+    ("residual / plain step (20k)", "residual", lambda d: d.get("residual_to_plain_ratio", nan), "<= 1.25"),
+    ("bench fisher / backward", "fisher", lambda d: d["fisher_to_backward_ratio"], "<= 1.0"),
+    ("heap allocations per step", "step20k", lambda d: d.get("allocations_per_step", nan), "0 after the first"),
+    ("saresgs train room360 512x384, it/s", "train", lambda d: d["iterations"] / d["seconds"], ">= 2.17x"),
+    ("main job, s", "main", lambda d: d["seconds"], "<= 0.64x"),
+    ("main job final-fit PSNR, dB", "main", lambda d: d["final_fit_psnr"], ">= 25.7"),
+    ("main job lines of output", "main", lambda d: d["lines"], "<= 200"),
+]
+print(f"this tree {head} against {base_sha}; {machine}; load {rows[0]['load']} at the start, {rows[-1]['load']} at the end")
+print("| measure | this tree | base | acceptance |")
+print("|---|---:|---:|---|")
+fmt = lambda xs: ", ".join(f"{x:.2f}" for x in xs) if xs else "(not measured)"
+for name, what, f, acc in measures:
+    print(f"| {name} | {fmt(vals('new', what, f))} | {fmt(vals('base', what, f))} | {acc} |")
+EOF
+  echo "wrote results/perf/accept.jsonl; load after $(load)" >&2
   exit 0
 fi
 
