@@ -166,7 +166,9 @@ TEST(SceneFrames, FiveFramesTrainToTheSamePsnr) {
     SCOPED_TRACE(fiveFrames()[k].name);
     EXPECT_NEAR(psnr[k], psnr[0], 0.2);
     // A change of unit is undone to the last bit the trainer sees: the same numbers.
-    if (!isTranslation(k)) EXPECT_EQ(psnr[k], psnr[0]);
+    if (!isTranslation(k)) {
+      EXPECT_EQ(psnr[k], psnr[0]);
+    }
   }
 }
 
@@ -230,7 +232,9 @@ TEST(SceneFrames, FiveFramesSelectAndCoverAlike) {
     SCOPED_TRACE(fiveFrames()[k].name);
     for (const auto& [m, views] : out[k].views) {
       EXPECT_EQ(views, ref.views.at(m)) << toString(m);
-      if (isTranslation(k)) EXPECT_NEAR(out[k].psnr.at(m), ref.psnr.at(m), 0.2) << toString(m);
+      if (isTranslation(k)) {
+        EXPECT_NEAR(out[k].psnr.at(m), ref.psnr.at(m), 0.2) << toString(m);
+      }
       else EXPECT_EQ(out[k].psnr.at(m), ref.psnr.at(m)) << toString(m);
     }
     EXPECT_NEAR(static_cast<double>(out[k].scene_voxels), static_cast<double>(ref.scene_voxels), 0.01 * ref.scene_voxels);

@@ -365,8 +365,9 @@ TEST(PhotometricLoss, DeterministicAcrossCallsAndThreadCounts) {
       EXPECT_EQ(std::memcmp(&a.l1, &r.l1, sizeof(double)), 0);
       ASSERT_EQ(a.grad.data.size(), r.grad.data.size());
       // (memcmp of an empty buffer would pass it null pointers: undefined behaviour.)
-      if (!a.grad.data.empty())
-        EXPECT_EQ(std::memcmp(a.grad.data.data(), r.grad.data.data(), a.grad.data.size() * sizeof(float)), 0);
+      if (!a.grad.data.empty()) {
+  EXPECT_EQ(std::memcmp(a.grad.data.data(), r.grad.data.data(), a.grad.data.size() * sizeof(float)), 0);
+}
     }
   }
 }

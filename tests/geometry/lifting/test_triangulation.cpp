@@ -319,7 +319,9 @@ TEST(Triangulation, RandomInputsNeverProduceNaN) {
     for (const auto& p : triangulateAll(c0, c1, ms)) {
       expectNoNaN(p);
       ++kinds[static_cast<int>(p.rejection)];
-      if (p.kept()) EXPECT_LT(p.reprojection_px, 1.0);
+      if (p.kept()) {
+        EXPECT_LT(p.reprojection_px, 1.0);
+      }
     }
   }
   EXPECT_GT(kinds[static_cast<int>(Rejection::kBorder)], 0);

@@ -490,10 +490,13 @@ TEST(SyntheticLayouts, TwoRoomsIsRealMeshesBehindAWallWithADoor) {
       const Eigen::Vector3f at = cc + t0 * (target - cc);
       const bool in_door = std::abs(at.y()) < 0.45f && at.z() < 2.0f;
       const bool outside = std::abs(at.y()) > 0.65f || at.z() > 2.2f;
-      if (in_door) EXPECT_FALSE(by_wall) << "segment through the door at (" << at.y() << ", " << at.z() << ")";
-      if (outside)
+      if (in_door) {
+        EXPECT_FALSE(by_wall) << "segment through the door at (" << at.y() << ", " << at.z() << ")";
+      }
+      if (outside) {
         EXPECT_TRUE(by_wall || (h.hit && h.distance < t0 * (target - cc).norm()))
             << "segment through the wall at (" << at.y() << ", " << at.z() << ")";
+      }
       through_door += in_door;
     }
   }

@@ -215,7 +215,12 @@ TEST(Ablation, TablesAggregateSeedsAndSplitMeanStdInCsv) {
     r.iterations = 100;
     r.seconds.training = 2.0;
     r.end_to_end_seconds = 3.0;
-    r.steps = {{4, 15.0, {}, {}, {}, {}, {}}, {5, 17.0, {}, {}, {}, {}, {}}};
+    StepReport s4, s5;
+    s4.views_before = 4;
+    s4.progress_psnr = 15.0;
+    s5.views_before = 5;
+    s5.progress_psnr = 17.0;
+    r.steps = {s4, s5};
     results.push_back({j, r, {}});
   }
   ASSERT_EQ(results.size(), 2u);
@@ -323,8 +328,12 @@ TEST(Ablation, BetterBaselineIsChosenPerSceneAndPairedBySeed) {
   const Table t = betterBaselineTable(g, results);
   ASSERT_EQ(t.rows.size(), 4u);
   for (const auto& r : t.rows) {
-    if (r[0] == "b" && r[2] == "adaptive") EXPECT_EQ(r[7], "at or above, interval clear of 0");
-    if (r[0] == "b" && r[2] == "fisher") EXPECT_EQ(r[7], "below");
+    if (r[0] == "b" && r[2] == "adaptive") {
+      EXPECT_EQ(r[7], "at or above, interval clear of 0");
+    }
+    if (r[0] == "b" && r[2] == "fisher") {
+      EXPECT_EQ(r[7], "below");
+    }
   }
   const std::vector<NamedPlot> plots = ablationPlots(g, results);
   EXPECT_TRUE(std::any_of(plots.begin(), plots.end(),

@@ -154,7 +154,9 @@ TEST(Trainer, DivergenceIsStoppedAndNamed) {
     stopped = true;
     EXPECT_GT(e.iteration, 0);
   }
-  if (!stopped) EXPECT_TRUE(allFinite(t.gaussians()));
+  if (!stopped) {
+    EXPECT_TRUE(allFinite(t.gaussians()));
+  }
 }
 
 TEST(Trainer, SameSeedSameParametersBitForBit) {
