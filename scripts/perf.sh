@@ -86,7 +86,11 @@ if [ "$mode" = accept ]; then
   timed() {  # the wall time of a command in seconds (its output to $work/log)
     local t0 t1
     t0=$(date +%s.%N)
-    "$@" > "$work/log" 2>&1
+    if ! "$@" > "$work/log" 2>&1; then
+      echo "perf.sh: failed: $*" >&2
+      tail -n 20 "$work/log" >&2
+      return 1
+    fi
     t1=$(date +%s.%N)
     /usr/bin/python3 -c "import sys; print(float(sys.argv[2]) - float(sys.argv[1]))" "$t0" "$t1"
   }
