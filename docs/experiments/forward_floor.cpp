@@ -24,27 +24,27 @@
 #include "splat/raster/raster_kernels_impl.h"
 
 namespace saresgs::raster_kernels::floorexp {
+// compositeFloor's loop (raster_kernels_impl.h), its constants and per-lane work, with the
+// blocks' state in a tile's ForwardState instead of registers.
 __attribute__((noinline)) float memoryFloor(long n, int blocks) {
-  static ForwardBlock b[kBlocks];
-  for (ForwardBlock& B : b) {
-    B.Tr = vs(1.0f);
-    B.C0 = B.C1 = B.C2 = B.D = B.walked = B.contrib = vs(0.0f);
-  }
+  static ForwardState F;
+  F.init(kTile, kTile);  // every pixel live: transmittance 1, sums 0
   const vf ha = vs(-0.5f * kLog2e * 0.02f), o = vs(0.6f), hx = vs(1e6f), qy = vs(-0.01f), by = vs(0.002f);
-  const vi row_in = vi{} - 1;
-  const vf col0 = vs(0.3f), col1 = vs(0.5f), col2 = vs(0.7f), dep = vs(2.0f), jf = vs(1.0f);
-  const vf dx0 = laneColCentres() - vs(2.0f);
+  const vi all = vi{} - 1;
+  const vf colour[3] = {vs(0.3f), vs(0.5f), vs(0.7f)};
+  const vf start = laneColCentres() - vs(2.0f);
   for (long i = 0; i < n; ++i) {
-    const vf dx = dx0 + vs(static_cast<float>(i & 1023) * (1.0f / 1024.0f));
+    const vf dx = start + vs(static_cast<float>(i & 1023) * (1.0f / 1024.0f));
     for (int k = 0; k < blocks; ++k) {
-      ForwardState::step(b[k], evalLanes(dx + vs(static_cast<float>(4 * (k & 1))), ha, qy, by, o, hx, row_in), col0,
-                         col1, col2, dep, jf);
-      b[k].Tr = vmax(b[k].Tr, vs(0.5f));
+      ForwardBlock& B = F.b[k];
+      const Lanes lanes = evalLanes(dx + vs(static_cast<float>(4 * (k & 1))), ha, qy, by, o, hx, all);
+      ForwardState::step(B, lanes, colour[0], colour[1], colour[2], vs(2.0f), vs(1.0f));
+      B.Tr = vmax(B.Tr, vs(0.5f));
     }
   }
-  vf s = vs(0.0f);
-  for (int k = 0; k < blocks; ++k) s = s + b[k].C0 + b[k].D + b[k].contrib;
-  return hsum(s);
+  vf sum = vs(0.0f);
+  for (int k = 0; k < blocks; ++k) sum = sum + F.b[k].C0 + F.b[k].D + F.b[k].contrib;
+  return hsum(sum);
 }
 
 long evaluatedLanes(const std::vector<TileGaussian<float>>& q) {
