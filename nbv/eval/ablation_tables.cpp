@@ -334,7 +334,8 @@ Table pairedTable(const AblationGrid& g, const std::vector<JobResult>& results) 
           "the share of (seed, test view) pairs the method wins (ties count half). final_fit_psnr: a fresh model "
           "trained on the chosen views with the method's own training (residual supervision for resgs and sa-resgs); "
           "plain_refit_psnr: plain 3DGS on the same views (selection alone); psnr: the loop's model (the paper's "
-          "protocol)",
+          "protocol); ause: the loop's model's AUSE of depth error against its uncertainty (lower is better, so a "
+          "negative difference is the method's gain; no per-view win rate)",
           {"scene", "method", "baseline", "metric", "mean_diff", "ci_low", "ci_high", "n", "win_rate"},
           {}};
   // The run of (scene, method, variant, seed), if finished.
@@ -343,7 +344,7 @@ Table pairedTable(const AblationGrid& g, const std::vector<JobResult>& results) 
       if (isActive(r) && r.job.scene == scene && r.job.method == m && r.job.variant == v && r.job.seed == seed) return &r.run;
     return nullptr;
   };
-  enum class Model { kFinalFit, kPlainRefit, kLoop };
+  enum class Model { kFinalFit, kPlainRefit, kLoop, kNone };  // kNone: no per-view figures
   struct Metric {
     const char* name;
     std::optional<double> (*value)(const RunReport&);
@@ -351,7 +352,8 @@ Table pairedTable(const AblationGrid& g, const std::vector<JobResult>& results) 
   };
   const Metric metrics[] = {{"final_fit_psnr", finalPsnrOf, Model::kFinalFit},
                             {"plain_refit_psnr", plainRefitPsnrOf, Model::kPlainRefit},
-                            {"psnr", psnrOf, Model::kLoop}};
+                            {"psnr", psnrOf, Model::kLoop},
+                            {"ause", auseOf, Model::kNone}};
   auto viewPsnrs = [](const RunReport& r, Model m) {
     std::vector<double> v;
     const std::vector<ViewReport>& views =
@@ -372,6 +374,7 @@ Table pairedTable(const AblationGrid& g, const std::vector<JobResult>& results) 
           if (!x || !y || !metric.value(*x) || !metric.value(*y)) continue;
           a.push_back(*metric.value(*x));
           b.push_back(*metric.value(*y));
+          if (metric.model == Model::kNone) continue;
           va.push_back(viewPsnrs(*x, metric.model));
           vb.push_back(viewPsnrs(*y, metric.model));
         }

@@ -2,7 +2,9 @@
 // rate with ties, the single-seed case (interval undefined, not zero), and the table.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "nbv/eval/ablation.h"
 #include "nbv/eval/paired_stats.h"
@@ -88,6 +90,42 @@ TEST(PairedStats, TableRowsPerSceneMethodBaselineAndMetric) {
   EXPECT_EQ(t.rows[0][6], "undefined");
   EXPECT_EQ(t.rows[0][7], "1");
   EXPECT_NE(t.csv().find("s,fisher,random,final_fit_psnr,1.000,undefined,undefined,1,1.000"), std::string::npos) << t.csv();
+}
+
+// AUSE (the paper's uncertainty claim) is paired like the PSNRs, as method minus baseline
+// (lower is better), over the seeds where both runs have it, with no per-view win rate.
+TEST(PairedStats, AuseIsPairedWhereBothRunsHaveIt) {
+  AblationGrid g;
+  g.scenes = {{"s", "x", ""}};
+  g.methods = {"random", "fisher"};
+  g.seeds = {0, 1, 2};
+  g.variants = {AblationVariant{}};
+  auto job = [](const std::string& m, std::uint64_t seed, std::optional<double> ause) {
+    JobResult r;
+    r.job.scene = "s";
+    r.job.method = m;
+    r.job.variant = "default";
+    r.job.seed = seed;
+    r.run.psnr = 20;
+    r.run.views = {{"t0", 20, 0.5}};
+    r.run.ause = ause;
+    return r;
+  };
+  // fisher - random: seed 0: 0.30 - 0.35 = -0.05, seed 1: 0.32 - 0.33 = -0.01; seed 2 has
+  // no AUSE for fisher (no ground-truth depth), so it is left out.
+  const std::vector<JobResult> results{job("random", 0, 0.35), job("random", 1, 0.33), job("random", 2, 0.40),
+                                       job("fisher", 0, 0.30), job("fisher", 1, 0.32), job("fisher", 2, std::nullopt)};
+  const Table t = pairedTable(g, results);
+  const auto row = std::find_if(t.rows.begin(), t.rows.end(), [](const std::vector<std::string>& r) {
+    return r[1] == "fisher" && r[2] == "random" && r[3] == "ause";
+  });
+  ASSERT_NE(row, t.rows.end()) << t.csv();
+  EXPECT_EQ((*row)[4], "-0.030");
+  EXPECT_EQ((*row)[7], "2");
+  EXPECT_EQ((*row)[8], "n/a");
+  // The interval: mean -0.03, sd 0.02828, t(1) 12.706: half width 0.254.
+  EXPECT_EQ((*row)[5], "-0.284");
+  EXPECT_EQ((*row)[6], "0.224");
 }
 
 }  // namespace
