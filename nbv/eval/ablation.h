@@ -135,7 +135,8 @@ Table finalFitPerViewTable(const AblationGrid& g, const std::vector<JobResult>& 
 Table sweepTable(const std::vector<JobResult>& results);
 // Paired differences (nbv/eval/paired_stats.h) of every method against random, fisher and
 // fvs (those in the grid), per scene, for the final-fit PSNR (the method's training), the
-// plain refit's PSNR (selection alone) and the in-loop PSNR:
+// plain refit's PSNR (selection alone), the in-loop PSNR and the in-loop model's AUSE
+// (lower is better; no per-view win rate, "n/a"):
 // columns scene, method, baseline, metric, mean_diff, ci_low, ci_high, n, win_rate; an
 // interval over a single seed is "undefined".
 Table pairedTable(const AblationGrid& g, const std::vector<JobResult>& results);
