@@ -111,9 +111,12 @@ void runSweep(const AblationGrid& g, const AblationJob& j, const std::string& ou
   const std::optional<SceneType> type = sceneTypeOfLayout(layout);
   if (type) applySceneType(grid, *type);
   PrefilterRegime regime;
-  SweepReport report{j.scene, sc.dataset, toString(g.sweep->lifting),
-                     "exact encoding of the Embree-visible sets, same score",
-                     prefilterSweep(scene, *g.sweep, render, depth, 0, grid, &regime)};
+  SweepReport report;
+  report.scene = j.scene;
+  report.dataset = sc.dataset;
+  report.lifting = toString(g.sweep->lifting);
+  report.reference = "exact encoding of the Embree-visible sets, same score";
+  report.rows = prefilterSweep(scene, *g.sweep, render, depth, 0, grid, &regime);
   report.scene_type = type ? toString(*type) : "";
   report.resolution = regime.resolution;
   report.min_points = regime.min_points;
