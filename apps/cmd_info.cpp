@@ -31,7 +31,9 @@ int runInfo(const InfoArgs& a) {
   std::cerr << formatWarnings(checkDataset(s));
   const std::string internal = s.frame.identity() ? "" : " (internal units; the frame below maps them to the world)";
   const Intrinsics& K = s.views.front().camera.K;
-  const bool adaptiveKmedian = usesKmedianGate(s, ActiveOptions{.method = Method::kAdaptive});
+  ActiveOptions adaptive;
+  adaptive.method = Method::kAdaptive;
+  const bool adaptiveKmedian = usesKmedianGate(s, adaptive);
   int with_depth = 0;
   for (size_t i = 0; i < s.views.size(); ++i) with_depth += s.hasDepth(static_cast<int>(i));
   std::cout << "dataset " << s.source << "\n"

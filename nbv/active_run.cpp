@@ -271,9 +271,11 @@ void ActiveRun::trainPhase() {
   if (last) {
     // The final phase's training belongs to no selection; a log entry without a
     // selected view keeps it in the totals.
-    SelectionSeconds tail;
-    tail.training = phase_seconds_;
-    steps_.push_back({k, -1, {}, {}, {}, tail, last_psnr_});
+    SelectionLog tail;
+    tail.views_before = k;
+    tail.seconds.training = phase_seconds_;
+    tail.progress_psnr = last_psnr_;
+    steps_.push_back(std::move(tail));
     finished_ = true;
   }
 }

@@ -33,9 +33,18 @@ RunReport sampleReport() {
   r.iterations = 100;
   r.threads = 2;
   r.views = {{"t.png", 22.5, 0.8}};
-  StepReport sel{2, 18.0, {}, "c.png", {"c.png", "d.png"}, {0.5, 0.25}, {"c.png"}};
+  StepReport sel;
+  sel.views_before = 2;
+  sel.progress_psnr = 18.0;
+  sel.selected = "c.png";
+  sel.candidates = {"c.png", "d.png"};
+  sel.scores = {0.5, 0.25};
+  sel.prefiltered = {"c.png"};
   sel.seconds.fisher = 1.5;
-  r.steps = {sel, {3, 19.0, {}, {}, {}, {}, {}}};
+  StepReport last;
+  last.views_before = 3;
+  last.progress_psnr = 19.0;
+  r.steps = {sel, last};
   r.frame = SceneFrame{Eigen::Vector3d(1e6, -5e4, 0.5), 1e-3};
   return r;
 }
