@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "nbv/eval/ablation.h"
 #include "nbv/eval/paired_stats.h"
@@ -56,20 +58,31 @@ TEST(PairedStats, StudentQuantiles) {
 }
 
 // The table pairs runs by seed and says "undefined" for a single seed.
-TEST(PairedStats, TableRowsPerSceneMethodBaselineAndMetric) {
+// A grid of one scene "s" with random and fisher at the given seeds, and one finished
+// run of it with the loop's PSNR on one test view.
+AblationGrid randomAndFisher(std::vector<std::uint64_t> seeds) {
   AblationGrid g;
   g.scenes = {{"s", "x", ""}};
   g.methods = {"random", "fisher"};
-  g.seeds = {0, 1};
+  g.seeds = std::move(seeds);
   g.variants = {AblationVariant{}};
+  return g;
+}
+JobResult finishedRun(const std::string& method, std::uint64_t seed, double psnr) {
+  JobResult r;
+  r.job.scene = "s";
+  r.job.method = method;
+  r.job.variant = "default";
+  r.job.seed = seed;
+  r.run.psnr = psnr;
+  r.run.views = {{"t0", psnr, 0.5}};
+  return r;
+}
+
+TEST(PairedStats, TableRowsPerSceneMethodBaselineAndMetric) {
+  const AblationGrid g = randomAndFisher({0, 1});
   auto job = [](const std::string& m, std::uint64_t seed, double psnr, double final_psnr) {
-    JobResult r;
-    r.job.scene = "s";
-    r.job.method = m;
-    r.job.variant = "default";
-    r.job.seed = seed;
-    r.run.psnr = psnr;
-    r.run.views = {{"t0", psnr, 0.5}};
+    JobResult r = finishedRun(m, seed, psnr);
     r.run.final_fit = FinalFitReport{100, false, final_psnr, 0.8, {{"t0", final_psnr, 0.8}}};
     return r;
   };
@@ -95,19 +108,9 @@ TEST(PairedStats, TableRowsPerSceneMethodBaselineAndMetric) {
 // AUSE (the paper's uncertainty claim) is paired like the PSNRs, as method minus baseline
 // (lower is better), over the seeds where both runs have it, with no per-view win rate.
 TEST(PairedStats, AuseIsPairedWhereBothRunsHaveIt) {
-  AblationGrid g;
-  g.scenes = {{"s", "x", ""}};
-  g.methods = {"random", "fisher"};
-  g.seeds = {0, 1, 2};
-  g.variants = {AblationVariant{}};
+  const AblationGrid g = randomAndFisher({0, 1, 2});
   auto job = [](const std::string& m, std::uint64_t seed, std::optional<double> ause) {
-    JobResult r;
-    r.job.scene = "s";
-    r.job.method = m;
-    r.job.variant = "default";
-    r.job.seed = seed;
-    r.run.psnr = 20;
-    r.run.views = {{"t0", 20, 0.5}};
+    JobResult r = finishedRun(m, seed, 20);
     r.run.ause = ause;
     return r;
   };
