@@ -30,7 +30,8 @@ namespace fs = std::filesystem;
 struct ActiveArgs {
   std::string dataset, out, method = "adaptive", preset = "quick", fvs_metric = "euclidean", ranking, replay;
   int downscale = 1, threads = 0;
-  bool resume = false, continue_training = false, sub_only = false, time_exhaustive_fisher = false, no_plain_refit = false;
+  bool resume = false, continue_training = false, sub_only = false, time_exhaustive_fisher = false, no_plain_refit = false,
+       final_residual = false;
   std::uint64_t seed = 0;
   double fisher_lambda = 1e-6;
   std::optional<int> max_views, interval, total, final_iterations, renamed_iterations;
@@ -55,6 +56,7 @@ ActiveOptions activeOptions(const ActiveArgs& a) {
   o.reset_after_add = !a.continue_training;
   o.time_exhaustive_fisher = a.time_exhaustive_fisher;
   o.plain_refit = !a.no_plain_refit;
+  o.final_residual = a.final_residual;
   o.fvs_metric = a.fvs_metric == "great-circle" ? ViewDistance::kGreatCircle : ViewDistance::kEuclidean;
   if (a.max_views) o.max_views = *a.max_views;
   if (a.interval) o.interval = *a.interval;
@@ -131,7 +133,7 @@ int runActive(const ActiveArgs& a) {
                                                                             std::max(opt.max_views, 1)));
     const std::size_t initial = initialModelSize(scene, opt.trainer);
     const int models =
-        1 + (opt.final_iterations > 0 ? (needsOf(opt.method).residual && opt.plain_refit ? 2 : 1) : 0);
+        1 + (opt.final_iterations > 0 ? (finalFitIsResidual(opt) && opt.plain_refit ? 2 : 1) : 0);
     std::size_t cap = opt.trainer.densify.max_gaussians;
     std::cerr << applyMemoryBudget(estimateTrainingMemory(scene, trained, scene.test.empty() ? scene.train : scene.test,
                                                           initial, opt.trainer.max_sh_degree, models),
@@ -207,6 +209,9 @@ CLI::App* addActiveOptions(CLI::App& app, const std::shared_ptr<ActiveArgs>& a) 
   sub->add_flag("--no-plain-refit", a->no_plain_refit,
                 "Methods with their own training (sa-resgs, resgs): leave out the plain 3DGS refit of the chosen "
                 "views that judges selection apart from training (as long as the final fit itself)");
+  sub->add_flag("--final-residual", a->final_residual,
+                "Final fit with the paper's residual supervision whatever the method (the loop and its selection "
+                "unchanged); a plain 3DGS refit of the same views follows unless --no-plain-refit");
   sub->add_option("--memory-budget", a->memory_budget_gb,
                   "GB this run may use: refused before it starts if its images and initial models do not fit, the "
                   "models capped to fit (default: refused only beyond what the machine has available)")

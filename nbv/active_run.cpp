@@ -66,11 +66,13 @@ void ActiveRun::checkReplay() const {
   }
 }
 
+bool finalFitIsResidual(const ActiveOptions& o) { return needsOf(o.method).residual || o.final_residual; }
+
 TrainerOptions finalFitOptions(const ActiveOptions& o, bool method_training) {
   TrainerOptions t = o.final_trainer;
   t.seed = o.seed;
   t.residual = o.trainer.residual;
-  t.residual.enabled = method_training && needsOf(o.method).residual;
+  t.residual.enabled = method_training && finalFitIsResidual(o);
   return t;
 }
 

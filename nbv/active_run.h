@@ -91,6 +91,10 @@ struct ActiveOptions {
   // needs it; a user who wants the reconstruction only may leave it out (it is as long
   // as the final fit itself).
   bool plain_refit = true;
+  // The final fit trains with residual supervision whatever the method (`--final-residual`):
+  // a plain-training selector's views with the paper's training, the loop and its
+  // selection unchanged; the plain refit above then judges the selection alone.
+  bool final_residual = false;
   // Its trainer options: 3DGS's own schedule (a fit of a few thousand iterations on 20
   // views is 3DGS's first iterations, not a quarter-speed loop phase), with the preset's
   // model cap and SH degree; residual supervision and the seed are set by finalFitOptions.
@@ -159,9 +163,13 @@ struct ActiveResult {
 // throws std::invalid_argument.
 bool usesKmedianGate(const Scene& scene, const ActiveOptions& o);
 
+// Whether the final fit trains with residual supervision: the method does, or
+// o.final_residual asks for it.
+bool finalFitIsResidual(const ActiveOptions& o);
+
 // The trainer options of the final fit: final_trainer with the run's seed and, when
-// `method_training` and the method trains with residual supervision, the loop's residual
-// options (otherwise none). `saresgs train` with these options on the chosen views
+// `method_training` and finalFitIsResidual, the loop's residual options (their alpha, beta
+// and ranking; otherwise none). `saresgs train` with these options on the chosen views
 // (`--residual` and its options for the method's training) trains the same model.
 TrainerOptions finalFitOptions(const ActiveOptions& o, bool method_training = true);
 

@@ -269,7 +269,7 @@ void bindNbv(py::module_& m) {
                        const std::string& preset, int threads, std::optional<int> max_views, std::optional<int> interval,
                        std::optional<int> min_iterations, std::optional<int> final_iterations,
                        std::optional<std::size_t> max_gaussians, const std::string& prefilter_scene, const std::string& checkpoint,
-                       bool plain_refit) {
+                       bool plain_refit, bool final_residual) {
              auto r = std::make_unique<PyActiveRun>();
              r->dataset = dataset;
              r->preset = preset;
@@ -284,6 +284,7 @@ void bindNbv(py::module_& m) {
              if (min_iterations) o.total_iterations = *min_iterations;
              if (final_iterations) o.final_iterations = *final_iterations;
              o.plain_refit = plain_refit;
+             o.final_residual = final_residual;
              if (max_gaussians) o.trainer.densify.max_gaussians = o.final_trainer.densify.max_gaussians = *max_gaussians;
              // As `saresgs active --prefilter-scene`: auto reads a `saresgs scene` manifest's layout.
              applySceneType(o.prefilter, prefilter_scene == "auto" ? sceneTypeOfDataset(dataset->source).value_or(SceneType::kOutdoor)
@@ -302,9 +303,10 @@ void bindNbv(py::module_& m) {
            py::arg("preset") = "quick", py::arg("threads") = 0, py::arg("max_views") = py::none(),
            py::arg("interval") = py::none(), py::arg("min_iterations") = py::none(), py::arg("final_iterations") = py::none(),
            py::arg("max_gaussians") = py::none(), py::arg("prefilter_scene") = "auto", py::arg("checkpoint") = "",
-           py::arg("plain_refit") = true,
+           py::arg("plain_refit") = true, py::arg("final_residual") = false,
            "Options as `saresgs active`'s (the preset's where not given); `checkpoint` names a checkpoint file "
-           "written after every added view and resumed when present; plain_refit=False is --no-plain-refit.")
+           "written after every added view and resumed when present; plain_refit=False is --no-plain-refit, "
+           "final_residual=True is --final-residual.")
       .def_property_readonly("method", [](const PyActiveRun& r) { return std::string(toString(r.opt.method)); })
       .def_property_readonly("held", [](const PyActiveRun& r) { return r.run->held(); }, "the views held, in order")
       .def_property_readonly("finished", [](const PyActiveRun& r) { return r.run->finished(); },

@@ -51,6 +51,18 @@ def test_python_random_selector_is_the_builtin_random_bit_for_bit(room, tmp_path
         assert cli[key] == builtin[key], key
 
 
+def test_final_residual_is_the_clis_and_keeps_the_selection(room, tmp_path):
+    plain = saresgs.ActiveRun(room, method="random", **SHORT).run()
+    res = saresgs.ActiveRun(room, method="random", final_residual=True, **SHORT).run()
+    assert res["selected_view_indices"] == plain["selected_view_indices"] and res["psnr"] == plain["psnr"]
+    assert res["final_fit"]["residual"] is True and plain["final_fit"]["residual"] is False
+    assert res["final_fit_views"] == plain["final_fit"] and res["final_fit"]["psnr"] != plain["final_fit"]["psnr"]
+    run_cli("active", "--dataset", room.source, "--method", "random", *SHORT_CLI, "--final-residual",
+            "--out", tmp_path / "cli")
+    cli = json.loads((tmp_path / "cli" / "results.json").read_text())
+    assert cli["final_fit"] == res["final_fit"] and cli["final_fit_views"] == res["final_fit_views"]
+
+
 def test_stepping_equals_run_and_accepts_overrides(room):
     whole = saresgs.ActiveRun(room, method="fvs", **SHORT).run()
     run = saresgs.ActiveRun(room, method="fvs", **SHORT)

@@ -213,6 +213,27 @@ TEST(Cli, FinalFitEqualsTrainOnTheChosenViews) {
   EXPECT_EQ(f["final_fit"]["residual"], false);
   EXPECT_EQ(f["final_fit_views"], f["final_fit"]);
   EXPECT_FALSE(std::filesystem::exists(d.file("f/final_fit_views.ply")));
+  // --final-residual gives a plain-training method the residual final fit: the same views,
+  // a final fit equal to `train --residual` on them, and the plain run's fit as the refit.
+  r = run("active --dataset " + d.file("s") + " --method fisher --max-views 5 --interval 4 --min-iterations 40 " +
+          "--final-iterations 150 --seed 3 --threads 2 --final-residual --out " + d.file("fr"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("final fit on these views (150 it, residual)"), std::string::npos) << r.output;
+  const nlohmann::json fr = nlohmann::json::parse(saresgs::test::readBytes(d.file("fr/results.json")));
+  EXPECT_EQ(fr["selected_views"], f["selected_views"]);
+  EXPECT_EQ(fr["psnr"], f["psnr"]);
+  EXPECT_EQ(fr["final_fit"]["residual"], true);
+  EXPECT_EQ(fr["final_fit_views"], f["final_fit"]);
+  std::string fviews;
+  for (const auto& v : f["initial_views"]) fviews += (fviews.empty() ? "" : ",") + v.get<std::string>();
+  for (const auto& v : f["selected_views"]) fviews += "," + v.get<std::string>();
+  r = run("train --dataset " + d.file("s") + " --views " + fviews +
+          " --iterations 150 --max-gaussians 40000 --sh-degree 0 --seed 3 --threads 2 --residual --out " + d.file("ftr"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  const nlohmann::json ftr = nlohmann::json::parse(saresgs::test::readBytes(d.file("ftr/results.json")));
+  EXPECT_EQ(ftr["psnr"].get<double>(), fr["final_fit"]["psnr"].get<double>());
+  EXPECT_EQ(saresgs::test::readBytes(d.file("ftr/point_cloud.ply")), saresgs::test::readBytes(d.file("fr/final_fit.ply")));
+  EXPECT_NE(fr["final_fit"]["psnr"].get<double>(), f["final_fit"]["psnr"].get<double>());
   // --no-plain-refit leaves the plain refit out (results.json, the table, the .ply) and
   // changes nothing else: the same views and the same final fit.
   r = run("active --dataset " + d.file("s") + " --method sa-resgs --max-views 5 --interval 4 --min-iterations 40 " +
