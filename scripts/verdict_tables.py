@@ -31,10 +31,9 @@ def main():
         print(f"| method | {metric} | vs fisher | vs fvs | seeds |")
         print("|---|---:|---:|---:|---:|")
         for r in rows:
-            m = r["method"]
-            key = m.split(" ")[0]
+            m = r["method"]  # with its variant, as paired.csv names it: "resgs (replay-fisher)"
             val = r.get(col, "")
-            print(f"| {m} | {val} | {cell(scene, key, 'fisher')} | {cell(scene, key, 'fvs')} | {r['seeds']} |")
+            print(f"| {m} | {val} | {cell(scene, m, 'fisher')} | {cell(scene, m, 'fvs')} | {r['seeds']} |")
         print()
 
 
