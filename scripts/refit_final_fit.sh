@@ -27,13 +27,7 @@ for run in "$@"; do
   job=$(basename "$run")
   [ -f "$run/results.json" ] || { echo "skip $job: no results.json"; continue; }
   [ -f "$run/final_fit.ply" ] && { echo "skip $job: has final_fit.ply"; continue; }
-  read -r ds views seed psnr residual iters preset cap < <(/usr/bin/python3 -c "
-import json, sys
-r = json.load(open(sys.argv[1]))
-f = r['final_fit']
-print(r['dataset'], ','.join(r['initial_views'] + r['selected_views']), r['seed'], repr(f['psnr']), f['residual'],
-      f['iterations'], r['preset'], r['options']['max_gaussians'])" \
-    "$run/results.json") || { echo "FAIL $job: results.json has no final fit"; status=1; continue; }
+  read -r ds views seed psnr residual iters preset cap < <(/usr/bin/python3 scripts/run_fit_options.py "$run/results.json") || { echo "FAIL $job: results.json has no final fit"; status=1; continue; }
   [ "$residual" = False ] || { echo "skip $job: its final fit trains with residual supervision"; continue; }
   [ "$preset" = quick ] || { echo "skip $job: preset $preset (only the quick preset's final fit is rebuilt here)"; continue; }
   out=$tmp/$job

@@ -30,13 +30,7 @@ for run in "$@"; do
   job=$(basename "$run")
   [ -f "$outdir/$job/refit.json" ] && { echo "skip $job: done"; continue; }
   [ -f "$run/results.json" ] || { echo "skip $job: no results.json"; continue; }
-  read -r ds views seed psnr residual iters preset cap < <(/usr/bin/python3 -c "
-import json, sys
-r = json.load(open(sys.argv[1]))
-f = r['final_fit']
-print(r['dataset'], ','.join(r['initial_views'] + r['selected_views']), r['seed'], repr(f['psnr']), f['residual'],
-      f['iterations'], r['preset'], r['options']['max_gaussians'])" \
-    "$run/results.json") || { echo "FAIL $job: results.json has no final fit"; status=1; continue; }
+  read -r ds views seed psnr residual iters preset cap < <(/usr/bin/python3 scripts/run_fit_options.py "$run/results.json") || { echo "FAIL $job: results.json has no final fit"; status=1; continue; }
   [ "$residual" = False ] || { echo "skip $job: its final fit already trains residually"; continue; }
   [ "$preset" = quick ] || { echo "skip $job: preset $preset (only the quick preset's final fit)"; continue; }
   train=("$bin" train --dataset "$ds" --views "$views" --iterations "$iters" --max-gaussians "$cap" --sh-degree 0
