@@ -47,7 +47,8 @@ for run in "$@"; do
     echo "FAIL $job: saresgs train --residual failed:"; tail -3 "$tmp/$job.log"; status=1; continue
   fi
   mkdir -p "$outdir/$job"
-  /usr/bin/python3 - "$out/results.json" "$outdir/$job/refit.json" "$run" "$psnr" <<'EOF' || { status=1; continue; }
+  # Written through a temporary name; prints the refit's PSNR for the log line.
+  got=$(/usr/bin/python3 - "$out/results.json" "$outdir/$job/refit.json" "$run" "$psnr" <<'EOF'
 import json, os, sys
 src, dst, run, psnr = sys.argv[1:]
 r = json.load(open(src))
@@ -56,8 +57,10 @@ r["source_final_fit_psnr"] = float(psnr)
 with open(dst + ".tmp", "w") as fh:
     json.dump(r, fh, indent=1)
 os.replace(dst + ".tmp", dst)
+print(round(r["psnr"], 3))
 EOF
-  echo "ok $job: residual $(/usr/bin/python3 -c "import json, sys; print(round(json.load(open(sys.argv[1]))['psnr'], 3))" "$outdir/$job/refit.json"), plain $psnr"
+) || { status=1; continue; }
+  echo "ok $job: residual $got, plain $psnr"
   rm -rf "$out"
 done
 exit $status

@@ -7,25 +7,14 @@ OUTDIR holds OUTDIR/SCENE__METHOD__VARIANT__sN/refit.json (a residual refit of t
 views); RUNS_DIR the grid's runs (results/verdict2/runs). For each scene and method it pairs,
 seed by seed, the residual refit against the run's own plain final fit (training alone, same
 views) and against fisher's and fvs's final fits (the method with residual training against
-the baselines as they are), and writes OUTDIR/paired.md: mean difference, 95 % Student-t
-interval over seeds, and the seeds.
+the baselines as they are), and writes OUTDIR/tables/paired.md: mean difference, 95 %
+Student-t interval over seeds, and the seeds.
 """
 import json
-import math
 import os
-import statistics
 import sys
 
-# Two-sided 95 % Student-t quantiles by degrees of freedom.
-T95 = {1: 12.706, 2: 4.303, 3: 3.182, 4: 2.776, 5: 2.571, 6: 2.447, 7: 2.365, 8: 2.306, 9: 2.262}
-
-
-def interval(xs):
-    m = statistics.mean(xs)
-    if len(xs) < 2:
-        return m, float("nan"), float("nan")
-    h = T95.get(len(xs) - 1, 1.96) * statistics.stdev(xs) / math.sqrt(len(xs))
-    return m, m - h, m + h
+from table_io import interval95, writeTable
 
 
 def psnr_of(path, key):
@@ -65,16 +54,11 @@ def main():
                     diffs.append(mine - theirs)
             if not diffs:
                 continue
-            m, lo, hi = interval(diffs)
+            m, lo, hi = interval95(diffs)
             per = ", ".join(f"{d:+.2f}" for d in diffs)
             lo_s, hi_s = ("n/a", "n/a") if len(diffs) < 2 else (f"{lo:+.3f}", f"{hi:+.3f}")
             lines.append(f"| {scene} | {name} | {against} | {m:+.3f} | {lo_s} | {hi_s} | {len(diffs)} | {per} |")
-    text = "\n".join(lines) + "\n"
-    tmp = os.path.join(outdir, "paired.md.tmp")
-    with open(tmp, "w") as fh:
-        fh.write(text)
-    os.replace(tmp, os.path.join(outdir, "paired.md"))
-    print(text, end="")
+    writeTable(outdir, "paired.md", lines)
 
 
 if __name__ == "__main__":

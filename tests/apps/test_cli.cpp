@@ -176,8 +176,21 @@ TEST(Cli, ActiveAcceptsEveryMethodOfTheList) {
 TEST(Cli, FinalFitEqualsTrainOnTheChosenViews) {
   TempDir d;
   ASSERT_EQ(run("scene --layout object --views 12 --width 64 --height 48 --out " + d.file("s")).code, 0);
-  Result r = run("active --dataset " + d.file("s") + " --method sa-resgs --max-views 5 --interval 4 --min-iterations 40 " +
-                 "--final-iterations 150 --seed 3 --threads 2 --out " + d.file("a"));
+  // One short active run of `method` (and `flags`) into OUT, and `saresgs train` on exactly
+  // a run's views (initial, then selected) with its final fit's options.
+  auto active = [&](const std::string& method, const std::string& flags, const std::string& out) {
+    return run("active --dataset " + d.file("s") + " --method " + method +
+               " --max-views 5 --interval 4 --min-iterations 40 --final-iterations 150 --seed 3 --threads 2 " + flags +
+               "--out " + d.file(out));
+  };
+  auto trainOn = [&](const nlohmann::json& of_run) {
+    std::string views;
+    for (const auto& v : of_run["initial_views"]) views += (views.empty() ? "" : ",") + v.get<std::string>();
+    for (const auto& v : of_run["selected_views"]) views += "," + v.get<std::string>();
+    return "train --dataset " + d.file("s") + " --views " + views +
+           " --iterations 150 --max-gaussians 40000 --sh-degree 0 --seed 3 --threads 2 ";
+  };
+  Result r = active("sa-resgs", "", "a");
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("final fit on these views (150 it, residual)"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("plain refit of these views (150 it)"), std::string::npos) << r.output;
@@ -186,11 +199,7 @@ TEST(Cli, FinalFitEqualsTrainOnTheChosenViews) {
   EXPECT_EQ(a["final_fit"]["iterations"], 150);
   EXPECT_EQ(a["final_fit"]["residual"], true);
   EXPECT_EQ(a["final_fit_views"]["residual"], false);
-  std::string views;
-  for (const auto& v : a["initial_views"]) views += (views.empty() ? "" : ",") + v.get<std::string>();
-  for (const auto& v : a["selected_views"]) views += "," + v.get<std::string>();
-  const std::string train = "train --dataset " + d.file("s") + " --views " + views +
-                            " --iterations 150 --max-gaussians 40000 --sh-degree 0 --seed 3 --threads 2 ";
+  const std::string train = trainOn(a);
   for (const bool residual : {true, false}) {
     const std::string out = d.file(residual ? "tr" : "tp");
     r = run(train + (residual ? "--residual " : "") + "--out " + out);
@@ -206,8 +215,7 @@ TEST(Cli, FinalFitEqualsTrainOnTheChosenViews) {
   // The two trainings differ (otherwise the comparison above would not tell them apart).
   EXPECT_NE(a["final_fit"]["psnr"].get<double>(), a["final_fit_views"]["psnr"].get<double>());
   // A method that trains plainly makes one fit, reported as both.
-  r = run("active --dataset " + d.file("s") + " --method fisher --max-views 5 --interval 4 --min-iterations 40 " +
-          "--final-iterations 150 --seed 3 --threads 2 --out " + d.file("f"));
+  r = active("fisher", "", "f");
   ASSERT_EQ(r.code, 0) << r.output;
   const nlohmann::json f = nlohmann::json::parse(saresgs::test::readBytes(d.file("f/results.json")));
   EXPECT_EQ(f["final_fit"]["residual"], false);
@@ -215,8 +223,7 @@ TEST(Cli, FinalFitEqualsTrainOnTheChosenViews) {
   EXPECT_FALSE(std::filesystem::exists(d.file("f/final_fit_views.ply")));
   // --final-residual gives a plain-training method the residual final fit: the same views,
   // a final fit equal to `train --residual` on them, and the plain run's fit as the refit.
-  r = run("active --dataset " + d.file("s") + " --method fisher --max-views 5 --interval 4 --min-iterations 40 " +
-          "--final-iterations 150 --seed 3 --threads 2 --final-residual --out " + d.file("fr"));
+  r = active("fisher", "--final-residual ", "fr");
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("final fit on these views (150 it, residual)"), std::string::npos) << r.output;
   const nlohmann::json fr = nlohmann::json::parse(saresgs::test::readBytes(d.file("fr/results.json")));
@@ -224,11 +231,7 @@ TEST(Cli, FinalFitEqualsTrainOnTheChosenViews) {
   EXPECT_EQ(fr["psnr"], f["psnr"]);
   EXPECT_EQ(fr["final_fit"]["residual"], true);
   EXPECT_EQ(fr["final_fit_views"], f["final_fit"]);
-  std::string fviews;
-  for (const auto& v : f["initial_views"]) fviews += (fviews.empty() ? "" : ",") + v.get<std::string>();
-  for (const auto& v : f["selected_views"]) fviews += "," + v.get<std::string>();
-  r = run("train --dataset " + d.file("s") + " --views " + fviews +
-          " --iterations 150 --max-gaussians 40000 --sh-degree 0 --seed 3 --threads 2 --residual --out " + d.file("ftr"));
+  r = run(trainOn(f) + "--residual --out " + d.file("ftr"));
   ASSERT_EQ(r.code, 0) << r.output;
   const nlohmann::json ftr = nlohmann::json::parse(saresgs::test::readBytes(d.file("ftr/results.json")));
   EXPECT_EQ(ftr["psnr"].get<double>(), fr["final_fit"]["psnr"].get<double>());
@@ -236,8 +239,7 @@ TEST(Cli, FinalFitEqualsTrainOnTheChosenViews) {
   EXPECT_NE(fr["final_fit"]["psnr"].get<double>(), f["final_fit"]["psnr"].get<double>());
   // --no-plain-refit leaves the plain refit out (results.json, the table, the .ply) and
   // changes nothing else: the same views and the same final fit.
-  r = run("active --dataset " + d.file("s") + " --method sa-resgs --max-views 5 --interval 4 --min-iterations 40 " +
-          "--final-iterations 150 --seed 3 --threads 2 --no-plain-refit --out " + d.file("n"));
+  r = active("sa-resgs", "--no-plain-refit ", "n");
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_EQ(r.output.find("plain refit"), std::string::npos) << r.output;
   const nlohmann::json n = nlohmann::json::parse(saresgs::test::readBytes(d.file("n/results.json")));
