@@ -36,8 +36,9 @@ int rasterThreadCount(const RasterExecution& e);
 // Throws std::invalid_argument for kernels the CPU lacks, as rendering with `e` does.
 const char* rasterKernelName(const RasterExecution& e);
 
-// The forward kernel's per-pair arithmetic alone (exponent, exp2, alpha, tests and the
-// compositing step, on register-resident pixels: no tile walk or memory traffic), timed
+// The forward kernel's per-pair arithmetic alone (on the lattice: G's two products, alpha,
+// tests and the compositing step, on register-resident pixels: no tile walk, no first
+// block's exponentials, no memory traffic), timed
 // on the calling thread with e's kernels for about `seconds`: nanoseconds per
 // Gaussian-pixel pair on one core, the floor against which `bench step` reports a pass.
 double rasterForwardFloorNsPerPair(const RasterExecution& e, double seconds = 0.2);

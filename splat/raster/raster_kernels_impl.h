@@ -129,8 +129,7 @@ inline vf vmax(vf a, vf b) {
 // < 2e-7). x is clamped to -125 so that 2^n stays a normal float: below it the result
 // is 2^-125 (~2.4e-38) instead of 2^x, which the kernels never see, as they use G only
 // where o G >= 1/255.
-inline vf exp2NonPositive(vf x) {
-  const vf xc = vmax(vs(-125.0f), x);  // -125 where x < -125 (x is never NaN here)
+inline vf exp2Core(vf xc) {
   const vf magic = vs(12582912.0f);     // 1.5 * 2^23
   const vf m = xc + magic;              // rounds to the nearest whole number (even on ties)
   const vf n = m - magic;
@@ -143,6 +142,12 @@ inline vf exp2NonPositive(vf x) {
   const vf scale = reinterpret_cast<vf>((reinterpret_cast<vi>(m) - (0x4B400000 - 127)) << 23);
   return p * scale;
 }
+inline vf exp2NonPositive(vf x) {
+  return exp2Core(vmax(vs(-125.0f), x));  // -125 where x < -125 (x is never NaN here)
+}
+// 2^x for x in [-125, 125] (clamped there), the same polynomial: the lattice's step
+// factors (forEachBlock), which may exceed 1.
+inline vf exp2Clamped(vf x) { return exp2Core(vmin(vs(125.0f), vmax(vs(-125.0f), x))); }
 
 // A Gaussian's exponent is evaluated in base 2 (power * log2 e, so G = 2^power2): the
 // factor is folded into its per-Gaussian coefficients, not paid per pixel.
@@ -226,11 +231,54 @@ inline vi absLe(vf v, vf bound) { return reinterpret_cast<vf>(reinterpret_cast<v
 constexpr int kBlocks = kTile * kTile / L;  // vector blocks per tile
 constexpr int kChordMinSpan = 32;           // pixels (see forEachBlock)
 
+// The lattice (forEachBlock): a Gaussian's base-2 exponent is a quadratic
+// p(dx, dy) = al dx^2 + be dx dy + ga dy^2, so along a row of blocks (dx += kBW) the
+// factor from one block's G to the next, 2^(p(dx + kBW) - p(dx)), changes by the constant
+// factor 2^(2 al kBW^2), and from one block row to the next (dy += kBH) G changes by
+// 2^(p(dy + kBH) - p(dy)), which changes by 2^(2 ga kBH^2), while the row factor changes
+// by 2^(kBW kBH be). Three exponentials of eight lanes and one of the constants give
+// every block's G by products: two multiplications per block instead of the exponent and
+// exp2. Used where every lane of the Gaussian's block rectangle has p >= kLatticeFloor,
+// so that every G and every step factor inside it is a normal float, and where the
+// rectangle has at least kLatticeMinBlocks blocks (below it the four exponentials cost
+// more than they save). G's relative error is then the first block's three exponents'
+// rounding (terms up to |kLatticeFloor|) plus one rounding per product, at most 4 + 8 + 4
+// in a 16-pixel tile: up to 1.4e-5 measured with eight lanes and 2.0e-5 with four,
+// against up to 1.1e-4 for the exponent per block on needle-like Gaussians, whose terms
+// cancel (TileWalk.*, tests/splat/raster/test_raster_lattice.cpp). Every kernel walks
+// the same lattice, so the forward, backward and Fisher passes make identical decisions.
+constexpr float kLatticeFloor = -100.0f;
+constexpr int kLatticeMinBlocks = 5;
+
+struct Lattice {
+  float al, be, ga;  // the exponent's coefficients in base 2
+};
+
+// Whether Gaussian g's block rectangle (columns [cb0, cbl + kBW), rows [rb0 kBH,
+// (rbl + 1) kBH) of the tile at x0, y0) suits the lattice. A concave quadratic takes its
+// minimum over a rectangle at a corner; NaN coefficients fail every comparison.
+inline bool latticeFits(const TileGaussian<float>& g, int x0, int y0, int cb0, int cbl, int rb0, int rbl,
+                        Lattice& lt) {
+  lt.al = -0.5f * kLog2e * g.a;
+  lt.be = -kLog2e * g.b;
+  lt.ga = -0.5f * kLog2e * g.c;
+  const float sx = 2.0f * kBW * kBW * lt.al, sy = 2.0f * kBH * kBH * lt.ga, sxy = kBW * kBH * lt.be;
+  if (!(sx >= kLatticeFloor && sy >= kLatticeFloor && sxy >= kLatticeFloor && sxy <= -kLatticeFloor)) return false;
+  const float X0 = static_cast<float>(x0 + cb0) + 0.5f - g.mx;
+  const float X1 = static_cast<float>(x0 + cbl + kBW - 1) + 0.5f - g.mx;
+  const float Y0 = static_cast<float>(y0 + rb0 * kBH) + 0.5f - g.my;
+  const float Y1 = static_cast<float>(y0 + rbl * kBH + kBH - 1) + 0.5f - g.my;
+  auto P = [&](float x, float y) { return (lt.al * x + lt.be * y) * x + lt.ga * y * y; };
+  const float p00 = P(X0, Y0), p01 = P(X0, Y1), p10 = P(X1, Y0), p11 = P(X1, Y1);
+  return p00 >= kLatticeFloor && p01 >= kLatticeFloor && p10 >= kLatticeFloor && p11 >= kLatticeFloor;
+}
+
 // Calls body(block, lanes, dy) for every block of the tile [x0, x1) x [y0, y1) that
 // Gaussian g may touch (its rectangle, narrowed per block row by blockRowSpan), row by
 // row and left to right: the one pixel loop of every kernel. Pixel centres are whole
 // numbers + 0.5, exact in float, so stepping them by kBW gives the same offsets as
-// computing each afresh.
+// computing each afresh. G comes from the lattice above where it fits, else from
+// evalLanes' exponent and exp2 per block.
 template <typename Body>
 __attribute__((always_inline)) inline void forEachBlock(const TileGaussian<float>& g, int x0, int y0, int x1,
                                                         int y1, Body&& body) {
@@ -239,7 +287,6 @@ __attribute__((always_inline)) inline void forEachBlock(const TileGaussian<float
   tileSpan(g.py0, g.py1, y0, y1, r0, r1);
   if (c0 > c1 || r0 > r1) return;
   const vf mx = vs(g.mx), my = vs(g.my), hx = vs(g.hx), hy = vs(g.hy), o = vs(g.o);
-  const vf ha = vs(-0.5f * kLog2e) * vs(g.a);
   const vf lane_x = laneColCentres(), lane_y = laneRowCentres();
   // Chords (blockRowSpan) only for Gaussians wider than kChordMinSpan pixels: for the
   // small ones, which are most pairs, a block row's span costs more than the blocks it
@@ -247,7 +294,64 @@ __attribute__((always_inline)) inline void forEachBlock(const TileGaussian<float
   // and 100k Gaussians and 1500 training iterations on room360 13 % faster, same
   // output); a long thin Gaussian across a tile still skips the blocks it misses.
   const bool narrow = g.px1 - g.px0 + 1 > kChordMinSpan;
-  for (int rb = r0 / kBH; rb <= r1 / kBH; ++rb) {
+  const int rb0 = r0 / kBH, rbl = r1 / kBH;
+  {
+    const int cb0 = c0 & ~(kBW - 1), cbl = c1 & ~(kBW - 1);
+    Lattice lt;
+    if ((cbl - cb0) / kBW * (rbl - rb0 + 1) + (rbl - rb0 + 1) >= kLatticeMinBlocks &&
+        latticeFits(g, x0, y0, cb0, cbl, rb0, rbl, lt)) {
+      const vf dx0 = (vs(static_cast<float>(x0 + cb0)) + lane_x) - mx;
+      const vf dy0 = (vs(static_cast<float>(y0 + rb0 * kBH)) + lane_y) - my;
+      const vf al = vs(lt.al), be = vs(lt.be), ga = vs(lt.ga);
+      // G at the first block, its step factor to the right and its step factor down.
+      vf g_row = exp2Clamped(fma(al * dx0 + be * dy0, dx0, ga * dy0 * dy0));
+      vf e_row = exp2Clamped(fma(al, fma(vs(2.0f * kBW), dx0, vs(static_cast<float>(kBW * kBW))),
+                                 vs(static_cast<float>(kBW)) * be * dy0));
+      vf f = exp2Clamped(fma(ga, fma(vs(2.0f * kBH), dy0, vs(static_cast<float>(kBH * kBH))),
+                             vs(static_cast<float>(kBH)) * be * dx0));
+      vf kv = vs(0.0f);
+      kv[0] = 2.0f * kBW * kBW * lt.al;
+      kv[1] = 2.0f * kBH * kBH * lt.ga;
+      kv[2] = kBW * kBH * lt.be;
+      kv = exp2Clamped(kv);
+      const vf kx = vs(kv[0]), ky = vs(kv[1]), kxy = vs(kv[2]);
+      const vf max_a = vs(kMaxA), min_a = vs(kMinA);
+      for (int rb = rb0; rb <= rbl; ++rb) {
+        // A wide Gaussian's rows skip the blocks its chord misses (the lattice still
+        // steps over them: two multiplications each, in the same order as in a row
+        // that visits them).
+        int lo = c0, hi = c1;
+        if (narrow) blockRowSpan(g, x0, y0, rb, c0, c1, lo, hi);
+        const vf dy = (vs(static_cast<float>(y0 + rb * kBH)) + lane_y) - my;
+        const vi row_in = absLe(dy, hy);
+        vf G = g_row, e = e_row;
+        int cb = cb0;
+        for (const int first = lo & ~(kBW - 1); cb < first; cb += kBW) {
+          G = G * e;
+          e = e * kx;
+        }
+        vf px = vs(static_cast<float>(x0 + cb)) + lane_x;
+        int blk = rb * kBX + cb / kBW;
+        for (; cb <= hi; cb += kBW, ++blk, px = px + vs(static_cast<float>(kBW))) {
+          Lanes l;
+          l.dx = px - mx;
+          l.G = G;
+          l.oG = o * G;
+          l.alpha = vmin(l.oG, max_a);
+          l.touches = row_in & absLe(l.dx, hx) & (l.oG >= min_a);
+          body(blk, l, dy);
+          G = G * e;
+          e = e * kx;
+        }
+        g_row = g_row * f;
+        f = f * ky;
+        e_row = e_row * kxy;
+      }
+      return;
+    }
+  }
+  const vf ha = vs(-0.5f * kLog2e) * vs(g.a);
+  for (int rb = rb0; rb <= rbl; ++rb) {
     int lo = c0, hi = c1;
     if (narrow) {
       blockRowSpan(g, x0, y0, rb, c0, c1, lo, hi);
@@ -356,30 +460,40 @@ void compositeTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1,
 }
 
 // The machine's floor for the forward kernel's arithmetic (raster_kernels.h): the same
-// per-lane work as compositeTile (evalLanes and ForwardState::step) on two blocks held
-// in registers, with no tile walk, gather or memory traffic, for n rounds. The offsets
-// move every round so nothing folds away; the checksum keeps the result alive. They
-// cycle through 1024 steps of 1/1024 px (dx within [-1.5, 6.5)), so the exponent stays above -1
-// and every value stays a normal float: offsets that grew with the round count (as they
-// did before 2026-11-27) sent the exponent below -125 after about 10^5 rounds, and from
-// there each round took denormal-operand assists (about 90 cycles each on this machine),
-// which made the "floor" 5-7 times slower than the kernels' arithmetic.
+// per-lane work as compositeTile on the lattice (forEachBlock: G and its step factor
+// multiplied on, the opacity, the alpha clamp, the rectangle and alpha tests, and
+// ForwardState::step) on two blocks held in registers, with no tile walk, gather or
+// memory traffic, for n rounds. Each round starts from a G that moves with the round
+// count, cycling through [0.3, 0.8) so that every value stays a normal float (offsets
+// that grew without bound sent an earlier version of this loop into denormal operands,
+// whose assists made the "floor" 5-7 times slower than the kernels' arithmetic); the
+// checksum keeps the result alive. Before 2026-11-27 the floor was evalLanes' exponent
+// and exp2 per block, the kernels' arithmetic before the lattice.
 float compositeFloor(long n) {
   ForwardBlock b[2];
   for (ForwardBlock& B : b) {
     B.Tr = vs(1.0f);
     B.C0 = B.C1 = B.C2 = B.D = B.walked = B.contrib = vs(0.0f);
   }
-  const vf ha = vs(-0.5f * kLog2e * 0.02f), o = vs(0.6f), hx = vs(1e6f), qy = vs(-0.01f), by = vs(0.002f);
+  const vf o = vs(0.6f), hx = vs(1e6f), mx = vs(2.0f), kx = vs(0.99f);
   const vi row_in = vi{} - 1;
   const vf col0 = vs(0.3f), col1 = vs(0.5f), col2 = vs(0.7f), dep = vs(2.0f), jf = vs(1.0f);
-  const vf dx0 = laneColCentres() - vs(2.0f);
+  const vf lane_x = laneColCentres();
   for (long i = 0; i < n; ++i) {
-    const vf dx = dx0 + vs(static_cast<float>(i & 1023) * (1.0f / 1024.0f));
-    for (int k = 0; k < 2; ++k) {
-      ForwardState::step(b[k], evalLanes(dx + vs(static_cast<float>(4 * k)), ha, qy, by, o, hx, row_in), col0, col1,
-                         col2, dep, jf);
+    const float t = static_cast<float>(i & 1023) * (1.0f / 2048.0f);
+    vf G = vs(0.3f + t) + lane_x * vs(0.01f), e = vs(0.9f + 0.1f * t);
+    vf px = lane_x;
+    for (int k = 0; k < 2; ++k, px = px + vs(static_cast<float>(kBW))) {
+      Lanes l;
+      l.dx = px - mx;
+      l.G = G;
+      l.oG = o * G;
+      l.alpha = vmin(l.oG, vs(kMaxA));
+      l.touches = row_in & absLe(l.dx, hx) & (l.oG >= vs(kMinA));
+      ForwardState::step(b[k], l, col0, col1, col2, dep, jf);
       b[k].Tr = vmax(b[k].Tr, vs(0.5f));  // keeps the pixels live (the real blocks mostly are)
+      G = G * e;
+      e = e * kx;
     }
   }
   return hsum(b[0].C0 + b[1].C0 + b[0].D + b[1].D + b[0].contrib + b[1].walked);
