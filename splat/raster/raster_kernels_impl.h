@@ -322,26 +322,28 @@ __attribute__((always_inline)) inline void forEachBlock(const TileGaussian<float
         // that visits them).
         int lo = c0, hi = c1;
         if (narrow) blockRowSpan(g, x0, y0, rb, c0, c1, lo, hi);
-        const vf dy = (vs(static_cast<float>(y0 + rb * kBH)) + lane_y) - my;
-        const vi row_in = absLe(dy, hy);
-        vf G = g_row, e = e_row;
-        int cb = cb0;
-        for (const int first = lo & ~(kBW - 1); cb < first; cb += kBW) {
-          G = G * e;
-          e = e * kx;
-        }
-        vf px = vs(static_cast<float>(x0 + cb)) + lane_x;
-        int blk = rb * kBX + cb / kBW;
-        for (; cb <= hi; cb += kBW, ++blk, px = px + vs(static_cast<float>(kBW))) {
-          Lanes l;
-          l.dx = px - mx;
-          l.G = G;
-          l.oG = o * G;
-          l.alpha = vmin(l.oG, max_a);
-          l.touches = row_in & absLe(l.dx, hx) & (l.oG >= min_a);
-          body(blk, l, dy);
-          G = G * e;
-          e = e * kx;
+        if (lo <= hi) {
+          const vf dy = (vs(static_cast<float>(y0 + rb * kBH)) + lane_y) - my;
+          const vi row_in = absLe(dy, hy);
+          vf G = g_row, e = e_row;
+          int cb = cb0;
+          for (const int first = lo & ~(kBW - 1); cb < first; cb += kBW) {
+            G = G * e;
+            e = e * kx;
+          }
+          vf px = vs(static_cast<float>(x0 + cb)) + lane_x;
+          int blk = rb * kBX + cb / kBW;
+          for (; cb <= hi; cb += kBW, ++blk, px = px + vs(static_cast<float>(kBW))) {
+            Lanes l;
+            l.dx = px - mx;
+            l.G = G;
+            l.oG = o * G;
+            l.alpha = vmin(l.oG, max_a);
+            l.touches = row_in & absLe(l.dx, hx) & (l.oG >= min_a);
+            body(blk, l, dy);
+            G = G * e;
+            e = e * kx;
+          }
         }
         g_row = g_row * f;
         f = f * ky;
