@@ -107,9 +107,9 @@ struct WalkStats {
 // Walks one Gaussian over the tile at (x0, y0) with namespace NS's forEachBlock and
 // checks every lane against double precision: the lane's offsets are exact, a pixel is
 // visited at most once, every pixel that passes rule 4's rectangle and the alpha
-// threshold (by a relative margin of 1e-5) is visited and touched, none that fails it by
-// that margin is touched, and where it passes, G is within kTolLattice (kTolExact off
-// the lattice) of exp in double.
+// threshold by more than the path's tolerance (kTolLattice on the lattice, kTolExact off
+// it) is visited and touched, none that fails it by that margin is touched, and where it
+// passes, G is within that tolerance of exp in double.
 #define SARESGS_LATTICE_WALK(NS)                                                                             \
   void walk##NS(const Spec& s, bool chords, int x0, int y0, WalkStats& st) {                               \
     using namespace raster_kernels::NS;                                                                    \
@@ -143,14 +143,14 @@ struct WalkStats {
                                           static_cast<double>(g.c) * dyd * dyd));                          \
         const double oG = static_cast<double>(g.o) * G;                                                    \
         const bool in_rect = std::abs(ex) <= g.hx && std::abs(ey) <= g.hy;                                 \
-        if (in_rect && oG >= kMinA * (1.0 + 1e-5)) {                                                       \
+        if (in_rect && oG >= kMinA * (1.0 + tol)) {                                                        \
           ASSERT_NE(ln.touches[i], 0) << "row " << row << " col " << col << " oG " << oG;                  \
           const double rel = std::abs(static_cast<double>(ln.G[i]) - G) / G;                               \
           (lattice ? st.max_rel_lattice : st.max_rel) = std::max(lattice ? st.max_rel_lattice : st.max_rel, rel); \
           ++st.lanes_checked;                                                                              \
           ASSERT_LE(rel, tol) << "row " << row << " col " << col << " G " << G;                            \
           ASSERT_NEAR(ln.alpha[i], std::min(oG, 0.99), 0.99 * tol + 1e-7);                                 \
-        } else if (!in_rect || oG <= kMinA * (1.0 - 1e-5)) {                                               \
+        } else if (!in_rect || oG <= kMinA * (1.0 - tol)) {                                                \
           ASSERT_EQ(ln.touches[i], 0) << "row " << row << " col " << col << " oG " << oG;                  \
         }                                                                                                  \
       }                                                                                                    \
@@ -161,7 +161,7 @@ struct WalkStats {
         const double ex = static_cast<float>(x0 + col) + 0.5f - g.mx;                                      \
         const double ey = static_cast<float>(y0 + row) + 0.5f - g.my;                                      \
         const double oG = g.o * std::exp(-0.5 * (g.a * ex * ex + 2.0 * g.b * ex * ey + g.c * ey * ey));    \
-        if (std::abs(ex) <= g.hx && std::abs(ey) <= g.hy && oG >= kMinA * (1.0 + 1e-5)) {                  \
+        if (std::abs(ex) <= g.hx && std::abs(ey) <= g.hy && oG >= kMinA * (1.0 + tol)) {                   \
           ASSERT_EQ(visits[row * kTile + col], 1) << "row " << row << " col " << col;                      \
           ASSERT_TRUE(touched[row * kTile + col]);                                                         \
         }                                                                                                  \
