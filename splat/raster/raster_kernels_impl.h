@@ -167,20 +167,28 @@ struct Lanes {
   vi touches;
 };
 
-inline Lanes evalLanes(vf dx, vf ha, vf qy, vf by, vf o, vf hx, vi row_in) {
+// The lanes of a block whose G is known (from evalLanes' exponent or from forEachBlock's
+// lattice): o G, the clamped alpha, and the rectangle test in x plus the alpha test.
+inline Lanes lanesOfG(vf dx, vf G, vf o, vf hx, vi row_in) {
   Lanes l;
   l.dx = dx;
+  l.G = G;
+  l.oG = o * G;
+  l.alpha = vmin(l.oG, vs(kMaxA));
+  const vf adx = reinterpret_cast<vf>(reinterpret_cast<vi>(dx) & 0x7fffffff);
+  l.touches = row_in & (adx <= hx) & (l.oG >= vs(kMinA));
+  return l;
+}
+
+inline Lanes evalLanes(vf dx, vf ha, vf qy, vf by, vf o, vf hx, vi row_in) {
   // ((-0.5 a log2e) dx) dx + row_quad - row_cross dx: the exponent in base 2.
 #if SARESGS_KERNEL_FMA
   const vf power = fma(-by, dx, fma(ha * dx, dx, qy));
 #else
   const vf power = ha * dx * dx + qy - by * dx;
 #endif
-  l.G = exp2NonPositive(vmin(power, vs(0.0f)));  // power < 0 ? power : 0
-  l.oG = o * l.G;
-  l.alpha = vmin(l.oG, vs(kMaxA));
-  const vf adx = reinterpret_cast<vf>(reinterpret_cast<vi>(dx) & 0x7fffffff);
-  l.touches = row_in & (adx <= hx) & (power <= vs(0.0f)) & (l.oG >= vs(kMinA));
+  Lanes l = lanesOfG(dx, exp2NonPositive(vmin(power, vs(0.0f))), o, hx, row_in);  // power < 0 ? power : 0
+  l.touches = l.touches & (power <= vs(0.0f));
   return l;
 }
 
@@ -255,10 +263,12 @@ struct Lattice {
 };
 
 // Whether Gaussian g's block rectangle (columns [cb0, cbl + kBW), rows [rb0 kBH,
-// (rbl + 1) kBH) of the tile at x0, y0) suits the lattice. A concave quadratic takes its
-// minimum over a rectangle at a corner; NaN coefficients fail every comparison.
+// (rbl + 1) kBH) of the tile at x0, y0) suits the lattice: at least kLatticeMinBlocks
+// blocks, and p >= kLatticeFloor at its corners (a concave quadratic takes its minimum
+// over a rectangle at a corner; NaN coefficients fail every comparison).
 inline bool latticeFits(const TileGaussian<float>& g, int x0, int y0, int cb0, int cbl, int rb0, int rbl,
                         Lattice& lt) {
+  if (((cbl - cb0) / kBW + 1) * (rbl - rb0 + 1) < kLatticeMinBlocks) return false;
   lt.al = -0.5f * kLog2e * g.a;
   lt.be = -kLog2e * g.b;
   lt.ga = -0.5f * kLog2e * g.c;
@@ -298,8 +308,7 @@ __attribute__((always_inline)) inline void forEachBlock(const TileGaussian<float
   {
     const int cb0 = c0 & ~(kBW - 1), cbl = c1 & ~(kBW - 1);
     Lattice lt;
-    if ((cbl - cb0) / kBW * (rbl - rb0 + 1) + (rbl - rb0 + 1) >= kLatticeMinBlocks &&
-        latticeFits(g, x0, y0, cb0, cbl, rb0, rbl, lt)) {
+    if (latticeFits(g, x0, y0, cb0, cbl, rb0, rbl, lt)) {
       const vf dx0 = (vs(static_cast<float>(x0 + cb0)) + lane_x) - mx;
       const vf dy0 = (vs(static_cast<float>(y0 + rb0 * kBH)) + lane_y) - my;
       const vf al = vs(lt.al), be = vs(lt.be), ga = vs(lt.ga);
@@ -315,7 +324,6 @@ __attribute__((always_inline)) inline void forEachBlock(const TileGaussian<float
       kv[2] = kBW * kBH * lt.be;
       kv = exp2Clamped(kv);
       const vf kx = vs(kv[0]), ky = vs(kv[1]), kxy = vs(kv[2]);
-      const vf max_a = vs(kMaxA), min_a = vs(kMinA);
       for (int rb = rb0; rb <= rbl; ++rb) {
         // A wide Gaussian's rows skip the blocks its chord misses (the lattice still
         // steps over them: two multiplications each, in the same order as in a row
@@ -334,13 +342,7 @@ __attribute__((always_inline)) inline void forEachBlock(const TileGaussian<float
           vf px = vs(static_cast<float>(x0 + cb)) + lane_x;
           int blk = rb * kBX + cb / kBW;
           for (; cb <= hi; cb += kBW, ++blk, px = px + vs(static_cast<float>(kBW))) {
-            Lanes l;
-            l.dx = px - mx;
-            l.G = G;
-            l.oG = o * G;
-            l.alpha = vmin(l.oG, max_a);
-            l.touches = row_in & absLe(l.dx, hx) & (l.oG >= min_a);
-            body(blk, l, dy);
+            body(blk, lanesOfG(px - mx, G, o, hx, row_in), dy);
             G = G * e;
             e = e * kx;
           }
@@ -486,13 +488,7 @@ float compositeFloor(long n) {
     vf G = vs(0.3f + t) + lane_x * vs(0.01f), e = vs(0.9f + 0.1f * t);
     vf px = lane_x;
     for (int k = 0; k < 2; ++k, px = px + vs(static_cast<float>(kBW))) {
-      Lanes l;
-      l.dx = px - mx;
-      l.G = G;
-      l.oG = o * G;
-      l.alpha = vmin(l.oG, vs(kMaxA));
-      l.touches = row_in & absLe(l.dx, hx) & (l.oG >= vs(kMinA));
-      ForwardState::step(b[k], l, col0, col1, col2, dep, jf);
+      ForwardState::step(b[k], lanesOfG(px - mx, G, o, hx, row_in), col0, col1, col2, dep, jf);
       b[k].Tr = vmax(b[k].Tr, vs(0.5f));  // keeps the pixels live (the real blocks mostly are)
       G = G * e;
       e = e * kx;

@@ -122,8 +122,7 @@ struct WalkStats {
     if (c0 <= c1 && r0 <= r1) {                                                                            \
       Lattice lt;                                                                                          \
       const int cb0 = c0 & ~(kBW - 1), cbl = c1 & ~(kBW - 1);                                              \
-      const bool fits = latticeFits(g, x0, y0, cb0, cbl, r0 / kBH, r1 / kBH, lt);                          \
-      lattice = fits && (cbl - cb0 + kBW) / kBW * (r1 / kBH - r0 / kBH + 1) >= kLatticeMinBlocks;          \
+      lattice = latticeFits(g, x0, y0, cb0, cbl, r0 / kBH, r1 / kBH, lt);                                  \
       st.on_lattice += lattice;                                                                            \
     }                                                                                                      \
     const double tol = lattice ? kTolLattice : kTolExact;                                                  \
