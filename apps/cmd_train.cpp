@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include <chrono>
+#include <cmath>
 #include <optional>
 #include <cstdio>
 #include <filesystem>
@@ -79,6 +80,18 @@ int runTrain(TrainArgs& a) {
   std::cerr << "training on " << views.size() << " views (" << scene.test.size() << " test), "
             << trainer.gaussians().size() << " initial Gaussians, " << a.iterations << " iterations\n";
   trainer.planUntil(a.iterations);
+  // Every image this run will read (the training visits each view once per pass when it
+  // has at least as many iterations left as views; the evaluation reads the rest), decoded
+  // on all cores at once rather than one by one inside the steps.
+  {
+    const std::vector<int>& eval = scene.test.empty() ? scene.train : scene.test;
+    std::vector<int> read(eval);
+    if (a.iterations - trainer.iteration() >= static_cast<int>(views.size())) read.insert(read.end(), views.begin(), views.end());
+    const auto d0 = std::chrono::steady_clock::now();
+    scene.preloadImages(read);
+    std::cerr << "decoded " << read.size() << " images in "
+              << std::lround(1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - d0).count()) << " ms\n";
+  }
   Progress progress;
   const int start = trainer.iteration();
   const auto t0 = std::chrono::steady_clock::now();
@@ -97,7 +110,7 @@ int runTrain(TrainArgs& a) {
   const double train_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   const std::vector<int>& eval_views = scene.test.empty() ? scene.train : scene.test;
-  const Evaluation ev = trainer.evaluate(eval_views);
+  const Evaluation ev = trainer.evaluate(eval_views, /*keep_renders=*/true);
   writeTestRenders(trainer, ev, a.out + "/test_renders");
   writeGaussiansPly(a.out + "/point_cloud.ply", gaussiansToWorld(trainer.gaussians(), scene.frame));
   writeCamerasJson(a.out + "/cameras.json", scene);  // beside the .ply, for splat viewers

@@ -30,6 +30,8 @@ using ImageF = ImageT<float>;         // float, RGB in [0,1] or 1-channel depth
 
 // 8-bit <-> float in [0,1]; values are clamped and rounded on the way back.
 ImageF toFloat(const Image8& img);
+// The same into `out`, reusing its storage when it is large enough.
+void toFloatInto(const Image8& img, ImageF& out);
 Image8 toByte(const ImageF& img);
 
 // Reads a PNG/JPEG as RGB or RGBA (alpha kept when `keep_alpha` and present).

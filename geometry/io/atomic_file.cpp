@@ -40,9 +40,26 @@ void writeFileAtomic(const std::string& path, const std::string& bytes) {
 std::string readFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, "file", "does not exist or cannot be read");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
+  std::error_code dir_ec;
+  if (fs::is_directory(path, dir_ec)) throw InputError(path, "file", "is a directory, expected a file");
+  // A regular file is read in one piece at its size (a stream copy grows by doubling and
+  // copies again: three times the file in fresh pages); whatever else (a pipe, a file
+  // that changes while read) by chunks to its end.
+  std::string out;
+  std::error_code ec;
+  const auto size = fs::is_regular_file(path, ec) ? fs::file_size(path, ec) : std::uintmax_t{0};
+  if (!ec && size > 0 && size < out.max_size()) {
+    out.resize(static_cast<std::size_t>(size));
+    in.read(out.data(), static_cast<std::streamsize>(out.size()));
+    out.resize(static_cast<std::size_t>(in.gcount()));
+  }
+  char chunk[1 << 16];
+  while (in) {
+    in.read(chunk, sizeof chunk);
+    out.append(chunk, static_cast<std::size_t>(in.gcount()));
+  }
+  if (in.bad()) throw InputError(path, "file", "read error");
+  return out;
 }
 
 int removeStaleTemporaries(const std::string& dir) {

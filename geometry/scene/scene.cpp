@@ -1,8 +1,11 @@
 #include "geometry/scene/scene.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <exception>
 #include <mutex>
+#include <tbb/parallel_for.h>
 #include <stdexcept>
 
 #include "geometry/error.h"
@@ -50,6 +53,38 @@ const Image8& Scene::image(int i) const {
   auto& slot = cache_->slots.at(static_cast<size_t>(i));
   if (!slot) slot = std::make_unique<Image8>(loadViewImage(views.at(i), load));
   return *slot;
+}
+
+void Scene::preloadImages(const std::vector<int>& which) const {
+  std::vector<int> missing;
+  {
+    std::lock_guard<std::mutex> lock(cache_->mutex);
+    if (cache_->slots.size() < views.size()) cache_->slots.resize(views.size());
+    for (int i : which)
+      if (!cache_->slots.at(static_cast<size_t>(i))) missing.push_back(i);
+  }
+  std::sort(missing.begin(), missing.end());
+  missing.erase(std::unique(missing.begin(), missing.end()), missing.end());
+  std::vector<std::unique_ptr<Image8>> loaded(missing.size());
+  std::vector<std::exception_ptr> failed(missing.size());
+  tbb::parallel_for(std::size_t{0}, missing.size(), [&](std::size_t k) {
+    try {
+      loaded[k] = std::make_unique<Image8>(loadViewImage(views.at(static_cast<size_t>(missing[k])), load));
+    } catch (...) {
+      failed[k] = std::current_exception();
+    }
+  });
+  // The first failure in `which`'s order, whatever order the decodes finished in.
+  for (int i : which) {
+    const auto at = std::lower_bound(missing.begin(), missing.end(), i);
+    if (at != missing.end() && *at == i && failed[static_cast<size_t>(at - missing.begin())])
+      std::rethrow_exception(failed[static_cast<size_t>(at - missing.begin())]);
+  }
+  std::lock_guard<std::mutex> lock(cache_->mutex);
+  for (std::size_t k = 0; k < missing.size(); ++k) {
+    auto& slot = cache_->slots[static_cast<size_t>(missing[k])];
+    if (!slot) slot = std::move(loaded[k]);
+  }
 }
 
 void Scene::releaseImages() const {

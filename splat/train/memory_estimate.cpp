@@ -19,13 +19,11 @@ MemoryEstimate estimateTrainingMemory(const Scene& scene, const std::vector<int>
   e.initial_gaussians = initial_gaussians;
   std::set<int> all(trained.begin(), trained.end());
   all.insert(evaluated.begin(), evaluated.end());
-  const std::set<int> train_set(trained.begin(), trained.end());
   for (int v : all) {
     if (v < 0 || static_cast<std::size_t>(v) >= scene.views.size()) continue;
     const Intrinsics& K = scene.views[static_cast<std::size_t>(v)].camera.K;
     const double px = static_cast<double>(K.width) * K.height;
-    e.image_bytes += 3.0 * px;                          // the scene's 8-bit copy
-    if (train_set.count(v)) e.image_bytes += 12.0 * px;  // the trainer's float target
+    e.image_bytes += 3.0 * px;  // the scene's 8-bit copy (the trainer's float target is one buffer)
     if (px > static_cast<double>(e.largest_width) * e.largest_height) {
       e.largest_width = K.width;
       e.largest_height = K.height;
@@ -34,9 +32,9 @@ MemoryEstimate estimateTrainingMemory(const Scene& scene, const std::vector<int>
   }
   // A step's per-pixel state: render outputs (rgb, alpha, depth, contributors, final T,
   // walk), the loss and its gradient, SSIM's five filtered planes and their gradients,
-  // a residual branch's second render: about 60 floats. Then 2x for what the allocator
+  // a residual branch's second render, the float target: about 63 floats. Then 2x for what the allocator
   // keeps between steps.
-  e.buffer_bytes = 2.0 * 60.0 * 4.0 * static_cast<double>(e.largest_width) * e.largest_height;
+  e.buffer_bytes = 2.0 * 63.0 * 4.0 * static_cast<double>(e.largest_width) * e.largest_height;
   // Per Gaussian: 11 + 3 (deg + 1)^2 floats held five times (model, gradient, two Adam
   // moments, initial copy), densification statistics (4 floats), the projection and tile
   // data (about 60 floats) and tile pairs (about 8 tiles of 14 floats: slots and lists).

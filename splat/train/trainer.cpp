@@ -233,9 +233,12 @@ RasterSettings Trainer::rasterSettings() const {
 }
 
 const ImageF& Trainer::target(int view) {
-  auto it = targets_.find(view);
-  if (it == targets_.end()) it = targets_.emplace(view, scene_.imageFloat(view)).first;
-  return it->second;
+  if (view != target_view_) {
+    target_view_ = -1;  // stays unset if the image cannot be read
+    toFloatInto(scene_.image(view), target_);
+    target_view_ = view;
+  }
+  return target_;
 }
 
 int Trainer::nextView(const std::vector<int>& views) {
@@ -327,12 +330,14 @@ double Trainer::step(int view) {
 
 RenderResult Trainer::render(const Camera& cam) const { return rasterize(g_, cam, rasterSettings()); }
 
-Evaluation Trainer::evaluate(const std::vector<int>& views) const {
+Evaluation Trainer::evaluate(const std::vector<int>& views, bool keep_renders) const {
   Evaluation e;
+  ImageF gt;
   for (int v : views) {
     const RenderResult r = render(scene_.views.at(static_cast<std::size_t>(v)).camera);
-    const ImageF gt = scene_.imageFloat(v);
+    toFloatInto(scene_.image(v), gt);
     e.views.push_back({v, psnr(r.rgb, gt), ssim(r.rgb, gt)});
+    if (keep_renders) e.renders.push_back(toByte(r.rgb));
     e.psnr += e.views.back().psnr;
     e.ssim += e.views.back().ssim;
   }

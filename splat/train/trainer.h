@@ -14,7 +14,6 @@
 #include <array>
 #include <cstdint>
 #include <functional>
-#include <map>
 #include <random>
 #include <span>
 #include <string>
@@ -88,6 +87,9 @@ struct ViewMetrics {
 struct Evaluation {
   std::vector<ViewMetrics> views;
   double psnr = 0, ssim = 0;  // means over views
+  // The 8-bit renders, one per entry of views, when evaluate() was asked to keep them
+  // (writeTestRenders then need not render again); empty otherwise.
+  std::vector<Image8> renders;
 };
 
 // The number of Gaussians the trainer starts from (Trainer's constructor): one per sparse
@@ -145,7 +147,7 @@ class Trainer {
   void checkFinite(int view) const;
 
   RenderResult render(const Camera& cam) const;
-  Evaluation evaluate(const std::vector<int>& views) const;
+  Evaluation evaluate(const std::vector<int>& views, bool keep_renders = false) const;
   // The model, optimiser and schedules as after construction; the random generator
   // continues (so that repeated resets do not replay the same views).
   void reset();
@@ -190,7 +192,11 @@ class Trainer {
   int planned_until_ = 0; // planUntil()'s value; 0: none
   double loss_ema_ = 0;
   std::vector<int> view_set_, view_stack_;
-  std::map<int, ImageF> targets_;  // float images of the views trained on
+  // The current step's view as float, converted from the scene's 8-bit image into one
+  // reused buffer: a float copy per view (12 bytes a pixel, 309 MB for room360's 131 views
+  // at 512x384) cost more in first-touch page faults than the conversion costs per step.
+  ImageF target_;
+  int target_view_ = -1;
   StageSeconds seconds_;
   StepBuffers step_buffers_;  // a step's renders and loss images, reused
 };

@@ -2,6 +2,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 #include <random>
+#include <tuple>
 
 #include "common/test_support.h"
 #include "geometry/image/image.h"
@@ -55,6 +56,35 @@ TEST(ImageIO, FloatConversionClampsAndRounds) {
   const Image8 b = toByte(f);
   EXPECT_EQ(b.data, (std::vector<std::uint8_t>{0, 128, 255, 0, 1, 255}));
   EXPECT_FLOAT_EQ(toFloat(b).data[2], 1.0f);
+}
+
+// Converting into a reused image gives what a fresh conversion gives, whatever the
+// image held before (larger, smaller, another channel count).
+TEST(ImageIO, FloatConversionIntoAReusedImageEqualsAFreshOne) {
+  ImageF out;
+  for (const auto& [w, h, c] : {std::tuple{31, 17, 3}, std::tuple{5, 4, 3}, std::tuple{40, 20, 4}, std::tuple{3, 2, 1}}) {
+    const Image8 img = randomImage(w, h, c, static_cast<std::uint64_t>(w * 100 + c));
+    toFloatInto(img, out);
+    const ImageF fresh = toFloat(img);
+    EXPECT_EQ(out.width, w);
+    EXPECT_EQ(out.height, h);
+    EXPECT_EQ(out.channels, c);
+    EXPECT_EQ(out.data, fresh.data);
+    for (std::size_t i = 0; i < img.data.size(); ++i) ASSERT_NEAR(out.data[i], img.data[i] / 255.0, 1.2e-7);  // within two ulps
+  }
+}
+
+// An 8-bit grey file comes back as RGB with each channel the grey value.
+TEST(ImageIO, GreyIsReplicatedIntoRgb) {
+  test::TempDir d;
+  const Image8 grey = randomImage(13, 9, 1, 5);
+  cv::Mat m(9, 13, CV_8UC1, const_cast<std::uint8_t*>(grey.data.data()));
+  cv::imwrite(d.file("grey.png"), m);
+  const Image8 img = readImage(d.file("grey.png"), /*keep_alpha=*/true);
+  ASSERT_EQ(img.channels, 3);
+  for (int y = 0; y < 9; ++y)
+    for (int x = 0; x < 13; ++x)
+      for (int ch = 0; ch < 3; ++ch) ASSERT_EQ(img.at(x, y, ch), grey.at(x, y, 0));
 }
 
 TEST(ImageIO, UnreadableFilesNameTheFile) {

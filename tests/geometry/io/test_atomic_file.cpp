@@ -1,6 +1,10 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
+#include <random>
+#include <sys/stat.h>
+#include <thread>
 #include <stdexcept>
 
 #include "common/test_support.h"
@@ -59,3 +63,26 @@ TEST(AtomicFile, StaleTemporariesOfDeadWritersAreRemoved) {
 
 }  // namespace
 }  // namespace saresgs
+
+// A regular file is read at its size, anything else to its end: a file past the chunk
+// size with every byte value, a pipe fed by a writer, an empty file; a folder is refused.
+TEST(AtomicFile, ReadsLargeFilesAndPipesAndRefusesFolders) {
+  test::TempDir d;
+  std::string big(1 << 20 | 12345, '\0');
+  std::mt19937 rng(7);
+  for (char& c : big) c = static_cast<char>(rng() & 0xff);
+  writeFileAtomic(d.file("big.bin"), big);
+  EXPECT_EQ(readFile(d.file("big.bin")), big);
+  writeFileAtomic(d.file("empty.bin"), "");
+  EXPECT_EQ(readFile(d.file("empty.bin")), "");
+
+  const std::string fifo = d.file("pipe");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::thread writer([&] { std::ofstream(fifo, std::ios::binary) << big.substr(0, 300000); });
+  const std::string got = readFile(fifo);
+  writer.join();
+  EXPECT_EQ(got, big.substr(0, 300000));
+
+  fs::create_directories(d.file("folder"));
+  EXPECT_TRUE(test::throwsInputError([&] { readFile(d.file("folder")); }, "folder", "file"));
+}

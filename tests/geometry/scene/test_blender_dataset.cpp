@@ -211,3 +211,42 @@ TEST(BlenderDataset, SizesAndCentresOfTheWrongTypeOrRangeNameTheirField) {
     EXPECT_TRUE(test::throwsInputError([&] { loadBlenderDataset(d.str()); }, file, field)) << input;
   }
 }
+
+// Preloading decodes several images at once: each view gets the image image() would have
+// read, and of several unreadable images the error names the first in the order asked,
+// whichever decode finished first.
+TEST(BlenderDataset, PreloadReadsWhatImageReadsAndNamesTheFirstBadViewAsked) {
+  TempDir d;
+  writeSplit(d, "transforms_train.json", "train", 6);
+  for (int i = 0; i < 6; ++i) writeRgba(d.file("train/r_" + std::to_string(i) + ".png"), 40, 30, static_cast<std::uint8_t>(30 * i + 10));
+  const Scene one_by_one = loadDataset(d.str());
+  const Scene preloaded = loadDataset(d.str());
+  std::vector<int> all(preloaded.views.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int>(i);
+  preloaded.preloadImages({5, 1, 3, 1});  // repeats, out of order, some views first
+  preloaded.preloadImages(all);
+  for (int v : all) {
+    EXPECT_EQ(preloaded.image(v).data, one_by_one.image(v).data) << "view " << v;
+    EXPECT_EQ(preloaded.image(v).width, 40);
+  }
+  // Distinct images, so the comparison above would see a view given another's image.
+  EXPECT_NE(one_by_one.image(0).data, one_by_one.image(1).data);
+
+  const Scene broken = loadDataset(d.str());
+  int v2 = -1, v4 = -1;
+  for (std::size_t i = 0; i < broken.views.size(); ++i) {
+    if (broken.views[i].image_path.find("r_2") != std::string::npos) v2 = static_cast<int>(i);
+    if (broken.views[i].image_path.find("r_4") != std::string::npos) v4 = static_cast<int>(i);
+  }
+  ASSERT_GE(v2, 0);
+  ASSERT_GE(v4, 0);
+  test::writeBytes(d.file("train/r_2.png"), "not a png");
+  test::writeBytes(d.file("train/r_4.png"), "not a png either");
+  for (int round = 0; round < 5; ++round) {
+    EXPECT_TRUE(test::throwsInputError([&] { broken.preloadImages({v4, 0, v2}); }, "r_4", "file"));
+    EXPECT_TRUE(test::throwsInputError([&] { broken.preloadImages({v2, 0, v4}); }, "r_2", "file"));
+  }
+  // What did decode is kept; the bad ones stay unread.
+  EXPECT_EQ(broken.image(0).data, one_by_one.image(0).data);
+  EXPECT_TRUE(test::throwsInputError([&] { (void)broken.image(v2); }, "r_2", "file"));
+}

@@ -115,6 +115,13 @@ TEST(Trainer, TrainingRaisesTrainPsnr) {
   EXPECT_EQ(t.activeShDegree(), 1);
   const double after = t.evaluate(s.train).psnr;
   EXPECT_GT(after, before + 3.0) << before << " -> " << after;
+  // Kept renders are the renders, and keeping them changes no metric.
+  const Evaluation kept = t.evaluate(s.train, /*keep_renders=*/true);
+  EXPECT_EQ(kept.psnr, after);
+  ASSERT_EQ(kept.renders.size(), s.train.size());
+  for (std::size_t i = 0; i < s.train.size(); ++i)
+    EXPECT_EQ(kept.renders[i].data, toByte(t.render(s.views[static_cast<std::size_t>(s.train[i])].camera).rgb).data);
+  EXPECT_TRUE(t.evaluate(s.train).renders.empty());
   EXPECT_NE(t.gaussians().size(), s.points.size());  // densification ran
   EXPECT_TRUE(allFinite(t.gaussians()));
 }
