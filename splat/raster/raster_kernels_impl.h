@@ -122,6 +122,18 @@ inline vf vmax(vf a, vf b) {
 #endif
 }
 
+// The square root lane by lane (correctly rounded, as std::sqrt).
+inline vf vsqrt(vf a) {
+#if SARESGS_KERNEL_FMA
+  return reinterpret_cast<vf>(_mm256_sqrt_ps(reinterpret_cast<__m256>(a)));
+#elif defined(__SSE__) && SARESGS_KERNEL_LANES == 4
+  return reinterpret_cast<vf>(_mm_sqrt_ps(reinterpret_cast<__m128>(a)));
+#else
+  for (int i = 0; i < L; ++i) a[i] = std::sqrt(a[i]);
+  return a;
+#endif
+}
+
 // 2^x for x <= 0 without a libm call, on a short dependency chain (the kernels are
 // bound by its latency, not by instruction count): x = n + r with n = round(x) by the
 // 1.5 * 2^23 trick (the sum's low mantissa bits are n; r = x - n is exact), and 2^r,
@@ -203,35 +215,47 @@ inline void tileSpan(std::int32_t span_lo, std::int32_t span_hi, int origin, int
   hi = hi < limit - origin - 1 ? hi : limit - origin - 1;
 }
 
-// The columns [lo, hi] (tile offsets, within the Gaussian's span [c0, c1]) that the
-// Gaussian may touch in block row rb: its rows' alpha-ellipse chords
+// The columns [lo[rb], hi[rb]] (tile offsets, within the Gaussian's span [c0, c1]) that
+// the Gaussian may touch in each block row rb of [rb0, rbl]: its rows' alpha-ellipse chords
 // (TileGaussian::chord_*, widened against rounding) all lie within [min centre - widest
 // half, max centre + widest half], plus 0.01 px for the centres' own rounding. One square
 // root per block row; empty (lo > hi) when no row of the block meets the ellipse. Loop
-// bounds only: the per-pixel test decides. Written with selects rather than early
-// returns: per (tile, Gaussian) pair and block row, its branches mispredicted often
-// enough to cost more than its arithmetic.
-inline void blockRowSpan(const TileGaussian<float>& g, int x0, int y0, int rb, int c0, int c1, int& lo,
-                         int& hi) {
-  const float dy0 = static_cast<float>(y0 + rb * kBH) + 0.5f - g.my;
-  const float dy1 = dy0 + static_cast<float>(kBH - 1);
-  // The row nearest the centre has the widest chord: dy0 > 0 ? dy0 : (dy1 < 0 ? dy1 : 0).
-  const float dmin = dy0 > 0.0f ? dy0 : (dy1 < 0.0f ? dy1 : 0.0f);
-  const float t = g.chord_k0 - g.chord_k1 * (dmin * dmin);
-  const float half = std::sqrt(t > 0.0f ? t : 0.0f) + 0.01f;
-  const float xa = g.mx + g.chord_slope * dy0 - static_cast<float>(x0);
-  const float xb = g.mx + g.chord_slope * dy1 - static_cast<float>(x0);
-  const float c0f = static_cast<float>(c0), c1f = static_cast<float>(c1);
-  float l = (xa < xb ? xa : xb) - half - 0.5f, u = (xa < xb ? xb : xa) + half - 0.5f;
-  l = l >= c0f ? l : c0f;  // NaN: no bound
-  u = u <= c1f ? u : c1f;
-  l = l <= c1f + 1.0f ? l : c1f + 1.0f;  // keeps the conversions in range
-  u = u >= c0f - 1.0f ? u : c0f - 1.0f;
-  const int li = static_cast<int>(l) + (static_cast<float>(static_cast<int>(l)) < l ? 1 : 0);  // ceiling, l >= 0
-  const int ui = static_cast<int>(u) - (static_cast<float>(static_cast<int>(u)) > u ? 1 : 0);  // floor, u >= -1
-  const bool none = !(t >= 0.0f);  // no row of the block meets the ellipse
-  lo = none ? c1 + 1 : li;
-  hi = none ? c0 - 1 : ui;
+// bounds only: the per-pixel test decides. L block rows per vector, with selects: one
+// row at a time in scalar code (before 2026-11-27; the same operations, so the same
+// bounds) it was a chain of conversions and compares per block row, about a tenth of the
+// backward kernel's cycles on room360 at 512x384, and with early returns its branches
+// mispredicted.
+constexpr int kBlockRows = kTile / kBH;
+inline void blockRowSpans(const TileGaussian<float>& g, int x0, int y0, int rb0, int rbl, int c0, int c1,
+                          int* lo, int* hi) {
+  const vf c0f = vs(static_cast<float>(c0)), c1f = vs(static_cast<float>(c1));
+  const vi c0v = vi{} + c0, c1v = vi{} + c1;
+  for (int base = rb0 - rb0 % L; base <= rbl; base += L) {
+    vi rows;
+    for (int i = 0; i < L; ++i) rows[i] = y0 + (base + i) * kBH;
+    const vf dy0 = (__builtin_convertvector(rows, vf) + vs(0.5f)) - vs(g.my);
+    const vf dy1 = dy0 + vs(static_cast<float>(kBH - 1));
+    const vf zero = vs(0.0f);
+    const vf dmin = dy0 > zero ? dy0 : (dy1 < zero ? dy1 : zero);
+    const vf t = vs(g.chord_k0) - vs(g.chord_k1) * (dmin * dmin);
+    const vf half = vsqrt(t > zero ? t : zero) + vs(0.01f);
+    const vf xa = (vs(g.mx) + vs(g.chord_slope) * dy0) - vs(static_cast<float>(x0));
+    const vf xb = (vs(g.mx) + vs(g.chord_slope) * dy1) - vs(static_cast<float>(x0));
+    vf l = ((xa < xb ? xa : xb) - half) - vs(0.5f), u = ((xa < xb ? xb : xa) + half) - vs(0.5f);
+    l = l >= c0f ? l : c0f;
+    u = u <= c1f ? u : c1f;
+    l = l <= c1f + vs(1.0f) ? l : c1f + vs(1.0f);
+    u = u >= c0f - vs(1.0f) ? u : c0f - vs(1.0f);
+    const vi lt = __builtin_convertvector(l, vi), ut = __builtin_convertvector(u, vi);  // truncation
+    const vi li = lt - (__builtin_convertvector(lt, vf) < l);  // masks are -1: ceiling, l >= 0
+    const vi ui = ut + (__builtin_convertvector(ut, vf) > u);  // floor, u >= -1
+    const vi none = ~(t >= zero);
+    const vi lov = none ? c1v + 1 : li, hiv = none ? c0v - 1 : ui;
+    for (int i = 0; i < L && base + i < kBlockRows; ++i) {
+      lo[base + i] = lov[i];
+      hi[base + i] = hiv[i];
+    }
+  }
 }
 
 inline vi absLe(vf v, vf bound) { return reinterpret_cast<vf>(reinterpret_cast<vi>(v) & 0x7fffffff) <= bound; }
@@ -305,6 +329,8 @@ __attribute__((always_inline)) inline void forEachBlock(const TileGaussian<float
   // output); a long thin Gaussian across a tile still skips the blocks it misses.
   const bool narrow = g.px1 - g.px0 + 1 > kChordMinSpan;
   const int rb0 = r0 / kBH, rbl = r1 / kBH;
+  int row_lo[kBlockRows], row_hi[kBlockRows];
+  if (narrow) blockRowSpans(g, x0, y0, rb0, rbl, c0, c1, row_lo, row_hi);
   {
     const int cb0 = c0 & ~(kBW - 1), cbl = c1 & ~(kBW - 1);
     Lattice lt;
@@ -328,8 +354,7 @@ __attribute__((always_inline)) inline void forEachBlock(const TileGaussian<float
         // A wide Gaussian's rows skip the blocks its chord misses (the lattice still
         // steps over them: two multiplications each, in the same order as in a row
         // that visits them).
-        int lo = c0, hi = c1;
-        if (narrow) blockRowSpan(g, x0, y0, rb, c0, c1, lo, hi);
+        const int lo = narrow ? row_lo[rb] : c0, hi = narrow ? row_hi[rb] : c1;
         if (lo <= hi) {
           const vf dy = (vs(static_cast<float>(y0 + rb * kBH)) + lane_y) - my;
           const vi row_in = absLe(dy, hy);
@@ -356,11 +381,8 @@ __attribute__((always_inline)) inline void forEachBlock(const TileGaussian<float
   }
   const vf ha = vs(-0.5f * kLog2e) * vs(g.a);
   for (int rb = rb0; rb <= rbl; ++rb) {
-    int lo = c0, hi = c1;
-    if (narrow) {
-      blockRowSpan(g, x0, y0, rb, c0, c1, lo, hi);
-      if (lo > hi) continue;
-    }
+    const int lo = narrow ? row_lo[rb] : c0, hi = narrow ? row_hi[rb] : c1;
+    if (lo > hi) continue;
     const vf dy = (vs(static_cast<float>(y0 + rb * kBH)) + lane_y) - my;
     const vi row_in = absLe(dy, hy);
     const vf qy = rowQuad(g, dy), by = rowCross(g, dy);
