@@ -103,12 +103,15 @@ void fisherTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, in
 }  // namespace avx2
 
 // The AVX2 Fisher kernel's arithmetic on AVX-512VL's 32 registers, its moments summed in
-// one pass (splat/raster/raster_kernels_avx512.cpp): bit-identical to avx2::fisherTile.
+// one pass, and the AVX2 backward kernel on 32 registers (splat/raster/raster_kernels_avx512.cpp):
+// bit-identical to avx2::fisherTile and avx2::backwardTile.
 namespace avx512 {
 // False when this build has no AVX-512 kernel (not x86-64, or not GCC/Clang).
 bool compiled();
 void fisherTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
                 const FisherIn& in, const std::uint32_t* entry_slot, float* slots);
+void backwardTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
+                  const BackwardIn& in, const std::uint32_t* entry_slot, float* slots);
 }  // namespace avx512
 
 // compositeTile's per-lane arithmetic for n rounds of two blocks in registers (no memory

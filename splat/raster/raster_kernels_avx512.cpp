@@ -7,11 +7,17 @@
 //   each block's two inputs and summing them in three later passes.
 // - compositeTilePair (residual supervision's two renders in one walk): the pair loop's
 //   Gaussian constants, which spill on AVX2's 16 registers, stay in registers.
+// - backwardTile: since the lattice (G by products, forEachBlock) its nine gradient sums,
+//   the lattice's G, step and row factor and the Gaussian's constants outgrow AVX2's 16
+//   registers; on 32 the backward stage of bench train (room360 512x384) took 0.94-0.97x
+//   the AVX2 kernel's time (2026-11-27; before the lattice it gained nothing).
 // Each value sees the same operations in the same order, so the outputs are bit-identical
-// to the AVX2 kernels' (tested: Fisher.Avx512WalkEqualsAvx2BitForBit, and SubsetPair.*
-// against the single-render AVX2 kernel on every kernel set). The other kernels, the pair
-// backward included, gained nothing or lost from the wider register file
-// (docs/PERFORMANCE_TRIED.md), so the avx512 kernel set uses the AVX2 ones.
+// to the AVX2 kernels' (tested: Fisher.Avx512WalkEqualsAvx2BitForBit,
+// FloatPath.Avx512BackwardEqualsAvx2BitForBit, and SubsetPair.* against the single-render
+// AVX2 kernel on every kernel set). The forward kernel and the pair backward gained
+// nothing or lost from the wider register file (docs/PERFORMANCE_TRIED.md; the pair
+// backward again 1.02-1.03x on bench step --residual 256x192/40k on 2026-11-27), so the
+// avx512 kernel set uses the AVX2 ones.
 #include "splat/raster/raster_kernels.h"
 
 #if defined(SARESGS_RASTER_AVX512)
@@ -19,7 +25,7 @@
 #define SARESGS_KERNEL_LANES 8
 #define SARESGS_KERNEL_FMA 1
 #define SARESGS_KERNEL_FISHER_ONE_PASS 1
-#define SARESGS_KERNEL_FISHER_ONLY 1
+#define SARESGS_KERNEL_NO_COMPOSITE 1
 #define SARESGS_KERNEL_PAIR_COMPOSITE_ONLY 1
 #include "splat/raster/raster_kernels_impl.h"
 #include "splat/raster/raster_kernels_pair_impl.h"
@@ -38,6 +44,10 @@ void fisherTile(const TileGaussian<float>*, int, int, int, int, int, const float
 }
 void compositeTilePair(const TileGaussian<float>*, const std::uint8_t*, int, int, int, int, int, const float*,
                        const ForwardOut&, const ForwardOut&) {
+  std::abort();
+}
+void backwardTile(const TileGaussian<float>*, int, int, int, int, int, const float*, const BackwardIn&,
+                  const std::uint32_t*, float*) {
   std::abort();
 }
 }  // namespace saresgs::raster_kernels::avx512

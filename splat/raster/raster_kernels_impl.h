@@ -21,12 +21,13 @@
 #endif
 // SARESGS_KERNEL_FISHER_ONE_PASS: the Fisher walk sums its 19 moments as it goes (for a
 // target with 32 vector registers; with 16 they spill and the three-pass form is faster).
-// SARESGS_KERNEL_FISHER_ONLY: only fisherTile is defined (raster_kernels_avx512.cpp).
+// SARESGS_KERNEL_NO_COMPOSITE: compositeTile and compositeFloor are not defined (the
+// avx512 set uses the AVX2 ones: raster_kernels_avx512.cpp).
 #ifndef SARESGS_KERNEL_FISHER_ONE_PASS
 #define SARESGS_KERNEL_FISHER_ONE_PASS 0
 #endif
-#ifndef SARESGS_KERNEL_FISHER_ONLY
-#define SARESGS_KERNEL_FISHER_ONLY 0
+#ifndef SARESGS_KERNEL_NO_COMPOSITE
+#define SARESGS_KERNEL_NO_COMPOSITE 0
 #endif
 #if !defined(SARESGS_KERNEL_NS) || !defined(SARESGS_KERNEL_LANES)
 #error "define SARESGS_KERNEL_NS and SARESGS_KERNEL_LANES before including raster_kernels_impl.h"
@@ -465,7 +466,7 @@ struct ForwardColour {
 
 }  // namespace
 
-#if !SARESGS_KERNEL_FISHER_ONLY
+#if !SARESGS_KERNEL_NO_COMPOSITE
 // Front-to-back compositing, Gaussian by Gaussian over the blocks it may touch, so the
 // inner loop is branch-free vector code; each pixel sees exactly the per-pixel sequence
 // of rule 7.
@@ -518,7 +519,7 @@ float compositeFloor(long n) {
   }
   return hsum(b[0].C0 + b[1].C0 + b[0].D + b[1].D + b[0].contrib + b[1].walked);
 }
-#endif  // !SARESGS_KERNEL_FISHER_ONLY
+#endif  // !SARESGS_KERNEL_NO_COMPOSITE
 
 namespace {
 
@@ -670,7 +671,6 @@ inline GradSums zeroSums() {
   return GradSums{z, z, z, z, z, z, z, z, z};
 }
 
-#if !SARESGS_KERNEL_FISHER_ONLY
 // The back-to-front walk (the scalar walkBack of rasterizer.cpp, per lane), Gaussian by
 // Gaussian. Entries beyond the longest walk get zero slots, so the caller needs no
 // cleared buffer.
@@ -693,11 +693,9 @@ void backwardTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int 
     writeSums(g, s, &slots[static_cast<std::size_t>(entry_slot[jj]) * kSlot]);
   }
 }
-#endif  // !SARESGS_KERNEL_FISHER_ONLY
 
 }  // namespace
 
-#if !SARESGS_KERNEL_FISHER_ONLY
 void backwardTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
                   const BackwardIn& in, const std::uint32_t* entry_slot, float* slots) {
   if (nq == 0) return;
@@ -706,7 +704,6 @@ void backwardTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, 
   else
     backwardTileImpl<false>(q, nq, x0, y0, x1, y1, bg, in, entry_slot, slots);
 }
-#endif  // !SARESGS_KERNEL_FISHER_ONLY
 
 // FisherRF's squared-gradient pass (FisherMoment in raster_kernels.h): the backward walk
 // for the fixed objective C_r + C_g + C_b, accumulating moments instead of gradients.

@@ -69,7 +69,8 @@ struct KernelSet {
 constexpr KernelSet kKernelSets[] = {
     {"baseline", raster_kernels::base4::compositeTile, raster_kernels::base4::backwardTile},
     {"avx2", raster_kernels::avx2::compositeTile, raster_kernels::avx2::backwardTile},
-    {"avx512", raster_kernels::avx2::compositeTile, raster_kernels::avx2::backwardTile},  // its Fisher walk differs
+    // avx512: AVX2's forward; its backward and Fisher walks on 32 registers, bit for bit AVX2's.
+    {"avx512", raster_kernels::avx2::compositeTile, raster_kernels::avx512::backwardTile},
 };
 static_assert(raster_kernels::base4::kTile == kTileSize && raster_kernels::base4::kMinA == kMinAlpha &&
               raster_kernels::base4::kMaxA == kMaxAlpha && raster_kernels::base4::kMinT == kMinTransmittance);

@@ -23,8 +23,8 @@ inline std::vector<std::pair<const char*, RasterKernels>> runnableKernels() {
   return k;
 }
 
-// runnableKernels() and, where the CPU has it, avx512, whose forward and backward are
-// avx2's: only the Fisher pass differs.
+// runnableKernels() and, where the CPU has it, avx512, whose forward is avx2's and whose
+// backward is avx2's on 32 registers (bit for bit: FloatPath.Avx512BackwardEqualsAvx2BitForBit).
 inline std::vector<std::pair<const char*, RasterKernels>> runnableFisherKernels() {
   auto k = runnableKernels();
   if (rasterCpuHasAvx512()) k.emplace_back("avx512", RasterKernels::kAvx512);

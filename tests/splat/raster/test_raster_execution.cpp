@@ -44,7 +44,7 @@ TEST(RasterExecution, ReportsTheKernelsItUses) {
   }
   if (rasterCpuHasAvx512()) {
     EXPECT_STREQ(rasterKernelName(RasterExecution{.kernels = RasterKernels::kAvx512}), "avx512");
-    EXPECT_TRUE(rasterCpuHasAvx2());  // avx512's forward and backward are avx2's
+    EXPECT_TRUE(rasterCpuHasAvx2());  // avx512's forward is avx2's
   } else {
     EXPECT_THROW(rasterKernelName(RasterExecution{.kernels = RasterKernels::kAvx512}), std::invalid_argument);
   }

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
+#include <bit>
 #include <cmath>
 #include <functional>
 #include <random>
@@ -110,7 +111,8 @@ TEST_P(FloatPath, MatchesDoublePath) {
 }
 
 // The baseline and avx2 kernel sets differ only in rounding (FMA, the order lanes are
-// summed); avx512 is avx2 bit for bit (Fisher.Avx512WalkEqualsAvx2BitForBit).
+// summed); avx512 is avx2 bit for bit (Fisher.Avx512WalkEqualsAvx2BitForBit,
+// FloatPath.Avx512BackwardEqualsAvx2BitForBit).
 TEST(FloatPath, KernelSetsAgree) {
   const Camera cam = test::smallCamera(72, 56);
   const Gaussians g = test::randomScene<double>(300, 2, 9, 1.2).cast<float>();
@@ -149,6 +151,55 @@ TEST(FloatPath, KernelSetsAgree) {
   EXPECT_TRUE(close(ga.rotations, gb.rotations));
   EXPECT_TRUE(close(ga.opacities, gb.opacities));
   EXPECT_TRUE(close(ga.sh, gb.sh));
+}
+
+// The avx512 set's backward kernel (the AVX2 kernel on 32 registers) gives the avx2
+// set's gradients bit for bit: with and without a background, small and wide Gaussians
+// (the chord spans and the lattice), one thread and all.
+TEST(FloatPath, Avx512BackwardEqualsAvx2BitForBit) {
+  if (!rasterCpuHasAvx512()) GTEST_SKIP() << "no AVX-512F and AVX-512VL on this CPU (the avx512 set cannot run here)";
+  const Camera cam = test::smallCamera(160, 120);
+  const auto w = lossWeights(160, 120, 10);
+  const std::vector<float> wf(w.begin(), w.end());
+  int nonzero = 0;
+  for (const double grow : {0.0, 1.5, 3.0}) {
+    Gaussians g = test::randomScene<double>(400, 2, 31, 1.3).cast<float>();
+    for (float& l : g.log_scales) l += static_cast<float>(grow);  // up to ~20x wider: chords
+    for (const bool bg : {false, true}) {
+      for (const int threads : {1, 0}) {
+        SCOPED_TRACE("grow " + std::to_string(grow) + (bg ? " background" : "") + " threads " + std::to_string(threads));
+        RasterSettings s;
+        s.sh_degree = 2;
+        if (bg) s.background = {0.1f, 0.2f, 0.3f};
+        s.execution.threads = threads;
+        auto run = [&](RasterKernels kernels) {
+          s.execution.kernels = kernels;
+          const auto r = rasterizeT(g, cam, s);
+          Gaussians grad = g.zerosLike();
+          std::vector<float> mean2d(2 * g.size(), 0.0f);
+          rasterizeBackwardT(g, cam, s, r, wf.data(), grad, &mean2d);
+          return std::make_pair(grad, mean2d);
+        };
+        const auto [a, am] = run(RasterKernels::kAvx2);
+        const auto [b, bm] = run(RasterKernels::kAvx512);
+        auto same = [&](const std::vector<float>& x, const std::vector<float>& y, const char* what) {
+          ASSERT_EQ(x.size(), y.size()) << what;
+          for (std::size_t k = 0; k < x.size(); ++k) {
+            ASSERT_EQ(std::bit_cast<std::uint32_t>(x[k]), std::bit_cast<std::uint32_t>(y[k]))
+                << what << "[" << k << "]: avx2 " << x[k] << ", avx512 " << y[k];
+            nonzero += x[k] != 0.0f;
+          }
+        };
+        same(a.means, b.means, "means");
+        same(a.log_scales, b.log_scales, "log_scales");
+        same(a.rotations, b.rotations, "rotations");
+        same(a.opacities, b.opacities, "opacities");
+        same(a.sh, b.sh, "sh");
+        same(am, bm, "mean2d");
+      }
+    }
+  }
+  EXPECT_GT(nonzero, 10000);  // the comparison saw real gradients
 }
 
 namespace {
