@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "apps/cli_checks.h"
+#include "apps/thread_limit.h"
 #include "apps/commands.h"
 #include "apps/memory_budget.h"
 #include "apps/prefilter_flags.h"
@@ -108,6 +109,7 @@ void printSummary(const RunReport& r, const std::string& out) {
 }
 
 int runActive(const ActiveArgs& a) {
+  const auto thread_limit = limitThreads(a.threads);
   ActiveOptions opt = activeOptions(a);
   DatasetOptions dopt;
   dopt.load.downscale = a.downscale;

@@ -29,6 +29,7 @@
 
 #include "apps/cli_checks.h"
 #include "apps/commands.h"
+#include "apps/thread_limit.h"
 #include "apps/heap_count.h"
 #include "apps/memory_budget.h"
 #include "geometry/error.h"
@@ -191,6 +192,7 @@ void checkBenchSize(const BenchArgs& a) {
 }
 
 int runBench(const BenchArgs& a) {
+  const auto thread_limit = limitThreads(a.threads);
   checkBenchSize(a);
   const Camera cam = benchCamera(a);
   RasterSettings s;
@@ -250,6 +252,7 @@ int runBench(const BenchArgs& a) {
 // addViewInformation (forward + Fisher pass) and the backward pass of the same view, each
 // timed per iteration in the same loop so that load changes hit all three alike.
 int runFisherBench(const BenchArgs& a) {
+  const auto thread_limit = limitThreads(a.threads);
   checkBenchSize(a);
   const Camera cam = benchCamera(a);
   RasterSettings s;
@@ -351,6 +354,7 @@ std::string trainBenchDataset(const TrainBenchArgs& a) {
 // extra time goes (the model's footprint per pixel, densification statistics, image
 // decoding, bookkeeping).
 int runTrainBench(const TrainBenchArgs& a) {
+  const auto thread_limit = limitThreads(a.threads);
   const std::string path = trainBenchDataset(a);
   const Scene scene = loadDataset(path);
   TrainerOptions opt;
@@ -505,8 +509,7 @@ double medianMs(int reps, const std::function<void()>& f) {
 }
 
 int runOccupancyBench(const OccupancyBenchArgs& a) {
-  std::optional<tbb::global_control> limit;
-  if (a.threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(a.threads));
+  const auto thread_limit = limitThreads(a.threads);
   const int threads = std::min<int>(tbb::info::default_concurrency(),
       static_cast<int>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)));
 

@@ -10,6 +10,7 @@
 #include <iostream>
 
 #include "apps/cli_checks.h"
+#include "apps/thread_limit.h"
 #include "apps/commands.h"
 #include "apps/memory_budget.h"
 #include "apps/progress.h"
@@ -53,6 +54,7 @@ std::string shortCount(std::size_t n) {
 }
 
 int runTrain(TrainArgs& a) {
+  const auto thread_limit = limitThreads(a.threads);
   a.opt.raster.execution.threads = a.threads;
   a.opt.residual.ranking = parseUncertaintyRanking(a.ranking);
   DatasetOptions dopt;
