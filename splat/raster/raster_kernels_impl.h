@@ -102,6 +102,73 @@ inline int hsumInt(vi v) {
   return s;
 }
 
+// A block's L values of a whole-image array (row stride W) at tile offset (c, r): kBW
+// consecutive values from each of its kBH rows, loaded as vectors (no lane-by-lane stores
+// that a full-width load would then wait on), and stored back the same way.
+typedef float v4f __attribute__((vector_size(16)));
+typedef std::int32_t v4i __attribute__((vector_size(16)));
+template <typename V4, typename V, typename S>
+inline V loadRows(const S* p, std::size_t W) {
+  V4 a;
+  std::memcpy(&a, p, sizeof a);
+  if constexpr (L == 4) {
+    return a;
+  } else {
+    V4 b;
+    std::memcpy(&b, p + W, sizeof b);
+    return __builtin_shufflevector(a, b, 0, 1, 2, 3, 4, 5, 6, 7);
+  }
+}
+template <typename V4, typename V, typename S>
+inline void storeRows(S* p, std::size_t W, V v) {
+  const V4 a = __builtin_shufflevector(v, v, 0, 1, 2, 3);
+  std::memcpy(p, &a, sizeof a);
+  if constexpr (L == 8) {
+    const V4 b = __builtin_shufflevector(v, v, 4, 5, 6, 7);
+    std::memcpy(p + W, &b, sizeof b);
+  }
+}
+// The three channels of kBW interleaved RGB pixels (12 floats) apart.
+inline void deinterleave3(const float* p, v4f& c0, v4f& c1, v4f& c2) {
+  v4f x0, x1, x2;
+  std::memcpy(&x0, p, 16);
+  std::memcpy(&x1, p + 4, 16);
+  std::memcpy(&x2, p + 8, 16);
+  typedef float v8f __attribute__((vector_size(32)));
+  const v8f ab = __builtin_shufflevector(x0, x1, 0, 1, 2, 3, 4, 5, 6, 7);
+  const v8f cc = __builtin_shufflevector(x2, x2, 0, 1, 2, 3, 0, 1, 2, 3);
+  c0 = __builtin_shufflevector(ab, cc, 0, 3, 6, 9);
+  c1 = __builtin_shufflevector(ab, cc, 1, 4, 7, 10);
+  c2 = __builtin_shufflevector(ab, cc, 2, 5, 8, 11);
+}
+inline void interleave3(float* p, v4f c0, v4f c1, v4f c2) {
+  typedef float v8f __attribute__((vector_size(32)));
+  const v8f a = __builtin_shufflevector(c0, c1, 0, 1, 2, 3, 4, 5, 6, 7);
+  const v8f b = __builtin_shufflevector(c2, c2, 0, 1, 2, 3, 0, 1, 2, 3);
+  const v4f x0 = __builtin_shufflevector(a, b, 0, 4, 8, 1);
+  const v4f x1 = __builtin_shufflevector(a, b, 5, 9, 2, 6);
+  const v4f x2 = __builtin_shufflevector(a, b, 10, 3, 7, 11);
+  std::memcpy(p, &x0, 16);
+  std::memcpy(p + 4, &x1, 16);
+  std::memcpy(p + 8, &x2, 16);
+}
+// Two rows' kBW lanes as one block vector, and back (the preprocessor picks the lane
+// count: shuffle indices must be constants even in a discarded branch outside a template).
+inline vf joinRows(v4f a, [[maybe_unused]] v4f b) {
+#if SARESGS_KERNEL_LANES == 4
+  return a;
+#else
+  return __builtin_shufflevector(a, b, 0, 1, 2, 3, 4, 5, 6, 7);
+#endif
+}
+inline v4f rowOf(vf v, [[maybe_unused]] int half) {
+#if SARESGS_KERNEL_LANES == 4
+  return v;
+#else
+  return half == 0 ? __builtin_shufflevector(v, v, 0, 1, 2, 3) : __builtin_shufflevector(v, v, 4, 5, 6, 7);
+#endif
+}
+
 // a < b ? a : b and a > b ? a : b, lane by lane (b where unordered): one min/max
 // instruction where the target has it (GCC keeps a vector ternary as compare + blend).
 inline vf vmin(vf a, vf b) {
@@ -408,13 +475,20 @@ struct ForwardState {
   int n_active = 0;
 
   void init(int w, int h) {
+    n_active = w * h;
+    if (w == kTile && h == kTile) {  // a whole tile: every pixel live
+      for (ForwardBlock& B : b) {
+        B.Tr = vs(1.0f);
+        B.C0 = B.C1 = B.C2 = B.D = B.walked = B.contrib = vs(0.0f);
+      }
+      return;
+    }
     for (int k = 0; k < kTile * kTile; ++k) {
       ForwardBlock& B = b[k / L];
       const int i = k % L;
       B.Tr[i] = blockCol(k) < w && blockRow(k) < h ? 1.0f : -1.0f;
       B.C0[i] = B.C1[i] = B.C2[i] = B.D[i] = B.walked[i] = B.contrib[i] = 0.0f;
     }
-    n_active = w * h;
   }
 
   // Rule 7 for one Gaussian (entry jf - 1) at one block; returns the lanes it stops.
@@ -437,6 +511,28 @@ struct ForwardState {
   }
 
   void write(int x0, int y0, int w, int h, const float bg[3], const ForwardOut& out) const {
+    if (w == kTile && h == kTile) {
+      // A whole tile, a block at a time: the per-pixel loop below, lane by lane (the same
+      // operations on every value), with vector loads and stores.
+      const std::size_t W = static_cast<std::size_t>(out.W);
+      for (int blk = 0; blk < kBlocks; ++blk) {
+        const ForwardBlock& B = b[blk];
+        const std::size_t pix = static_cast<std::size_t>(y0 + blk / kBX * kBH) * W + (x0 + blk % kBX * kBW);
+        const vf T = reinterpret_cast<vf>(reinterpret_cast<vi>(B.Tr) & 0x7fffffff);
+        const vf r = B.C0 + T * vs(bg[0]), g = B.C1 + T * vs(bg[1]), bl = B.C2 + T * vs(bg[2]);
+        const vf a = vs(1.0f) - T;
+        const vi covered = a >= vs(1e-6f);
+        const vf depth = covered ? B.D / (covered ? a : vs(1.0f)) : vs(0.0f);
+        for (int half = 0; half < kBH; ++half)
+          interleave3(out.rgb + (pix + half * W) * 3, rowOf(r, half), rowOf(g, half), rowOf(bl, half));
+        storeRows<v4f>(out.alpha + pix, W, a);
+        storeRows<v4f>(out.depth + pix, W, depth);
+        storeRows<v4i>(out.contributors + pix, W, __builtin_convertvector(B.contrib, vi));
+        storeRows<v4f>(out.final_T + pix, W, T);
+        storeRows<v4i>(reinterpret_cast<std::int32_t*>(out.n_walked + pix), W, __builtin_convertvector(B.walked, vi));
+      }
+      return;
+    }
     for (int k = 0; k < kTile * kTile; ++k) {
       const int r = blockRow(k), c = blockCol(k);
       if (r >= h || c >= w) continue;
@@ -562,6 +658,30 @@ struct BackwardState {
 
   void init(int x0, int y0, int w, int h, const float bg[3], const BackwardIn& in) {
     jmax = 0;
+    if (w == kTile && h == kTile) {
+      // A whole tile, a block at a time: the per-pixel loop below, lane by lane, with
+      // vector loads (its lane-by-lane stores made each later full-width load of the
+      // state wait).
+      const std::size_t W = static_cast<std::size_t>(in.W);
+      vi jm = vi{} + 0;
+      for (int blk = 0; blk < kBlocks; ++blk) {
+        BackwardBlock& B = b[blk];
+        const std::size_t pix = static_cast<std::size_t>(y0 + blk / kBX * kBH) * W + (x0 + blk % kBX * kBW);
+        B.Tr = B.finalT = loadRows<v4f, vf>(in.final_T + pix, W);
+        const vi nw = loadRows<v4i, vi>(reinterpret_cast<const std::int32_t*>(in.n_walked + pix), W);
+        B.walked = __builtin_convertvector(nw, vf);
+        jm = jm > nw ? jm : nw;
+        v4f r[2], g[2], bl[2];
+        for (int half = 0; half < kBH; ++half) deinterleave3(in.dL_drgb + (pix + half * W) * 3, r[half], g[half], bl[half]);
+        B.w0 = joinRows(r[0], r[kBH - 1]);
+        B.w1 = joinRows(g[0], g[kBH - 1]);
+        B.w2 = joinRows(bl[0], bl[kBH - 1]);
+        B.acc0 = B.acc1 = B.acc2 = vs(0.0f);
+        B.bgdot = vs(bg[0]) * B.w0 + vs(bg[1]) * B.w1 + vs(bg[2]) * B.w2;
+      }
+      for (int i = 0; i < L; ++i) jmax = static_cast<std::uint32_t>(jm[i]) > jmax ? static_cast<std::uint32_t>(jm[i]) : jmax;
+      return;
+    }
     for (int k = 0; k < kTile * kTile; ++k) {
       const int r = blockRow(k), c = blockCol(k);
       const bool inside = c < w && r < h;
