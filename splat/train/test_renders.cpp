@@ -1,12 +1,38 @@
 #include "splat/train/test_renders.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <tbb/parallel_for.h>
 
 #include "geometry/image/contact_sheet.h"
 
 namespace saresgs {
+
+std::vector<std::string> testRenderNames(const Scene& scene, const Evaluation& ev) {
+  namespace fs = std::filesystem;
+  const std::size_t n = ev.views.size();
+  std::vector<std::string> names(n);
+  std::map<std::string, int> uses{{"all", 1}};  // the sheet of all views
+  auto nameOf = [&](std::size_t i) -> const std::string& {
+    return scene.views[static_cast<std::size_t>(ev.views[i].view)].name;
+  };
+  for (std::size_t i = 0; i < n; ++i) ++uses[names[i] = fs::path(nameOf(i)).stem().string()];
+  // Where two views (say cam1/0001.png and cam2/0001.png), or a view and the sheet, share
+  // a stem: the path without its extension, folders joined by '_'.
+  for (std::size_t i = 0; i < n; ++i)
+    if (uses[names[i]] > 1) {
+      names[i] = fs::path(nameOf(i)).replace_extension().generic_string();
+      std::replace(names[i].begin(), names[i].end(), '/', '_');
+    }
+  // And if even those meet (a view listed twice, "a_b" beside "a/b"): the view's index.
+  std::map<std::string, int> again;
+  for (const std::string& s : names) ++again[s];
+  for (std::size_t i = 0; i < n; ++i)
+    if (again[names[i]] > 1 || names[i] == "all") names[i] += "_" + std::to_string(ev.views[i].view);
+  return names;
+}
 
 void writeTestRenders(const Trainer& t, const Evaluation& ev, const std::string& dir) {
   namespace fs = std::filesystem;
@@ -28,10 +54,10 @@ void writeTestRenders(const Trainer& t, const Evaluation& ev, const std::string&
     sheet[2 * i + 1] = {&renders[i], std::string("render ") + label, true};
   }
   // One PNG per view (truth | render), encoded side by side: an encode is single-threaded.
+  const std::vector<std::string> names = testRenderNames(t.scene(), ev);
   tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
-    const SceneView& v = t.scene().views[static_cast<std::size_t>(ev.views[i].view)];
     const std::vector<ContactSheetItem> pair(sheet.begin() + 2 * i, sheet.begin() + 2 * i + 2);
-    writeImage(dir + "/" + fs::path(v.name).stem().string() + ".png", makeContactSheet(pair, 2, renders[i].width));
+    writeImage(dir + "/" + names[i] + ".png", makeContactSheet(pair, 2, renders[i].width));
   });
   if (!sheet.empty()) writeImage(dir + "/all.png", makeContactSheet(sheet, 4, 256));
 }
