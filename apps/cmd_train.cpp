@@ -67,7 +67,9 @@ int runTrain(TrainArgs& a) {
   if (const int n = removeStaleTemporaries(a.out)) std::cerr << "removed " << n << " temporaries left by a killed run\n";
   const std::string ckpt = a.out + "/checkpoint.bin";
   const std::size_t initial = initialModelSize(scene, a.opt);
-  const MemoryEstimate memory = estimateTrainingMemory(scene, views, scene.test.empty() ? scene.train : scene.test,
+  // The views evaluated at the end (the train views where the dataset has no test split).
+  const std::vector<int>& eval_views = scene.test.empty() ? scene.train : scene.test;
+  const MemoryEstimate memory = estimateTrainingMemory(scene, views, eval_views,
                                                        initial, a.opt.max_sh_degree);
   const double budget = memoryBudgetBytes(a.memory_budget_gb);
   std::cerr << applyMemoryBudget(memory, budget, a.memory_budget_gb.has_value(), a.opt.densify.max_gaussians);
@@ -86,12 +88,11 @@ int runTrain(TrainArgs& a) {
   // has at least as many iterations left as views; the evaluation reads the rest), decoded
   // on all cores at once rather than one by one inside the steps.
   {
-    const std::vector<int>& eval = scene.test.empty() ? scene.train : scene.test;
-    std::vector<int> read(eval);
+    std::vector<int> read(eval_views);
     if (a.iterations - trainer.iteration() >= static_cast<int>(views.size())) read.insert(read.end(), views.begin(), views.end());
     const auto d0 = std::chrono::steady_clock::now();
-    scene.preloadImages(read);
-    std::cerr << "decoded " << read.size() << " images in "
+    const std::size_t decoded = scene.preloadImages(read);
+    std::cerr << "decoded " << decoded << " images in "
               << std::lround(1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - d0).count()) << " ms\n";
   }
   Progress progress;
@@ -111,7 +112,6 @@ int runTrain(TrainArgs& a) {
   }
   const double train_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-  const std::vector<int>& eval_views = scene.test.empty() ? scene.train : scene.test;
   const Evaluation ev = trainer.evaluate(eval_views, /*keep_renders=*/true);
   writeTestRenders(trainer, ev, a.out + "/test_renders");
   writeGaussiansPly(a.out + "/point_cloud.ply", gaussiansToWorld(trainer.gaussians(), scene.frame));

@@ -55,7 +55,7 @@ const Image8& Scene::image(int i) const {
   return *slot;
 }
 
-void Scene::preloadImages(const std::vector<int>& which) const {
+std::size_t Scene::preloadImages(const std::vector<int>& which) const {
   std::vector<int> missing;
   {
     std::lock_guard<std::mutex> lock(cache_->mutex);
@@ -85,6 +85,7 @@ void Scene::preloadImages(const std::vector<int>& which) const {
     auto& slot = cache_->slots[static_cast<size_t>(missing[k])];
     if (!slot) slot = std::move(loaded[k]);
   }
+  return missing.size();
 }
 
 void Scene::releaseImages() const {

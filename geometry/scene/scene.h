@@ -72,8 +72,9 @@ class Scene {
   // The 8-bit RGB image of view i, read on first use and kept. Thread-safe.
   const Image8& image(int i) const;
   // Reads the images of `which` not yet kept, several at once (decoding is single-threaded
-  // per image); on an unreadable one, throws the error of the first in `which`'s order.
-  void preloadImages(const std::vector<int>& which) const;
+  // per image), and returns how many it read; on an unreadable one, throws the error of
+  // the first in `which`'s order.
+  std::size_t preloadImages(const std::vector<int>& which) const;
   // The same as float RGB in [0,1], converted on each call.
   ImageF imageFloat(int i) const { return toFloat(image(i)); }
   bool hasDepth(int i) const { return !views.at(i).depth_path.empty(); }

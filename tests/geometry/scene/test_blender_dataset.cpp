@@ -223,8 +223,8 @@ TEST(BlenderDataset, PreloadReadsWhatImageReadsAndNamesTheFirstBadViewAsked) {
   const Scene preloaded = loadDataset(d.str());
   std::vector<int> all(preloaded.views.size());
   for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int>(i);
-  preloaded.preloadImages({5, 1, 3, 1});  // repeats, out of order, some views first
-  preloaded.preloadImages(all);
+  EXPECT_EQ(preloaded.preloadImages({5, 1, 3, 1}), 3u);  // repeats, out of order, some views first
+  EXPECT_EQ(preloaded.preloadImages(all), all.size() - 3);  // the kept ones are not read again
   for (int v : all) {
     EXPECT_EQ(preloaded.image(v).data, one_by_one.image(v).data) << "view " << v;
     EXPECT_EQ(preloaded.image(v).width, 40);
