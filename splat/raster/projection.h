@@ -8,6 +8,7 @@
 #include "geometry/camera/camera.h"
 #include "splat/gaussians.h"
 #include "splat/rasterize.h"
+#include "splat/raster/projected.h"
 #include "splat/raster/sh.h"
 
 namespace saresgs::projection {
@@ -107,21 +108,6 @@ template <typename T>
 T sigmoid(T v) {
   return T(1) / (T(1) + std::exp(-std::clamp(v, T(-80), T(80))));
 }
-
-// The projected form of one Gaussian.
-template <typename T>
-struct Projected {
-  bool visible = false;
-  T mean2d[2];
-  T conic[3];  // inverse 2D covariance (a, b, c)
-  T cov2d[3];  // 2D covariance incl. eps2d (a, b, c)
-  T depth;     // camera z
-  T opacity;
-  T color[3];
-  bool clamped[3];  // colour channel clamped at 0 (no gradient)
-  T half[2];        // rectangle half sizes in px
-  T radius;
-};
 
 // Rules 1-5 for Gaussian i.
 // The SH basis along the unit view direction from the camera centre to Gaussian i's

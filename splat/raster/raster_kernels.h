@@ -11,7 +11,10 @@
 // written as fma() and the baseline rounds them twice, so the baseline and AVX2 paths
 // agree to float rounding (FloatPath.KernelSetsAgree), while each is bit-identical
 // across runs and thread counts.
+#include <cstddef>
 #include <cstdint>
+
+#include "splat/raster/projected.h"
 
 namespace saresgs {
 
@@ -91,6 +94,36 @@ struct FisherIn {
 // entry's slot is written, zeros where no pixel reaches it).
 using FisherFn = void (*)(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1,
                           const float bg[3], const FisherIn& in, const std::uint32_t* entry_slot, float* slots);
+
+// What the projection kernels (splat/raster/project_kernels_impl.h) read: the model's
+// arrays (GaussiansT<float>'s storage), the camera in float (projection::CameraT<float>)
+// and the settings, converted as project() converts them.
+struct ProjectIn {
+  const float* means;       // 3 per Gaussian
+  const float* log_scales;  // 3
+  const float* rotations;   // 4 (w, x, y, z)
+  const float* opacities;   // 1 (logit)
+  const float* sh;          // sh_stride per Gaussian
+  int sh_stride;            // 3 x the model's SH coefficients
+  int sh_degree;            // active degree, 0-3
+  float R[3][3], t[3], center[3];
+  float fx, fy, cx, cy, width, height;
+  float gx_mid, gx_half, gy_mid, gy_half;
+  float near_plane, eps2d;
+};
+
+// Rules 1-5 (projection::project<float> with the opacity-aware extent) for Gaussians
+// [begin, end), SARESGS_KERNEL_LANES at a time, into out[i] for each i: bit for bit what
+// project() returns for every visible Gaussian, and visible = false where it culls (the
+// other fields of a culled Gaussian are unspecified there as here).
+using ProjectFn = void (*)(const ProjectIn& in, std::size_t begin, std::size_t end,
+                           projection::Projected<float>* out);
+namespace base4 {
+void projectRange(const ProjectIn& in, std::size_t begin, std::size_t end, projection::Projected<float>* out);
+}
+namespace avx2 {
+void projectRange(const ProjectIn& in, std::size_t begin, std::size_t end, projection::Projected<float>* out);
+}
 
 namespace base4 {
 void fisherTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],

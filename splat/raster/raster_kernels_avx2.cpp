@@ -10,6 +10,7 @@
 #define SARESGS_KERNEL_FMA 1
 #include "splat/raster/raster_kernels_impl.h"
 #include "splat/raster/raster_kernels_pair_impl.h"
+#include "splat/raster/project_kernels_impl.h"
 
 namespace saresgs::raster_kernels::avx2 {
 bool compiled() { return true; }
@@ -19,6 +20,7 @@ bool compiled() { return true; }
 
 namespace saresgs::raster_kernels::avx2 {
 bool compiled() { return false; }
+void projectRange(const ProjectIn&, std::size_t, std::size_t, projection::Projected<float>*) { std::abort(); }
 float compositeFloor(long) { std::abort(); }
 void compositeTile(const TileGaussian<float>*, int, int, int, int, int, const float*, const ForwardOut&) {
   std::abort();

@@ -6,6 +6,7 @@
 #include <span>
 #include <vector>
 
+#include "splat/raster/projected.h"
 #include "splat/rasterize.h"
 
 namespace saresgs {
@@ -45,5 +46,12 @@ void rasterizeSquaredGradientsT(const GaussiansT<T>& g, const Camera& cam, const
 template <typename T>
 void rasterizeSquaredGradientsWalkT(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& s,
                                     const RenderOutputT<T>& fwd, GaussiansT<T>& sq);
+
+// Rules 1-5 for Gaussians [begin, end) of a float model as every float render with `s`
+// runs them (the SIMD projection of s.execution.kernels with the opacity-aware extent,
+// project<float> otherwise), into out[begin, end) (out is resized to g.size()): tests hold
+// the SIMD kernels to project<float> bit for bit.
+void projectRangeFloat(const GaussiansT<float>& g, const Camera& cam, const RasterSettings& s, std::size_t begin,
+                       std::size_t end, std::vector<projection::Projected<float>>& out);
 
 }  // namespace saresgs

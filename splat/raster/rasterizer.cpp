@@ -26,6 +26,7 @@
 #define SARESGS_KERNEL_LANES 4
 #include "splat/raster/raster_kernels_impl.h"
 #include "splat/raster/raster_kernels_pair_impl.h"
+#include "splat/raster/project_kernels_impl.h"
 #include "geometry/float_env.h"
 #undef SARESGS_KERNEL_NS
 #undef SARESGS_KERNEL_LANES
@@ -65,13 +66,18 @@ struct KernelSet {
   const char* name;
   raster_kernels::CompositeFn composite;
   raster_kernels::BackwardFn backward;
+  raster_kernels::ProjectFn project;
 };
 constexpr KernelSet kKernelSets[] = {
-    {"baseline", raster_kernels::base4::compositeTile, raster_kernels::base4::backwardTile},
-    {"avx2", raster_kernels::avx2::compositeTile, raster_kernels::avx2::backwardTile},
+    {"baseline", raster_kernels::base4::compositeTile, raster_kernels::base4::backwardTile,
+     raster_kernels::base4::projectRange},
+    {"avx2", raster_kernels::avx2::compositeTile, raster_kernels::avx2::backwardTile,
+     raster_kernels::avx2::projectRange},
     // avx512: AVX2's forward; its backward and Fisher walks on 32 registers, bit for bit AVX2's.
-    {"avx512", raster_kernels::avx2::compositeTile, raster_kernels::avx512::backwardTile},
+    {"avx512", raster_kernels::avx2::compositeTile, raster_kernels::avx512::backwardTile,
+     raster_kernels::avx2::projectRange},
 };
+static_assert(raster_kernels::base4::kProjShC0 == static_cast<float>(kShC0));
 static_assert(raster_kernels::base4::kTile == kTileSize && raster_kernels::base4::kMinA == kMinAlpha &&
               raster_kernels::base4::kMaxA == kMaxAlpha && raster_kernels::base4::kMinT == kMinTransmittance);
 
@@ -389,6 +395,47 @@ void forEachTileMet(const TileGaussian<T>& g, const std::array<int, 4>& rect, in
     }
 }
 
+// The projection kernels' view of a float model and camera (raster_kernels::ProjectIn).
+raster_kernels::ProjectIn projectInput(const GaussiansT<float>& g, const CameraT<float>& cam,
+                                       const RasterSettings& rs) {
+  raster_kernels::ProjectIn in{};
+  in.means = g.means.data();
+  in.log_scales = g.log_scales.data();
+  in.rotations = g.rotations.data();
+  in.opacities = g.opacities.data();
+  in.sh = g.sh.data();
+  in.sh_stride = 3 * g.shCoeffs();
+  in.sh_degree = rs.sh_degree;
+  for (int r = 0; r < 3; ++r) {
+    for (int k = 0; k < 3; ++k) in.R[r][k] = cam.R[r][k];
+    in.t[r] = cam.t[r];
+    in.center[r] = cam.center[r];
+  }
+  in.fx = cam.fx;
+  in.fy = cam.fy;
+  in.cx = cam.cx;
+  in.cy = cam.cy;
+  in.width = static_cast<float>(cam.width);
+  in.height = static_cast<float>(cam.height);
+  in.gx_mid = cam.gx_mid;
+  in.gx_half = cam.gx_half;
+  in.gy_mid = cam.gy_mid;
+  in.gy_half = cam.gy_half;
+  in.near_plane = static_cast<float>(rs.near_plane);
+  in.eps2d = static_cast<float>(rs.eps2d);
+  return in;
+}
+
+// One Gaussian range of projectAll's projection (without its tile work).
+void projectRangeWith(const GaussiansT<float>& g, const CameraT<float>& camT, const RasterSettings& rs, int isa,
+                      std::size_t begin, std::size_t end, Projected<float>* out) {
+  if (rs.extent == ExtentRule::kOpacityAware) {
+    kKernelSets[isa].project(projectInput(g, camT, rs), begin, end, out);
+    return;
+  }
+  for (std::size_t i = begin; i < end; ++i) out[i] = projection::project(g, i, camT, rs);
+}
+
 // Projects every unmasked Gaussian, culls, fills its tile data, radius and visibility,
 // and counts the tiles its pixel rectangle touches.
 // `cover` is the caller's (kept between renders: rasterizeIntoT).
@@ -406,12 +453,16 @@ void projectAll(const GaussiansT<T>& g, const CameraT<T>& camT, std::span<const 
   arena(st).execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& r) {
       const FloatEnvGuard fenv;  // geometry/float_env.h
+      // Float: the SIMD projection of the render's kernel set, bit for bit project()'s
+      // (ProjectKernels.*); masked Gaussians are projected and then cleared.
+      if constexpr (std::is_same_v<T, float>) projectRangeWith(g, camT, rs, st.isa, r.begin(), r.end(), st.proj.data());
       for (std::size_t i = r.begin(); i < r.end(); ++i) {
         if (!mask.empty() && !mask[i]) {
           st.proj[i] = Projected<T>{};
           continue;
         }
-        Projected<T>& P = st.proj[i] = projection::project(g, i, camT, rs);
+        if constexpr (!std::is_same_v<T, float>) st.proj[i] = projection::project(g, i, camT, rs);
+        Projected<T>& P = st.proj[i];
         if (!P.visible) continue;
         st.tile_data[i] = tileData(P, W, H);
         out.visible[i] = 1;
@@ -552,6 +603,17 @@ void rasterizeIntoT(const GaussiansT<T>& g, const Camera& cam, const RasterSetti
   binAndSort(cover, W, H, *st);
   compositeTiles(W, H, *st, out);
   out.state = std::move(st);
+}
+
+void projectRangeFloat(const GaussiansT<float>& g, const Camera& cam, const RasterSettings& s, std::size_t begin,
+                       std::size_t end, std::vector<projection::Projected<float>>& out) {
+  if (begin > end || end > g.size()) throw std::invalid_argument("projectRangeFloat: range beyond the model");
+  RasterStateT<float> st;
+  beginState(st, s, g.max_sh_degree, cam.K.width, cam.K.height);
+  const CameraT<float> camT(cam, s.guard_band);
+  out.resize(g.size());
+  const FloatEnvGuard fenv;
+  projectRangeWith(g, camT, st.settings, st.isa, begin, end, out.data());
 }
 
 template <typename T>

@@ -3,17 +3,9 @@
 // constants are those of the standard real SH, with 3DGS's signs). Templated so that
 // the float fast path and the double reference share one definition of the basis.
 #include "splat/gaussians.h"
+#include "splat/raster/sh_constants.h"
 
 namespace saresgs {
-
-namespace sh_constants {
-inline constexpr double C1 = 0.4886025119029199;
-inline constexpr double C2[5] = {1.0925484305920792, -1.0925484305920792, 0.31539156525252005,
-                                 -1.0925484305920792, 0.5462742152960396};
-inline constexpr double C3[7] = {-0.5900435899266435, 2.890611442640554, -0.4570457994644658,
-                                 0.3731763325901154,  -0.4570457994644658, 1.445305721320277,
-                                 -0.5900435899266435};
-}  // namespace sh_constants
 
 // Writes the shCoeffCount(degree) basis values Y_k(d) for a unit direction d.
 template <typename T>
