@@ -204,15 +204,6 @@ Projected<T> project(const GaussiansT<T>& g, std::size_t i, const CameraT<T>& ca
   return P;
 }
 
-// Gradients of the projected quantities of one Gaussian.
-template <typename T>
-struct ProjectedGrad {
-  T mean2d[2] = {0, 0};
-  T conic[3] = {0, 0, 0};
-  T color[3] = {0, 0, 0};
-  T opacity = 0;  // dL/d(sigmoid opacity)
-};
-
 // Where projectBackward adds one Gaussian's parameter gradients; a null pointer skips
 // that parameter (the Fisher mode asks for means and scales only).
 template <typename T>

@@ -118,6 +118,33 @@ struct ProjectIn {
 // other fields of a culled Gaussian are unspecified there as here).
 using ProjectFn = void (*)(const ProjectIn& in, std::size_t begin, std::size_t end,
                            projection::Projected<float>* out);
+// Where the projection's backward kernels add a Gaussian's parameter gradients
+// (GaussiansT<float>'s storage; sh with ProjectIn::sh_stride per Gaussian).
+struct ProjectGradOut {
+  float* means;
+  float* log_scales;
+  float* rotations;
+  float* opacities;
+  float* sh;
+};
+
+// projection::projectBackward<float> with every parameter asked for, for the Gaussians
+// idx[0, count) (distinct), given their projections (proj[idx[j]]) and the gradients of
+// their projected quantities (dP[j]): adds to `out` bit for bit what projectBackward adds.
+using ProjectBackwardFn = void (*)(const ProjectIn& in, const std::uint32_t* idx, int count,
+                                   const projection::Projected<float>* proj,
+                                   const projection::ProjectedGrad<float>* dP, const ProjectGradOut& out);
+namespace base4 {
+void projectBackwardList(const ProjectIn& in, const std::uint32_t* idx, int count,
+                         const projection::Projected<float>* proj, const projection::ProjectedGrad<float>* dP,
+                         const ProjectGradOut& out);
+}
+namespace avx2 {
+void projectBackwardList(const ProjectIn& in, const std::uint32_t* idx, int count,
+                         const projection::Projected<float>* proj, const projection::ProjectedGrad<float>* dP,
+                         const ProjectGradOut& out);
+}
+
 namespace base4 {
 void projectRange(const ProjectIn& in, std::size_t begin, std::size_t end, projection::Projected<float>* out);
 }

@@ -21,6 +21,10 @@ bool compiled() { return true; }
 namespace saresgs::raster_kernels::avx2 {
 bool compiled() { return false; }
 void projectRange(const ProjectIn&, std::size_t, std::size_t, projection::Projected<float>*) { std::abort(); }
+void projectBackwardList(const ProjectIn&, const std::uint32_t*, int, const projection::Projected<float>*,
+                         const projection::ProjectedGrad<float>*, const ProjectGradOut&) {
+  std::abort();
+}
 float compositeFloor(long) { std::abort(); }
 void compositeTile(const TileGaussian<float>*, int, int, int, int, int, const float*, const ForwardOut&) {
   std::abort();

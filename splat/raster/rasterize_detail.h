@@ -54,4 +54,11 @@ void rasterizeSquaredGradientsWalkT(const GaussiansT<T>& g, const Camera& cam, c
 void projectRangeFloat(const GaussiansT<float>& g, const Camera& cam, const RasterSettings& s, std::size_t begin,
                        std::size_t end, std::vector<projection::Projected<float>>& out);
 
+// projectBackward<float> for Gaussians idx (distinct, each with proj[idx[j]] and dP[j])
+// as every float backward pass with `s` runs it (the SIMD kernel of s.execution.kernels),
+// adding to `grad`: tests hold it to the scalar projectBackward bit for bit.
+void projectBackwardFloat(const GaussiansT<float>& g, const Camera& cam, const RasterSettings& s,
+                          const std::vector<std::uint32_t>& idx, const std::vector<projection::Projected<float>>& proj,
+                          const std::vector<projection::ProjectedGrad<float>>& dP, GaussiansT<float>& grad);
+
 }  // namespace saresgs

@@ -67,15 +67,16 @@ struct KernelSet {
   raster_kernels::CompositeFn composite;
   raster_kernels::BackwardFn backward;
   raster_kernels::ProjectFn project;
+  raster_kernels::ProjectBackwardFn project_backward;
 };
 constexpr KernelSet kKernelSets[] = {
     {"baseline", raster_kernels::base4::compositeTile, raster_kernels::base4::backwardTile,
-     raster_kernels::base4::projectRange},
+     raster_kernels::base4::projectRange, raster_kernels::base4::projectBackwardList},
     {"avx2", raster_kernels::avx2::compositeTile, raster_kernels::avx2::backwardTile,
-     raster_kernels::avx2::projectRange},
+     raster_kernels::avx2::projectRange, raster_kernels::avx2::projectBackwardList},
     // avx512: AVX2's forward; its backward and Fisher walks on 32 registers, bit for bit AVX2's.
     {"avx512", raster_kernels::avx2::compositeTile, raster_kernels::avx512::backwardTile,
-     raster_kernels::avx2::projectRange},
+     raster_kernels::avx2::projectRange, raster_kernels::avx2::projectBackwardList},
 };
 static_assert(raster_kernels::base4::kProjShC0 == static_cast<float>(kShC0));
 static_assert(raster_kernels::base4::kTile == kTileSize && raster_kernels::base4::kMinA == kMinAlpha &&
@@ -616,6 +617,24 @@ void projectRangeFloat(const GaussiansT<float>& g, const Camera& cam, const Rast
   projectRangeWith(g, camT, st.settings, st.isa, begin, end, out.data());
 }
 
+void projectBackwardFloat(const GaussiansT<float>& g, const Camera& cam, const RasterSettings& s,
+                          const std::vector<std::uint32_t>& idx, const std::vector<Projected<float>>& proj,
+                          const std::vector<ProjectedGrad<float>>& dP, GaussiansT<float>& grad) {
+  if (idx.size() != dP.size() || proj.size() != g.size() || grad.size() != g.size() ||
+      grad.shCoeffs() != g.shCoeffs())
+    throw std::invalid_argument("projectBackwardFloat: sizes disagree");
+  for (const std::uint32_t i : idx)
+    if (i >= g.size()) throw std::invalid_argument("projectBackwardFloat: index beyond the model");
+  RasterStateT<float> st;
+  beginState(st, s, g.max_sh_degree, cam.K.width, cam.K.height);
+  const CameraT<float> camT(cam, s.guard_band);
+  const FloatEnvGuard fenv;
+  kKernelSets[st.isa].project_backward(projectInput(g, camT, st.settings), idx.data(), static_cast<int>(idx.size()),
+                                       proj.data(), dP.data(),
+                                       {grad.means.data(), grad.log_scales.data(), grad.rotations.data(),
+                                        grad.opacities.data(), grad.sh.data()});
+}
+
 template <typename T>
 RenderOutputT<T> rasterizeT(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& s,
                             std::span<const std::uint8_t> mask) {
@@ -669,24 +688,49 @@ void chainSlots(const GaussiansT<T>& g, const Camera& cam, const RasterStateT<T>
   const std::size_t n = g.size();
   arena(st).execute([&] {
     const CameraT<T> camT(cam, T(rs.guard_band));
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& r) {
+    // Float: the Gaussians that have pairs are listed, up to kChunk at a time, with their
+    // summed gradients and chained by the kernel set's SIMD projectBackward (bit for bit
+    // the scalar one: ProjectKernels.*).
+    constexpr std::size_t kChunk = 256;
+    [[maybe_unused]] raster_kernels::ProjectIn pin{};
+    [[maybe_unused]] raster_kernels::ProjectGradOut pout{};
+    if constexpr (std::is_same_v<T, float>) {
+      pin = projectInput(g, camT, rs);
+      pout = {grad.means.data(), grad.log_scales.data(), grad.rotations.data(), grad.opacities.data(),
+              grad.sh.data()};
+    }
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kChunk), [&](const auto& r) {
       const FloatEnvGuard fenv;  // geometry/float_env.h
-      for (std::size_t i = r.begin(); i < r.end(); ++i) {
-        if (st.gauss_start[i] == st.gauss_start[i + 1]) continue;
-        ProjectedGrad<T> dP;
-        for (std::uint32_t k = st.gauss_start[i]; k < st.gauss_start[i + 1]; ++k) {
-          const T* sl = &slots[static_cast<std::size_t>(k) * kSlot];
-          dP.opacity += sl[0];
-          dP.mean2d[0] += sl[1];
-          dP.mean2d[1] += sl[2];
-          for (int c = 0; c < 3; ++c) dP.conic[c] += sl[3 + c];
-          for (int c = 0; c < 3; ++c) dP.color[c] += sl[6 + c];
+      [[maybe_unused]] std::uint32_t list[kChunk];
+      [[maybe_unused]] ProjectedGrad<T> list_dP[kChunk];
+      // A range may be longer than the grain: at most kChunk Gaussians per list.
+      for (std::size_t b = r.begin(); b < r.end(); b += kChunk) {
+        const std::size_t e = std::min(r.end(), b + kChunk);
+        int listed = 0;
+        for (std::size_t i = b; i < e; ++i) {
+          if (st.gauss_start[i] == st.gauss_start[i + 1]) continue;
+          ProjectedGrad<T> dP;
+          for (std::uint32_t k = st.gauss_start[i]; k < st.gauss_start[i + 1]; ++k) {
+            const T* sl = &slots[static_cast<std::size_t>(k) * kSlot];
+            dP.opacity += sl[0];
+            dP.mean2d[0] += sl[1];
+            dP.mean2d[1] += sl[2];
+            for (int c = 0; c < 3; ++c) dP.conic[c] += sl[3 + c];
+            for (int c = 0; c < 3; ++c) dP.color[c] += sl[6 + c];
+          }
+          if (grad_mean2d) {
+            (*grad_mean2d)[2 * i] += dP.mean2d[0];
+            (*grad_mean2d)[2 * i + 1] += dP.mean2d[1];
+          }
+          if constexpr (std::is_same_v<T, float>) {
+            list[listed] = static_cast<std::uint32_t>(i);
+            list_dP[listed++] = dP;
+          } else {
+            projection::projectBackward(g, i, camT, rs, st.proj[i], dP, projection::ParamGradRef<T>::of(grad, i));
+          }
         }
-        if (grad_mean2d) {
-          (*grad_mean2d)[2 * i] += dP.mean2d[0];
-          (*grad_mean2d)[2 * i + 1] += dP.mean2d[1];
-        }
-        projection::projectBackward(g, i, camT, rs, st.proj[i], dP, projection::ParamGradRef<T>::of(grad, i));
+        if constexpr (std::is_same_v<T, float>)
+          if (listed) kKernelSets[st.isa].project_backward(pin, list, listed, st.proj.data(), list_dP, pout);
       }
     });
   });

@@ -93,6 +93,7 @@ struct FloatCase {
   double spread;
   float background;
   std::uint64_t seed;
+  int threads = 0;  // the rasterizer's (0: all cores)
 };
 
 class FloatPath : public ::testing::TestWithParam<FloatCase> {};
@@ -203,6 +204,7 @@ void checkFloatAgainstDouble(const FloatCase& fc, RasterKernels kernels) {
   RasterSettings s;
   s.sh_degree = fc.sh_degree;
   s.execution.kernels = kernels;
+  s.execution.threads = fc.threads;
   s.background = {fc.background, 0.5f * fc.background, 1.0f - fc.background};
   const auto rd = rasterizeT(gd, cam, s);
   const auto rf = rasterizeT(gf, cam, s);
@@ -234,7 +236,10 @@ void checkFloatAgainstDouble(const FloatCase& fc, RasterKernels kernels) {
 
 INSTANTIATE_TEST_SUITE_P(Scenes, FloatPath,
                          ::testing::Values(FloatCase{60, 3, 0.9, 0.0f, 5}, FloatCase{300, 0, 0.6, 0.7f, 6},
-                                           FloatCase{150, 1, 1.5, 0.3f, 7}));
+                                           FloatCase{150, 1, 1.5, 0.3f, 7},
+                                           // Thousands: the backward's per-Gaussian chain
+                                           // runs over ranges longer than its 256-entry lists.
+                                           FloatCase{3000, 2, 1.2, 0.2f, 8, 1}));
 
 // Gaussians wider than 32 pixels take the kernels' chord bounds (per block row, only the
 // columns the alpha ellipse can reach); smaller ones the plain rectangle. Long thin
