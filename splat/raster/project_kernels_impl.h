@@ -147,6 +147,77 @@ inline vf viewBasisLanes(const ProjectIn& in, const vf m[3], vf d[3], vf basis[1
   return dn;
 }
 
+
+// backwardFrame: what projectBackward recomputes of project() (projection.h).
+struct FrameLanes {
+  vf p[3], iz, iz2, d[3], dn, basis[16];
+  QuatLanes q;
+  vf sc[3], M[3][3], Sig[3][3], A[2][3];
+};
+inline FrameLanes frameLanes(const ProjectIn& in, const LaneSet& ls) {
+  FrameLanes f;
+  const vf m[3] = {ls.at(in.means, 3, 0), ls.at(in.means, 3, 1), ls.at(in.means, 3, 2)};
+  cameraSpace(in, m, f.p);
+  f.iz = vs(1.0f) / f.p[2];
+  f.iz2 = f.iz * f.iz;
+  f.dn = viewBasisLanes(in, m, f.d, f.basis);
+  f.q = quatLanes(ls, in.rotations);
+  covarianceLanes(ls, in.log_scales, f.q, f.sc, f.M, f.Sig);
+  jacobianTimesW(in, vs(in.fx) * f.iz, vs(-in.fx) * f.p[0] * f.iz2, vs(in.fy) * f.iz, vs(-in.fy) * f.p[1] * f.iz2,
+                 f.A);
+  return f;
+}
+
+// colorBackward's view-direction part: the mean's gradient dm through the SH basis and
+// the normalisation, for the colour gradients dc (zero where clamped); zero at SH degree
+// 0 and where the mean is the camera centre.
+inline void viewDirectionGrad(const ProjectIn& in, const LaneSet& ls, const FrameLanes& f, const vf dc[3],
+                              vf dm[3]) {
+  using namespace sh_constants;
+  const vf zero = vs(0.0f);
+  const std::size_t stride = static_cast<std::size_t>(in.sh_stride);
+  const int degree = in.sh_degree, active = (degree + 1) * (degree + 1);
+  dm[0] = dm[1] = dm[2] = zero;
+  if (degree <= 0) return;
+  vf gb[16];
+  for (int k = 0; k < active; ++k) {
+    const std::size_t o3 = static_cast<std::size_t>(k * 3);
+    gb[k] = dc[0] * ls.at(in.sh, stride, o3) + dc[1] * ls.at(in.sh, stride, o3 + 1) + dc[2] * ls.at(in.sh, stride, o3 + 2);
+  }
+  const vf x = f.d[0], y = f.d[1], z = f.d[2];
+  const float c1 = static_cast<float>(C1);
+  vf gd[3];
+  gd[0] = zero + vs(-c1) * gb[3];
+  gd[1] = zero + vs(-c1) * gb[1];
+  gd[2] = zero + vs(c1) * gb[2];
+  if (degree > 1) {
+    const float c20 = static_cast<float>(C2[0]), c21 = static_cast<float>(C2[1]), c22 = static_cast<float>(C2[2]),
+                c23 = static_cast<float>(C2[3]), c24 = static_cast<float>(C2[4]);
+    gd[0] = gd[0] + (vs(c20) * y * gb[4] - vs(2 * c22) * x * gb[6] + vs(c23) * z * gb[7] + vs(2 * c24) * x * gb[8]);
+    gd[1] = gd[1] + (vs(c20) * x * gb[4] + vs(c21) * z * gb[5] - vs(2 * c22) * y * gb[6] - vs(2 * c24) * y * gb[8]);
+    gd[2] = gd[2] + (vs(c21) * y * gb[5] + vs(4 * c22) * z * gb[6] + vs(c23) * x * gb[7]);
+  }
+  if (degree > 2) {
+    const vf xx = x * x, yy = y * y, zz = z * z;
+    const vf three = vs(3.0f), four = vs(4.0f), six = vs(6.0f);
+    const float c30 = static_cast<float>(C3[0]), c31 = static_cast<float>(C3[1]), c32 = static_cast<float>(C3[2]),
+                c33 = static_cast<float>(C3[3]), c34 = static_cast<float>(C3[4]), c35 = static_cast<float>(C3[5]),
+                c36 = static_cast<float>(C3[6]);
+    gd[0] = gd[0] + (vs(6 * c30) * x * y * gb[9] + vs(c31) * y * z * gb[10] - vs(2 * c32) * x * y * gb[11] -
+                     vs(6 * c33) * x * z * gb[12] + vs(c34) * (four * zz - three * xx - yy) * gb[13] +
+                     vs(2 * c35) * x * z * gb[14] + vs(c36) * (three * xx - three * yy) * gb[15]);
+    gd[1] = gd[1] + (vs(c30) * (three * xx - three * yy) * gb[9] + vs(c31) * x * z * gb[10] +
+                     vs(c32) * (four * zz - xx - three * yy) * gb[11] - vs(6 * c33) * y * z * gb[12] -
+                     vs(2 * c34) * x * y * gb[13] - vs(2 * c35) * y * z * gb[14] - vs(6 * c36) * x * y * gb[15]);
+    gd[2] = gd[2] + (vs(c31) * x * y * gb[10] + vs(8 * c32) * y * z * gb[11] +
+                     vs(c33) * (six * zz - three * xx - three * yy) * gb[12] + vs(8 * c34) * x * z * gb[13] +
+                     vs(c35) * (xx - yy) * gb[14]);
+  }
+  const vf dot = gd[0] * f.d[0] + gd[1] * f.d[1] + gd[2] * f.d[2];
+  const vi away = f.dn > zero;
+  for (int r = 0; r < 3; ++r) dm[r] = away ? zero + (gd[r] - f.d[r] * dot) / f.dn : zero;
+}
+
 }  // namespace
 
 void projectRange(const ProjectIn& in, std::size_t begin, std::size_t end, projection::Projected<float>* out) {
@@ -195,7 +266,7 @@ void projectRange(const ProjectIn& in, std::size_t begin, std::size_t end, proje
     vf d[3], basis[16];
     viewBasisLanes(in, m, d, basis);
     vf col[3];
-    vi clamped[3];
+    vi clamped[3] = {};
     for (int c = 0; c < 3; ++c) {
       vf v = vs(0.5f);
       for (int k = 0; k < active; ++k) v = v + basis[k] * ls.at(in.sh, stride, static_cast<std::size_t>(k * 3 + c));
@@ -248,8 +319,8 @@ void projectBackwardList(const ProjectIn& in, const std::uint32_t* idx, int coun
       ls.ix[l] = idx[jx[l]];
     }
     const int n = ls.n;
-    vf Pa, Pb, Pc, Po, dPo, dmx, dmy, dca, dcb, dcc, dcol[3];
-    vi clamped[3];
+    vf Pa{}, Pb{}, Pc{}, Po{}, dPo{}, dmx{}, dmy{}, dca{}, dcb{}, dcc{}, dcol[3] = {};
+    vi clamped[3] = {};
     for (int l = 0; l < L; ++l) {
       const projection::Projected<float>& P = proj[ls.ix[l]];
       const projection::ProjectedGrad<float>& g = dP[jx[l]];
@@ -269,19 +340,15 @@ void projectBackwardList(const ProjectIn& in, const std::uint32_t* idx, int coun
       dcc[l] = g.conic[2];
     }
 
-    // backwardFrame.
-    const vf m[3] = {ls.at(in.means, 3, 0), ls.at(in.means, 3, 1), ls.at(in.means, 3, 2)};
-    vf p[3];
-    cameraSpace(in, m, p);
-    const vf iz = one / p[2];
-    const vf iz2 = iz * iz;
-    vf d[3], basis[16];
-    const vf dn = viewBasisLanes(in, m, d, basis);
-    const QuatLanes q = quatLanes(ls, in.rotations);
-    vf sc[3], M[3][3], Sig[3][3];
-    covarianceLanes(ls, in.log_scales, q, sc, M, Sig);
-    vf A[2][3];
-    jacobianTimesW(in, vs(in.fx) * iz, vs(-in.fx) * p[0] * iz2, vs(in.fy) * iz, vs(-in.fy) * p[1] * iz2, A);
+    const FrameLanes f = frameLanes(in, ls);
+    const vf (&p)[3] = f.p;
+    const vf iz = f.iz, iz2 = f.iz2;
+    const vf(&M)[3][3] = f.M;
+    const vf(&Sig)[3][3] = f.Sig;
+    const vf(&A)[2][3] = f.A;
+    const vf(&sc)[3] = f.sc;
+    const QuatLanes& q = f.q;
+    const vf(&basis)[16] = f.basis;
 
     // The opacity logit.
     const vf g_opacity = dPo * Po * (one - Po);
@@ -289,52 +356,8 @@ void projectBackwardList(const ProjectIn& in, const std::uint32_t* idx, int coun
     // colorBackward.
     vf dc[3];
     for (int c = 0; c < 3; ++c) dc[c] = clamped[c] ? zero : dcol[c];
-    vf dm[3] = {zero, zero, zero};
-    if (degree > 0) {
-      vf gb[16];
-      for (int k = 0; k < active; ++k) {
-        const std::size_t o3 = static_cast<std::size_t>(k * 3);
-        gb[k] = dc[0] * ls.at(in.sh, stride, o3) + dc[1] * ls.at(in.sh, stride, o3 + 1) +
-                dc[2] * ls.at(in.sh, stride, o3 + 2);
-      }
-      const vf x = d[0], y = d[1], z = d[2];
-      const float c1 = static_cast<float>(C1);
-      vf gd[3];
-      gd[0] = zero + vs(-c1) * gb[3];
-      gd[1] = zero + vs(-c1) * gb[1];
-      gd[2] = zero + vs(c1) * gb[2];
-      if (degree > 1) {
-        const float c20 = static_cast<float>(C2[0]), c21 = static_cast<float>(C2[1]),
-                    c22 = static_cast<float>(C2[2]), c23 = static_cast<float>(C2[3]),
-                    c24 = static_cast<float>(C2[4]);
-        gd[0] = gd[0] + (vs(c20) * y * gb[4] - vs(2 * c22) * x * gb[6] + vs(c23) * z * gb[7] +
-                         vs(2 * c24) * x * gb[8]);
-        gd[1] = gd[1] + (vs(c20) * x * gb[4] + vs(c21) * z * gb[5] - vs(2 * c22) * y * gb[6] -
-                         vs(2 * c24) * y * gb[8]);
-        gd[2] = gd[2] + (vs(c21) * y * gb[5] + vs(4 * c22) * z * gb[6] + vs(c23) * x * gb[7]);
-      }
-      if (degree > 2) {
-        const vf xx = x * x, yy = y * y, zz = z * z;
-        const vf three = vs(3.0f), four = vs(4.0f), six = vs(6.0f);
-        const float c30 = static_cast<float>(C3[0]), c31 = static_cast<float>(C3[1]),
-                    c32 = static_cast<float>(C3[2]), c33 = static_cast<float>(C3[3]),
-                    c34 = static_cast<float>(C3[4]), c35 = static_cast<float>(C3[5]),
-                    c36 = static_cast<float>(C3[6]);
-        gd[0] = gd[0] + (vs(6 * c30) * x * y * gb[9] + vs(c31) * y * z * gb[10] - vs(2 * c32) * x * y * gb[11] -
-                         vs(6 * c33) * x * z * gb[12] + vs(c34) * (four * zz - three * xx - yy) * gb[13] +
-                         vs(2 * c35) * x * z * gb[14] + vs(c36) * (three * xx - three * yy) * gb[15]);
-        gd[1] = gd[1] + (vs(c30) * (three * xx - three * yy) * gb[9] + vs(c31) * x * z * gb[10] +
-                         vs(c32) * (four * zz - xx - three * yy) * gb[11] - vs(6 * c33) * y * z * gb[12] -
-                         vs(2 * c34) * x * y * gb[13] - vs(2 * c35) * y * z * gb[14] -
-                         vs(6 * c36) * x * y * gb[15]);
-        gd[2] = gd[2] + (vs(c31) * x * y * gb[10] + vs(8 * c32) * y * z * gb[11] +
-                         vs(c33) * (six * zz - three * xx - three * yy) * gb[12] + vs(8 * c34) * x * z * gb[13] +
-                         vs(c35) * (xx - yy) * gb[14]);
-      }
-      const vf dot = gd[0] * d[0] + gd[1] * d[1] + gd[2] * d[2];
-      const vi away = dn > zero;
-      for (int r = 0; r < 3; ++r) dm[r] = away ? zero + (gd[r] - d[r] * dot) / dn : zero;
-    }
+    vf dm[3];
+    viewDirectionGrad(in, ls, f, dc, dm);
 
     // conicBackward.
     const vf gQ00 = dca, gQ01 = vs(0.5f) * dcb, gQ11 = dcc;
@@ -414,6 +437,141 @@ void projectBackwardList(const ProjectIn& in, const std::uint32_t* idx, int coun
         if (scale_live[k][l]) out.log_scales[3 * i + k] += g_scale[k][l];
       if (q.ok[l])
         for (int k = 0; k < 4; ++k) out.rotations[4 * i + k] += g_rot[k][l];
+    }
+  }
+}
+
+// squaredGradientsFloat's per-Gaussian stage (rasterizer.cpp) for L Gaussians at a time:
+// backwardFrame and projectJacobian<float> (projection.h) lane by lane in their order,
+// then the quadratic forms of the tile moments in double, L double lanes (the scalar code's
+// operations, in its order), and the squared gradients added as the scalar stage adds them.
+void fisherChainList(const ProjectIn& in, const std::uint32_t* idx, int count, const projection::Projected<float>* proj,
+                     const double* moments, const FisherGradOut& out) {
+  typedef double vd __attribute__((vector_size(8 * L)));
+  const std::size_t stride = static_cast<std::size_t>(in.sh_stride);
+  const int active = (in.sh_degree + 1) * (in.sh_degree + 1);
+  const vf zero = vs(0.0f), one = vs(1.0f);
+  auto dv = [](vf v) { return __builtin_convertvector(v, vd); };
+  auto ds = [](double x) { return x - vd{}; };
+  for (int j0 = 0; j0 < count; j0 += L) {
+    LaneSet ls;
+    ls.n = count - j0 < L ? count - j0 : L;
+    int jx[L];
+    for (int l = 0; l < L; ++l) {
+      jx[l] = j0 + (l < ls.n ? l : ls.n - 1);
+      ls.ix[l] = idx[jx[l]];
+    }
+    const int n = ls.n;
+    vf Pa{}, Pb{}, Pc{}, Po{};
+    vi clamped[3] = {};
+    for (int l = 0; l < L; ++l) {
+      const projection::Projected<float>& P = proj[ls.ix[l]];
+      Pa[l] = P.conic[0];
+      Pb[l] = P.conic[1];
+      Pc[l] = P.conic[2];
+      Po[l] = P.opacity;
+      for (int c = 0; c < 3; ++c) clamped[c][l] = P.clamped[c] ? -1 : 0;
+    }
+    const FrameLanes f = frameLanes(in, ls);
+
+    // projectJacobian: J[r][0..2] the means', J[r][3..5] the log-scales' row r.
+    vf J[6][6];
+    for (int r = 0; r < 6; ++r)
+      for (int k = 0; k < 6; ++k) J[r][k] = zero;
+    // cameraToMean onto a zero row: 0 + (R^T gp + dm).
+    auto toMean = [&](const vf gp[3], const vf dm[3], vf row[6]) {
+      for (int k = 0; k < 3; ++k)
+        row[k] = row[k] + (vs(in.R[0][k]) * gp[0] + vs(in.R[1][k]) * gp[1] + vs(in.R[2][k]) * gp[2] + dm[k]);
+    };
+    const vf zero3[3] = {zero, zero, zero};
+    for (int r = 0; r < 2; ++r) {
+      const vf d0 = r == 0 ? one : zero, d1 = r == 1 ? one : zero;
+      vf gp[3];
+      gp[0] = zero + d0 * vs(in.fx) * f.iz;
+      gp[1] = zero + d1 * vs(in.fy) * f.iz;
+      gp[2] = zero - d0 * vs(in.fx) * f.p[0] * f.iz2 - d1 * vs(in.fy) * f.p[1] * f.iz2;
+      toMean(gp, zero3, J[r]);
+    }
+    const vf qm[2][2] = {{Pa, Pb}, {Pb, Pc}};
+    vf rA[2][3], wR[2][3], tR[2][3];
+    for (int j = 0; j < 2; ++j) {
+      for (int k = 0; k < 3; ++k) rA[j][k] = qm[j][0] * f.A[0][k] + qm[j][1] * f.A[1][k];
+      vf sS[3];
+      for (int k = 0; k < 3; ++k) sS[k] = f.Sig[k][0] * rA[j][0] + f.Sig[k][1] * rA[j][1] + f.Sig[k][2] * rA[j][2];
+      for (int k = 0; k < 3; ++k)
+        wR[j][k] = vs(in.R[k][0]) * sS[0] + vs(in.R[k][1]) * sS[1] + vs(in.R[k][2]) * sS[2];
+      for (int k = 0; k < 3; ++k)
+        tR[j][k] = f.q.R[0][k] * rA[j][0] + f.q.R[1][k] * rA[j][1] + f.q.R[2][k] * rA[j][2];
+    }
+    vi scale_live[3];
+    for (int k = 0; k < 3; ++k) {
+      const vf raw = ls.at(in.log_scales, 3, static_cast<std::size_t>(k));
+      scale_live[k] = (raw > vs(-60.0f)) & (raw < vs(60.0f));
+    }
+    const int uv[3][2] = {{0, 0}, {0, 1}, {1, 1}};
+    const vf fx_iz2 = vs(-in.fx) * f.iz2, fy_iz2 = vs(-in.fy) * f.iz2;
+    for (int r = 0; r < 3; ++r) {
+      const int u = uv[r][0], v = uv[r][1];
+      vf gJ[2][3];
+      for (int row = 0; row < 2; ++row)
+        for (int k = 0; k < 3; ++k) gJ[row][k] = -(qm[u][row] * wR[v][k] + qm[v][row] * wR[u][k]);
+      vf gp[3];
+      gp[0] = gJ[0][2] * fx_iz2;
+      gp[1] = gJ[1][2] * fy_iz2;
+      gp[2] = gJ[0][0] * fx_iz2 + gJ[0][2] * (vs(2.0f * in.fx) * f.p[0] * f.iz2 * f.iz) + gJ[1][1] * fy_iz2 +
+              gJ[1][2] * (vs(2.0f * in.fy) * f.p[1] * f.iz2 * f.iz);
+      toMean(gp, zero3, J[2 + r]);
+      for (int k = 0; k < 3; ++k)
+        J[2 + r][3 + k] = scale_live[k] ? vs(-2.0f) * f.sc[k] * f.sc[k] * tR[u][k] * tR[v][k] : zero;
+    }
+    vf dc[3], dm[3];
+    for (int c = 0; c < 3; ++c) dc[c] = clamped[c] ? zero : one;
+    viewDirectionGrad(in, ls, f, dc, dm);
+    toMean(zero3, dm, J[5]);
+
+    // The quadratic forms, in double.
+    vd mo[kFisherSlot];
+    for (int m = 0; m < kFisherSlot; ++m)
+      for (int l = 0; l < L; ++l) mo[m][l] = moments[static_cast<std::size_t>(jx[l]) * kFisherSlot + m];
+    const vd a = dv(Pa), b = dv(Pb), c = dv(Pc), o = dv(Po);
+    const vd E[5][5] = {{mo[kE20], mo[kE11], mo[kE30], mo[kE21], mo[kE12]},
+                        {mo[kE11], mo[kE02], mo[kE21], mo[kE12], mo[kE03]},
+                        {mo[kE30], mo[kE21], mo[kE40], mo[kE31], mo[kE22]},
+                        {mo[kE21], mo[kE12], mo[kE31], mo[kE22], mo[kE13]},
+                        {mo[kE12], mo[kE03], mo[kE22], mo[kE13], mo[kE04]}};
+    const vd F[5] = {mo[kF10], mo[kF01], mo[kF20], mo[kF11], mo[kF02]};
+    vd res[6];
+    for (int p = 0; p < 6; ++p) {
+      const vd J0 = dv(J[0][p]), J1 = dv(J[1][p]);
+      const vd k[5] = {a * J0 + b * J1, b * J0 + c * J1, ds(-0.5) * dv(J[2][p]), -dv(J[3][p]),
+                       ds(-0.5) * dv(J[4][p])};
+      vd quad = ds(0.0), lin = ds(0.0);
+      for (int u = 0; u < 5; ++u) {
+        vd row = ds(0.0);
+        for (int v = 0; v < 5; ++v) row = row + E[u][v] * k[v];
+        quad = quad + k[u] * row;
+        lin = lin + k[u] * F[u];
+      }
+      const vd jc = dv(J[5][p]);
+      const vd val = o * o * quad + ds(2.0) * o * jc * lin + jc * jc * mo[kW];
+      res[p] = ds(0.0) < val ? val : ds(0.0);  // std::max(0.0, val)
+    }
+    const vd dlogit = o * (ds(1.0) - o);
+    const vd g_opacity = dlogit * dlogit * mo[kE00];
+    vd g_sh[16];
+    for (int k = 0; k < active; ++k) {
+      const vd y = dv(f.basis[k]);
+      g_sh[k] = mo[kW] * y * y;
+    }
+    for (int l = 0; l < n; ++l) {
+      const std::size_t i = ls.ix[l];
+      for (int p = 0; p < 3; ++p) out.means[3 * i + p] += static_cast<float>(res[p][l]);
+      for (int p = 0; p < 3; ++p) out.log_scales[3 * i + p] += static_cast<float>(res[3 + p][l]);
+      out.opacities[i] += static_cast<float>(g_opacity[l]);
+      float* gsh = out.sh + i * stride;
+      for (int k = 0; k < active; ++k)
+        for (int ch = 0; ch < 3; ++ch)
+          if (!clamped[ch][l]) gsh[k * 3 + ch] += static_cast<float>(g_sh[k][l]);
     }
   }
 }

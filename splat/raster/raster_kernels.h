@@ -145,6 +145,31 @@ void projectBackwardList(const ProjectIn& in, const std::uint32_t* idx, int coun
                          const ProjectGradOut& out);
 }
 
+// Where the Fisher chain adds a Gaussian's squared gradients (GaussiansT<float>'s storage).
+struct FisherGradOut {
+  float* means;
+  float* log_scales;
+  float* opacities;
+  float* sh;
+};
+
+// The Fisher pass's per-Gaussian stage (rasterizer.cpp's squaredGradientsFloat): for the
+// Gaussians idx[0, count) (distinct), given their projections (proj[idx[j]]) and their
+// tile moments summed in double (moments[j * kFisherSlot + m]), backwardFrame and
+// projectJacobian in float, the quadratic forms in double, and the squared gradients of
+// the means, log-scales, opacity logit and SH added to `out`, bit for bit the scalar stage.
+using FisherChainFn = void (*)(const ProjectIn& in, const std::uint32_t* idx, int count,
+                               const projection::Projected<float>* proj, const double* moments,
+                               const FisherGradOut& out);
+namespace base4 {
+void fisherChainList(const ProjectIn& in, const std::uint32_t* idx, int count, const projection::Projected<float>* proj,
+                     const double* moments, const FisherGradOut& out);
+}
+namespace avx2 {
+void fisherChainList(const ProjectIn& in, const std::uint32_t* idx, int count, const projection::Projected<float>* proj,
+                     const double* moments, const FisherGradOut& out);
+}
+
 namespace base4 {
 void projectRange(const ProjectIn& in, std::size_t begin, std::size_t end, projection::Projected<float>* out);
 }

@@ -25,6 +25,10 @@ void projectBackwardList(const ProjectIn&, const std::uint32_t*, int, const proj
                          const projection::ProjectedGrad<float>*, const ProjectGradOut&) {
   std::abort();
 }
+void fisherChainList(const ProjectIn&, const std::uint32_t*, int, const projection::Projected<float>*, const double*,
+                     const FisherGradOut&) {
+  std::abort();
+}
 float compositeFloor(long) { std::abort(); }
 void compositeTile(const TileGaussian<float>*, int, int, int, int, int, const float*, const ForwardOut&) {
   std::abort();

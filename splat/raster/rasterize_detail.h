@@ -61,4 +61,14 @@ void projectBackwardFloat(const GaussiansT<float>& g, const Camera& cam, const R
                           const std::vector<std::uint32_t>& idx, const std::vector<projection::Projected<float>>& proj,
                           const std::vector<projection::ProjectedGrad<float>>& dP, GaussiansT<float>& grad);
 
+// The Fisher pass's per-Gaussian stage for Gaussian i, scalar (the reference), and for
+// Gaussians idx by the SIMD kernel of s.execution.kernels (what every float Fisher pass
+// runs): from its projection and its kFisherSlot tile moments summed in double
+// (moments[j * kFisherSlot ...] for idx[j]), the squared gradients added to `sq`.
+void fisherChainReference(const GaussiansT<float>& g, const Camera& cam, const RasterSettings& s, std::size_t i,
+                          const projection::Projected<float>& P, const double* moments, GaussiansT<float>& sq);
+void fisherChainFloat(const GaussiansT<float>& g, const Camera& cam, const RasterSettings& s,
+                      const std::vector<std::uint32_t>& idx, const std::vector<projection::Projected<float>>& proj,
+                      const std::vector<double>& moments, GaussiansT<float>& sq);
+
 }  // namespace saresgs

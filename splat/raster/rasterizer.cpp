@@ -68,15 +68,19 @@ struct KernelSet {
   raster_kernels::BackwardFn backward;
   raster_kernels::ProjectFn project;
   raster_kernels::ProjectBackwardFn project_backward;
+  raster_kernels::FisherChainFn fisher_chain;
 };
 constexpr KernelSet kKernelSets[] = {
     {"baseline", raster_kernels::base4::compositeTile, raster_kernels::base4::backwardTile,
-     raster_kernels::base4::projectRange, raster_kernels::base4::projectBackwardList},
+     raster_kernels::base4::projectRange, raster_kernels::base4::projectBackwardList,
+     raster_kernels::base4::fisherChainList},
     {"avx2", raster_kernels::avx2::compositeTile, raster_kernels::avx2::backwardTile,
-     raster_kernels::avx2::projectRange, raster_kernels::avx2::projectBackwardList},
+     raster_kernels::avx2::projectRange, raster_kernels::avx2::projectBackwardList,
+     raster_kernels::avx2::fisherChainList},
     // avx512: AVX2's forward; its backward and Fisher walks on 32 registers, bit for bit AVX2's.
     {"avx512", raster_kernels::avx2::compositeTile, raster_kernels::avx512::backwardTile,
-     raster_kernels::avx2::projectRange, raster_kernels::avx2::projectBackwardList},
+     raster_kernels::avx2::projectRange, raster_kernels::avx2::projectBackwardList,
+     raster_kernels::avx2::fisherChainList},
 };
 static_assert(raster_kernels::base4::kProjShC0 == static_cast<float>(kShC0));
 static_assert(raster_kernels::base4::kTile == kTileSize && raster_kernels::base4::kMinA == kMinAlpha &&
@@ -1125,58 +1129,99 @@ void squaredGradientsFloat(const Gaussians& g, const Camera& cam, const RenderOu
   float* const slots = lease.data();
   fisherMoments(st, fwd.width, fwd.height, slots);
   const CameraT<float> camT(cam, float(rs.guard_band));
+  const ProjectIn pin = projectInput(g, camT, rs);
+  const FisherGradOut out{sq.means.data(), sq.log_scales.data(), sq.opacities.data(), sq.sh.data()};
   arena(st).execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& r) {
       const FloatEnvGuard fenv;  // geometry/float_env.h
-      const int K = g.shCoeffs(), active = shCoeffCount(rs.sh_degree);
-      for (std::size_t i = r.begin(); i < r.end(); ++i) {
-        if (st.gauss_start[i] == st.gauss_start[i + 1]) continue;
-        double mo[kFisherSlot] = {};
-        for (std::uint32_t k = st.gauss_start[i]; k < st.gauss_start[i + 1]; ++k)
-          for (int p = 0; p < kFisherSlot; ++p) mo[p] += slots[static_cast<std::size_t>(k) * kFisherSlot + p];
-        const Projected<float>& P = st.proj[i];
-        // One frame for the Jacobian and the SH basis below.
-        const projection::BackwardFrame<float> frame = projection::backwardFrame(g, i, camT, rs);
-        float J[6][6];
-        projection::projectJacobian(g, i, camT, rs, P, frame, J);
-        const double a = P.conic[0], b = P.conic[1], c = P.conic[2], o = P.opacity;
-        // The moments of the monomials (dx, dy, dx^2, dx dy, dy^2) pairwise.
-        const double E[5][5] = {{mo[kE20], mo[kE11], mo[kE30], mo[kE21], mo[kE12]},
-                                {mo[kE11], mo[kE02], mo[kE21], mo[kE12], mo[kE03]},
-                                {mo[kE30], mo[kE21], mo[kE40], mo[kE31], mo[kE22]},
-                                {mo[kE21], mo[kE12], mo[kE31], mo[kE22], mo[kE13]},
-                                {mo[kE12], mo[kE03], mo[kE22], mo[kE13], mo[kE04]}};
-        const double F[5] = {mo[kF10], mo[kF01], mo[kF20], mo[kF11], mo[kF02]};
-        double out[6];
-        for (int p = 0; p < 6; ++p) {
-          const double k[5] = {a * J[0][p] + b * J[1][p], b * J[0][p] + c * J[1][p], -0.5 * J[2][p], -J[3][p],
-                               -0.5 * J[4][p]};
-          double quad = 0, lin = 0;
-          for (int u = 0; u < 5; ++u) {
-            double row = 0;
-            for (int v = 0; v < 5; ++v) row += E[u][v] * k[v];
-            quad += k[u] * row;
-            lin += k[u] * F[u];
-          }
-          const double jc = J[5][p];
-          // A sum of squares: a negative value can only be rounding of the expansion.
-          out[p] = std::max(0.0, o * o * quad + 2.0 * o * jc * lin + jc * jc * mo[kW]);
+      // The Gaussians with pairs, at most kChunk at a time, with their moments summed in
+      // double in slot order, then the kernel set's SIMD chain (bit for bit
+      // fisherChainReference: ProjectKernels.FisherChainEqualsReferenceBitForBit).
+      constexpr std::size_t kChunk = 128;
+      std::uint32_t list[kChunk];
+      double mo[kChunk * kFisherSlot];
+      for (std::size_t b = r.begin(); b < r.end(); b += kChunk) {
+        const std::size_t e = std::min(r.end(), b + kChunk);
+        int listed = 0;
+        for (std::size_t i = b; i < e; ++i) {
+          if (st.gauss_start[i] == st.gauss_start[i + 1]) continue;
+          double* m = &mo[static_cast<std::size_t>(listed) * kFisherSlot];
+          std::fill(m, m + kFisherSlot, 0.0);
+          for (std::uint32_t k = st.gauss_start[i]; k < st.gauss_start[i + 1]; ++k)
+            for (int p = 0; p < kFisherSlot; ++p) m[p] += slots[static_cast<std::size_t>(k) * kFisherSlot + p];
+          list[listed++] = static_cast<std::uint32_t>(i);
         }
-        for (int p = 0; p < 3; ++p) sq.means[3 * i + p] += static_cast<float>(out[p]);
-        for (int p = 0; p < 3; ++p) sq.log_scales[3 * i + p] += static_cast<float>(out[3 + p]);
-        const double dlogit = o * (1.0 - o);
-        sq.opacities[i] += static_cast<float>(dlogit * dlogit * mo[kE00]);
-        // SH: d C / d sh_kc = alpha T Y_k for unclamped channels.
-        for (int k = 0; k < active; ++k)
-          for (int ch = 0; ch < 3; ++ch)
-            if (!P.clamped[ch])
-              sq.sh[(i * K + k) * 3 + ch] += static_cast<float>(mo[kW] * frame.basis[k] * frame.basis[k]);
+        if (listed) kKernelSets[st.isa].fisher_chain(pin, list, listed, st.proj.data(), mo, out);
       }
     });
   });
 }
 
 }  // namespace
+
+void fisherChainReference(const Gaussians& g, const Camera& cam, const RasterSettings& s, std::size_t i,
+                          const Projected<float>& P, const double* mo, Gaussians& sq) {
+  using namespace raster_kernels;
+  RasterStateT<float> st;
+  beginState(st, s, g.max_sh_degree, cam.K.width, cam.K.height);
+  const RasterSettings& rs = st.settings;
+  const CameraT<float> camT(cam, float(rs.guard_band));
+  const FloatEnvGuard fenv;
+  const int K = g.shCoeffs(), active = shCoeffCount(rs.sh_degree);
+  // One frame for the Jacobian and the SH basis below.
+  const projection::BackwardFrame<float> frame = projection::backwardFrame(g, i, camT, rs);
+  float J[6][6];
+  projection::projectJacobian(g, i, camT, rs, P, frame, J);
+  const double a = P.conic[0], b = P.conic[1], c = P.conic[2], o = P.opacity;
+  // The moments of the monomials (dx, dy, dx^2, dx dy, dy^2) pairwise.
+  const double E[5][5] = {{mo[kE20], mo[kE11], mo[kE30], mo[kE21], mo[kE12]},
+                          {mo[kE11], mo[kE02], mo[kE21], mo[kE12], mo[kE03]},
+                          {mo[kE30], mo[kE21], mo[kE40], mo[kE31], mo[kE22]},
+                          {mo[kE21], mo[kE12], mo[kE31], mo[kE22], mo[kE13]},
+                          {mo[kE12], mo[kE03], mo[kE22], mo[kE13], mo[kE04]}};
+  const double F[5] = {mo[kF10], mo[kF01], mo[kF20], mo[kF11], mo[kF02]};
+  double out[6];
+  for (int p = 0; p < 6; ++p) {
+    const double k[5] = {a * J[0][p] + b * J[1][p], b * J[0][p] + c * J[1][p], -0.5 * J[2][p], -J[3][p],
+                         -0.5 * J[4][p]};
+    double quad = 0, lin = 0;
+    for (int u = 0; u < 5; ++u) {
+      double row = 0;
+      for (int v = 0; v < 5; ++v) row += E[u][v] * k[v];
+      quad += k[u] * row;
+      lin += k[u] * F[u];
+    }
+    const double jc = J[5][p];
+    // A sum of squares: a negative value can only be rounding of the expansion.
+    out[p] = std::max(0.0, o * o * quad + 2.0 * o * jc * lin + jc * jc * mo[kW]);
+  }
+  for (int p = 0; p < 3; ++p) sq.means[3 * i + p] += static_cast<float>(out[p]);
+  for (int p = 0; p < 3; ++p) sq.log_scales[3 * i + p] += static_cast<float>(out[3 + p]);
+  const double dlogit = o * (1.0 - o);
+  sq.opacities[i] += static_cast<float>(dlogit * dlogit * mo[kE00]);
+  // SH: d C / d sh_kc = alpha T Y_k for unclamped channels.
+  for (int k = 0; k < active; ++k)
+    for (int ch = 0; ch < 3; ++ch)
+      if (!P.clamped[ch])
+        sq.sh[(i * K + k) * 3 + ch] += static_cast<float>(mo[kW] * frame.basis[k] * frame.basis[k]);
+}
+
+void fisherChainFloat(const Gaussians& g, const Camera& cam, const RasterSettings& s,
+                      const std::vector<std::uint32_t>& idx, const std::vector<Projected<float>>& proj,
+                      const std::vector<double>& moments, Gaussians& sq) {
+  if (moments.size() != idx.size() * raster_kernels::kFisherSlot || proj.size() != g.size() ||
+      sq.size() != g.size() || sq.shCoeffs() != g.shCoeffs())
+    throw std::invalid_argument("fisherChainFloat: sizes disagree");
+  for (const std::uint32_t i : idx)
+    if (i >= g.size()) throw std::invalid_argument("fisherChainFloat: index beyond the model");
+  RasterStateT<float> st;
+  beginState(st, s, g.max_sh_degree, cam.K.width, cam.K.height);
+  const CameraT<float> camT(cam, s.guard_band);
+  const FloatEnvGuard fenv;
+  kKernelSets[st.isa].fisher_chain(projectInput(g, camT, st.settings), idx.data(), static_cast<int>(idx.size()),
+                                   proj.data(), moments.data(),
+                                   {sq.means.data(), sq.log_scales.data(), sq.opacities.data(), sq.sh.data()});
+}
 
 template <typename T>
 void rasterizeSquaredGradientsWalkT(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& s,
