@@ -218,16 +218,59 @@ inline void viewDirectionGrad(const ProjectIn& in, const LaneSet& ls, const Fram
   for (int r = 0; r < 3; ++r) dm[r] = away ? zero + (gd[r] - f.d[r] * dot) / f.dn : zero;
 }
 
+// Rule 1's frustum test alone (the first of project()'s culls, the same operations) for
+// the L Gaussians of ls.
+inline vi inFrustum(const ProjectIn& in, const LaneSet& ls) {
+  const vf m[3] = {ls.at(in.means, 3, 0), ls.at(in.means, 3, 1), ls.at(in.means, 3, 2)};
+  vf p[3];
+  cameraSpace(in, m, p);
+  const vf xz = p[0] / p[2], yz = p[1] / p[2];
+  return (p[2] >= vs(in.near_plane)) & (absLanes(xz - vs(in.gx_mid)) <= vs(in.gx_half)) &
+         (absLanes(yz - vs(in.gy_mid)) <= vs(in.gy_half));
+}
+
+// Rules 1-5 for the Gaussians listed in ls (its first ls.n lanes written to out).
+void projectLanes(const ProjectIn& in, const LaneSet& ls, projection::Projected<float>* out);
+
 }  // namespace
 
+// Two passes per block of up to kProjectBlock Gaussians: the frustum test for all, then
+// the whole projection for those it keeps, gathered eight at a time (most of a room's
+// Gaussians are outside a view's frustum, and a lane computes its Gaussian's every value
+// whether or not an earlier cull rejects it). The others are written visible = false, as
+// project() leaves them.
 void projectRange(const ProjectIn& in, std::size_t begin, std::size_t end, projection::Projected<float>* out) {
+  constexpr std::size_t kProjectBlock = 256;
+  std::uint32_t kept[kProjectBlock];
+  for (std::size_t b = begin; b < end; b += kProjectBlock) {
+    const std::size_t e = end - b < kProjectBlock ? end : b + kProjectBlock;
+    int nk = 0;
+    for (std::size_t i0 = b; i0 < e; i0 += L) {
+      LaneSet ls;
+      ls.n = e - i0 < static_cast<std::size_t>(L) ? static_cast<int>(e - i0) : L;
+      for (int l = 0; l < L; ++l) ls.ix[l] = i0 + static_cast<std::size_t>(l < ls.n ? l : ls.n - 1);
+      const vi keep = inFrustum(in, ls);
+      for (int l = 0; l < ls.n; ++l) {
+        out[ls.ix[l]].visible = false;
+        if (keep[l]) kept[nk++] = static_cast<std::uint32_t>(ls.ix[l] - b);
+      }
+    }
+    for (int j0 = 0; j0 < nk; j0 += L) {
+      LaneSet ls;
+      ls.n = nk - j0 < L ? nk - j0 : L;
+      for (int l = 0; l < L; ++l) ls.ix[l] = b + kept[j0 + (l < ls.n ? l : ls.n - 1)];
+      projectLanes(in, ls, out);
+    }
+  }
+}
+
+namespace {
+
+void projectLanes(const ProjectIn& in, const LaneSet& ls, projection::Projected<float>* out) {
   const std::size_t stride = static_cast<std::size_t>(in.sh_stride);
   const int active = (in.sh_degree + 1) * (in.sh_degree + 1);
   const vf one = vs(1.0f), zero = vs(0.0f), two = vs(2.0f);
-  for (std::size_t i0 = begin; i0 < end; i0 += L) {
-    LaneSet ls;
-    ls.n = end - i0 < static_cast<std::size_t>(L) ? static_cast<int>(end - i0) : L;
-    for (int l = 0; l < L; ++l) ls.ix[l] = i0 + static_cast<std::size_t>(l < ls.n ? l : ls.n - 1);
+  {
     const int n = ls.n;
     const vf m[3] = {ls.at(in.means, 3, 0), ls.at(in.means, 3, 1), ls.at(in.means, 3, 2)};
     vf p[3];
@@ -275,7 +318,7 @@ void projectRange(const ProjectIn& in, std::size_t begin, std::size_t end, proje
     }
 
     for (int l = 0; l < n; ++l) {
-      projection::Projected<float>& P = out[i0 + static_cast<std::size_t>(l)];
+      projection::Projected<float>& P = out[ls.ix[l]];
       P.visible = vis[l] != 0;
       P.mean2d[0] = mx[l];
       P.mean2d[1] = my[l];
@@ -298,6 +341,7 @@ void projectRange(const ProjectIn& in, std::size_t begin, std::size_t end, proje
   }
 }
 
+}  // namespace
 
 // projectBackward<float> (projection.h: backwardFrame, then colorBackward, conicBackward,
 // mean2dBackward, cameraToMean, scaleBackward and the rotation) for L Gaussians at a time,
