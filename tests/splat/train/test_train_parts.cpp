@@ -357,15 +357,20 @@ TEST(TrainResidual, SameGeneratorStateSameSubset) {
 
 // selectResidualSubset against a plain restatement of its definition (the partial
 // Fisher-Yates draw; the rankings as a full sort by (key, index)), on keys with many ties
-// and a NaN, so a faster selection cannot change which Gaussians train.
+// and a NaN, negative and positive keys, both zeros and infinities, so a faster selection
+// cannot change which Gaussians train.
 TEST(TrainResidual, SubsetEqualsItsDefinition) {
   const std::size_t n = 2000;
   Gaussians g = rankedModel(static_cast<int>(n));
   for (std::size_t i = 0; i < n; ++i) {
-    g.opacities[i] = static_cast<float>(i % 17);  // ties
-    for (int k = 0; k < 3; ++k) g.log_scales[3 * i + k] = static_cast<float>((i * (k + 3)) % 23);
+    g.opacities[i] = static_cast<float>(i % 17) - 8.0f;  // ties, both signs
+    for (int k = 0; k < 3; ++k) g.log_scales[3 * i + k] = static_cast<float>((i * (k + 3)) % 23) - 11.0f;
   }
   g.opacities[77] = NAN;
+  for (std::size_t i = 5; i < n; i += 97) g.opacities[i] = (i / 97) % 2 ? -0.0f : 0.0f;  // ties of -0 and +0
+  g.opacities[300] = -INFINITY;
+  g.opacities[301] = INFINITY;
+  g.log_scales[3 * 400 + 1] = INFINITY;
   ResidualOptions o;
   std::mt19937_64 rng(5), ref_rng(5);
   const ResidualSubset s = selectResidualSubset(g, o, rng);
