@@ -118,10 +118,23 @@ void pixelSpan(T mean, T half, int n, std::int32_t& lo, std::int32_t& hi) {
 // Beyond (needle-like Gaussians) or for anything not finite, no chord: the loops then
 // cover the whole rectangle, as they would without these terms.
 template <typename T>
-TileGaussian<T> tileData(const Projected<T>& P, int W, int H) {
-  TileGaussian<T> q{P.mean2d[0], P.mean2d[1], P.conic[0], P.conic[1], P.conic[2], P.opacity, P.half[0],
-                    P.half[1], P.depth, {P.color[0], P.color[1], P.color[2]}, T(0),
-                    std::numeric_limits<T>::max(), T(0)};
+void tileData(const Projected<T>& P, int W, int H, TileGaussian<T>& q) {
+  // Written field by field in place: built on the stack and copied, its 16-byte loads
+  // waited on the narrower stores before them (a failed store forwarding: 40% of
+  // projectAll's cycles in bench step).
+  q.mx = P.mean2d[0];
+  q.my = P.mean2d[1];
+  q.a = P.conic[0];
+  q.b = P.conic[1];
+  q.c = P.conic[2];
+  q.o = P.opacity;
+  q.hx = P.half[0];
+  q.hy = P.half[1];
+  q.depth = P.depth;
+  for (int k = 0; k < 3; ++k) q.col[k] = P.color[k];
+  q.chord_slope = T(0);
+  q.chord_k0 = std::numeric_limits<T>::max();
+  q.chord_k1 = T(0);
   pixelSpan(P.mean2d[0], P.half[0], W, q.px0, q.px1);
   pixelSpan(P.mean2d[1], P.half[1], H, q.py0, q.py1);
   const double a = P.conic[0], b = P.conic[1], c = P.conic[2], o = P.opacity;
@@ -132,7 +145,6 @@ TileGaussian<T> tileData(const Projected<T>& P, int W, int H) {
     q.chord_k0 = static_cast<T>(k2 / a);
     q.chord_k1 = static_cast<T>(det / (a * a));
   }
-  return q;
 }
 
 // Whether a Gaussian's alpha ellipse can reach a pixel centre of the tile [x0, x1) x
@@ -469,7 +481,7 @@ void projectAll(const GaussiansT<T>& g, const CameraT<T>& camT, std::span<const 
         if constexpr (!std::is_same_v<T, float>) st.proj[i] = projection::project(g, i, camT, rs);
         Projected<T>& P = st.proj[i];
         if (!P.visible) continue;
-        st.tile_data[i] = tileData(P, W, H);
+        tileData(P, W, H, st.tile_data[i]);
         out.visible[i] = 1;
         out.radii[i] = P.radius;
         int px0, px1, py0, py1;
