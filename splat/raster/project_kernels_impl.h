@@ -53,6 +53,18 @@ struct LaneSet {
   }
 };
 
+// Lanes j0 .. j0 + L - 1 of a list idx[0, count) (a short last vector repeats its last
+// entry): the Gaussians in ls, their list positions in jx.
+inline LaneSet listLanes(const std::uint32_t* idx, int count, int j0, int jx[L]) {
+  LaneSet ls;
+  ls.n = count - j0 < L ? count - j0 : L;
+  for (int l = 0; l < L; ++l) {
+    jx[l] = j0 + (l < ls.n ? l : ls.n - 1);
+    ls.ix[l] = idx[jx[l]];
+  }
+  return ls;
+}
+
 // p = R m + t, as project() and backwardFrame() compute it.
 inline void cameraSpace(const ProjectIn& in, const vf m[3], vf p[3]) {
   for (int r = 0; r < 3; ++r)
@@ -355,13 +367,8 @@ void projectBackwardList(const ProjectIn& in, const std::uint32_t* idx, int coun
   const int degree = in.sh_degree, active = (degree + 1) * (degree + 1);
   const vf one = vs(1.0f), zero = vs(0.0f), two = vs(2.0f);
   for (int j0 = 0; j0 < count; j0 += L) {
-    LaneSet ls;
-    ls.n = count - j0 < L ? count - j0 : L;
     int jx[L];
-    for (int l = 0; l < L; ++l) {
-      jx[l] = j0 + (l < ls.n ? l : ls.n - 1);
-      ls.ix[l] = idx[jx[l]];
-    }
+    const LaneSet ls = listLanes(idx, count, j0, jx);
     const int n = ls.n;
     vf Pa{}, Pb{}, Pc{}, Po{}, dPo{}, dmx{}, dmy{}, dca{}, dcb{}, dcc{}, dcol[3] = {};
     vi clamped[3] = {};
@@ -498,13 +505,8 @@ void fisherChainList(const ProjectIn& in, const std::uint32_t* idx, int count, c
   auto dv = [](vf v) { return __builtin_convertvector(v, vd); };
   auto ds = [](double x) { return x - vd{}; };
   for (int j0 = 0; j0 < count; j0 += L) {
-    LaneSet ls;
-    ls.n = count - j0 < L ? count - j0 : L;
     int jx[L];
-    for (int l = 0; l < L; ++l) {
-      jx[l] = j0 + (l < ls.n ? l : ls.n - 1);
-      ls.ix[l] = idx[jx[l]];
-    }
+    const LaneSet ls = listLanes(idx, count, j0, jx);
     const int n = ls.n;
     vf Pa{}, Pb{}, Pc{}, Po{};
     vi clamped[3] = {};

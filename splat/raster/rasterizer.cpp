@@ -644,14 +644,23 @@ void projectRangeFloat(const GaussiansT<float>& g, const Camera& cam, const Rast
   projectRangeWith(g, camT, st.settings, st.isa, begin, end, out.data());
 }
 
+namespace {
+// The tests' entries to the per-Gaussian kernels: one gradient entry per listed Gaussian,
+// arrays of the model's sizes, indices inside it.
+void checkChainInputs(const Gaussians& g, const std::vector<std::uint32_t>& idx, std::size_t per_listed,
+                      const std::vector<Projected<float>>& proj, const Gaussians& out, const char* who) {
+  if (idx.size() != per_listed || proj.size() != g.size() || out.size() != g.size() ||
+      out.shCoeffs() != g.shCoeffs())
+    throw std::invalid_argument(std::string(who) + ": sizes disagree");
+  for (const std::uint32_t i : idx)
+    if (i >= g.size()) throw std::invalid_argument(std::string(who) + ": index beyond the model");
+}
+}  // namespace
+
 void projectBackwardFloat(const GaussiansT<float>& g, const Camera& cam, const RasterSettings& s,
                           const std::vector<std::uint32_t>& idx, const std::vector<Projected<float>>& proj,
                           const std::vector<ProjectedGrad<float>>& dP, GaussiansT<float>& grad) {
-  if (idx.size() != dP.size() || proj.size() != g.size() || grad.size() != g.size() ||
-      grad.shCoeffs() != g.shCoeffs())
-    throw std::invalid_argument("projectBackwardFloat: sizes disagree");
-  for (const std::uint32_t i : idx)
-    if (i >= g.size()) throw std::invalid_argument("projectBackwardFloat: index beyond the model");
+  checkChainInputs(g, idx, dP.size(), proj, grad, "projectBackwardFloat");
   RasterStateT<float> st;
   beginState(st, s, g.max_sh_degree, cam.K.width, cam.K.height);
   const CameraT<float> camT(cam, s.guard_band);
@@ -1232,11 +1241,8 @@ void fisherChainReference(const Gaussians& g, const Camera& cam, const RasterSet
 void fisherChainFloat(const Gaussians& g, const Camera& cam, const RasterSettings& s,
                       const std::vector<std::uint32_t>& idx, const std::vector<Projected<float>>& proj,
                       const std::vector<double>& moments, Gaussians& sq) {
-  if (moments.size() != idx.size() * raster_kernels::kFisherSlot || proj.size() != g.size() ||
-      sq.size() != g.size() || sq.shCoeffs() != g.shCoeffs())
-    throw std::invalid_argument("fisherChainFloat: sizes disagree");
-  for (const std::uint32_t i : idx)
-    if (i >= g.size()) throw std::invalid_argument("fisherChainFloat: index beyond the model");
+  checkChainInputs(g, idx, moments.size() / raster_kernels::kFisherSlot, proj, sq, "fisherChainFloat");
+  if (moments.size() % raster_kernels::kFisherSlot) throw std::invalid_argument("fisherChainFloat: sizes disagree");
   RasterStateT<float> st;
   beginState(st, s, g.max_sh_degree, cam.K.width, cam.K.height);
   const CameraT<float> camT(cam, s.guard_band);

@@ -83,6 +83,32 @@ void expectSame(const projection::Projected<float>& a, const projection::Project
   same(a.radius, b.radius, "radius");
 }
 
+// Every array of `got` equal to `want`'s bit for bit (fatal at the first difference).
+void expectArraysBitEqual(const Gaussians& got, const Gaussians& want) {
+  std::vector<const std::vector<float>*> w;
+  want.forEachArray([&](const std::vector<float>& a, std::size_t) { w.push_back(&a); });
+  std::size_t array = 0;
+  got.forEachArray([&](const std::vector<float>& a, std::size_t) {
+    const std::vector<float>& b = *w[array++];
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t k = 0; k < a.size(); ++k)
+      ASSERT_EQ(bits(a[k]), bits(b[k])) << "array " << array - 1 << " entry " << k << ": " << a[k] << " vs " << b[k];
+  });
+}
+
+// How many values of `after` differ from `before`'s.
+int countChanged(const Gaussians& before, const Gaussians& after) {
+  std::vector<const std::vector<float>*> b;
+  before.forEachArray([&](const std::vector<float>& a, std::size_t) { b.push_back(&a); });
+  std::size_t array = 0;
+  int changed = 0;
+  after.forEachArray([&](const std::vector<float>& a, std::size_t) {
+    for (std::size_t k = 0; k < a.size(); ++k) changed += a[k] != (*b[array])[k];
+    ++array;
+  });
+  return changed;
+}
+
 struct ProjectCase {
   const char* name;
   Camera cam;
@@ -216,30 +242,26 @@ TEST(ProjectKernels, BackwardEqualsProjectBackwardBitForBit) {
         s.execution.kernels = kernels;
         Gaussians got = start;
         projectBackwardFloat(g, pc.cam, s, idx, proj, dP, got);
-        std::vector<const std::vector<float>*> want;
-        ref.forEachArray([&](const std::vector<float>& a, std::size_t) { want.push_back(&a); });
-        std::size_t array = 0;
-        got.forEachArray([&](const std::vector<float>& a, std::size_t) {
-          const std::vector<float>& b = *want[array++];
-          ASSERT_EQ(a.size(), b.size());
-          for (std::size_t k = 0; k < a.size(); ++k) {
-            ASSERT_EQ(bits(a[k]), bits(b[k])) << "array " << array - 1 << " entry " << k << ": " << a[k] << " vs " << b[k];
-          }
-        });
+        expectArraysBitEqual(got, ref);
         if (::testing::Test::HasFatalFailure()) return;
         chained += static_cast<int>(idx.size());
       }
-      std::size_t array = 0;
-      std::vector<const std::vector<float>*> st;
-      start.forEachArray([&](const std::vector<float>& a, std::size_t) { st.push_back(&a); });
-      ref.forEachArray([&](const std::vector<float>& a, std::size_t) {
-        for (std::size_t k = 0; k < a.size(); ++k) nonzero += a[k] != (*st[array])[k];
-        ++array;
-      });
+      nonzero += countChanged(start, ref);
     }
   }
   EXPECT_GT(chained, 3000);    // the comparison saw many Gaussians
   EXPECT_GT(nonzero, 100000);  // and real gradients
+  // Mismatched lists and indices beyond the model are refused, not read.
+  const Camera cam = test::smallCamera(64, 48);
+  const Gaussians g = wideScene(20, 1, 3, Eigen::Vector3d::Zero(), 0.6);
+  Gaussians grad = g.zerosLike();
+  const std::vector<projection::Projected<float>> proj(g.size());
+  RasterSettings s;
+  EXPECT_THROW(projectBackwardFloat(g, cam, s, {1, 2}, proj, {{}}, grad), std::invalid_argument);
+  EXPECT_THROW(projectBackwardFloat(g, cam, s, {20}, proj, {{}}, grad), std::invalid_argument);
+  EXPECT_THROW(fisherChainFloat(g, cam, s, {1}, proj, std::vector<double>(5), grad), std::invalid_argument);
+  EXPECT_THROW(fisherChainFloat(g, cam, s, {25}, proj, std::vector<double>(raster_kernels::kFisherSlot), grad),
+               std::invalid_argument);
 }
 
 // The Fisher pass's per-Gaussian stage by the SIMD kernels equals the scalar reference bit
@@ -294,25 +316,11 @@ TEST(ProjectKernels, FisherChainEqualsReferenceBitForBit) {
         s.execution.kernels = kernels;
         Gaussians got = start;
         fisherChainFloat(g, pc.cam, s, sidx, proj, smo, got);
-        std::vector<const std::vector<float>*> want;
-        ref.forEachArray([&](const std::vector<float>& a, std::size_t) { want.push_back(&a); });
-        std::size_t array = 0;
-        got.forEachArray([&](const std::vector<float>& a, std::size_t) {
-          const std::vector<float>& b = *want[array++];
-          ASSERT_EQ(a.size(), b.size());
-          for (std::size_t k = 0; k < a.size(); ++k)
-            ASSERT_EQ(bits(a[k]), bits(b[k])) << "array " << array - 1 << " entry " << k << ": " << a[k] << " vs " << b[k];
-        });
+        expectArraysBitEqual(got, ref);
         if (::testing::Test::HasFatalFailure()) return;
         chained += static_cast<int>(sidx.size());
       }
-      std::size_t array = 0;
-      std::vector<const std::vector<float>*> st;
-      start.forEachArray([&](const std::vector<float>& a, std::size_t) { st.push_back(&a); });
-      ref.forEachArray([&](const std::vector<float>& a, std::size_t) {
-        for (std::size_t k = 0; k < a.size(); ++k) changed += a[k] != (*st[array])[k];
-        ++array;
-      });
+      changed += countChanged(start, ref);
     }
   }
   EXPECT_GT(chained, 2000);
