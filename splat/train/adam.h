@@ -31,5 +31,8 @@ struct AdamState {
 // One Adam step of `params` along `grad` (same shape). Deterministic and parallel
 // (element-wise, no reductions).
 void adamStep(Gaussians& params, const Gaussians& grad, AdamState& state, const LearningRates& lr);
+// The same step, leaving `grad` zero: each value is cleared as the step reads it, so a
+// training loop needs no separate pass over the gradient before its next backward.
+void adamStepClearingGradient(Gaussians& params, Gaussians& grad, AdamState& state, const LearningRates& lr);
 
 }  // namespace saresgs

@@ -286,8 +286,12 @@ double Trainer::step(int view) {
   if (adam_.m.size() != g_.size()) adam_.resetFor(g_);
   if (stats_.count.size() != g_.size()) stats_.resize(g_.size());
   const RasterSettings s = rasterSettings();
+  // The gradient is zero here: the last step's Adam cleared it as it read it
+  // (adamStepClearingGradient), unless that step stopped before Adam or the model changed.
   if (grad_.size() != g_.size() || grad_.max_sh_degree != g_.max_sh_degree) grad_ = g_.zerosLike();
-  else grad_.forEachArray([](std::vector<float>& a, std::size_t) { std::fill(a.begin(), a.end(), 0.0f); });
+  else if (!grad_cleared_)
+    grad_.forEachArray([](std::vector<float>& a, std::size_t) { std::fill(a.begin(), a.end(), 0.0f); });
+  grad_cleared_ = false;
   grad2d_.assign(2 * g_.size(), 0.0f);
 
   const ViewLoss vl =
@@ -306,7 +310,8 @@ double Trainer::step(int view) {
   LearningRates lr = opt_.lr;
   const double ext = std::max(scene_.extent, 1e-12);
   lr.means = meansLearningRate(opt_, iteration_, ext);
-  adamStep(g_, grad_, adam_, lr);
+  adamStepClearingGradient(g_, grad_, adam_, lr);
+  grad_cleared_ = true;
   seconds_.optimizer += since(t0);
 
   t0 = Clock::now();

@@ -182,6 +182,7 @@ class Trainer {
   TrainerOptions opt_;
   int sh_clock_start_ = 0;
   Gaussians initial_, g_, grad_;
+  bool grad_cleared_ = false;  // grad_ is all zeros (the last step's Adam cleared it)
   std::vector<float> grad2d_;
   AdamState adam_;
   DensifyStats stats_;

@@ -161,6 +161,47 @@ TEST(TrainAdam, EveryValueIsTheFloatFormulaBitForBit) {
   for (std::size_t k = 0; k < p.sh.size(); ++k) EXPECT_NE(p.sh[k], initial.sh[k]) << k;  // every value moved
 }
 
+// adamStepClearingGradient is adamStep (the same parameters and moments, bit for bit) that
+// leaves the gradient zero, at every SH degree's row length.
+TEST(TrainAdam, ClearingStepEqualsTheStepAndZeroesTheGradient) {
+  for (int degree = 0; degree <= 3; ++degree) {
+    std::mt19937_64 rng(20 + degree);
+    std::normal_distribution<float> nd(0, 1);
+    Gaussians p;
+    p.max_sh_degree = degree;
+    p.resize(2100);  // more than one block of the parallel loop
+    p.forEachArray([&](std::vector<float>& a, std::size_t) { for (float& x : a) x = nd(rng); });
+    Gaussians q = p;
+    AdamState a, b;
+    a.resetFor(p);
+    b.resetFor(p);
+    for (int t = 0; t < 2; ++t) {
+      Gaussians g = p.zerosLike();
+      g.forEachArray([&](std::vector<float>& x, std::size_t) { for (float& v : x) v = nd(rng); });
+      Gaussians h = g;
+      adamStep(p, g, a, LearningRates{});
+      adamStepClearingGradient(q, h, b, LearningRates{});
+      h.forEachArray([&](const std::vector<float>& x, std::size_t) {
+        for (const float v : x) ASSERT_EQ(std::bit_cast<std::uint32_t>(v), 0u);
+      });
+    }
+    auto same = [](const Gaussians& x, const Gaussians& y) {
+      std::vector<const std::vector<float>*> w;
+      y.forEachArray([&](const std::vector<float>& a, std::size_t) { w.push_back(&a); });
+      std::size_t array = 0;
+      bool eq = true;
+      x.forEachArray([&](const std::vector<float>& a, std::size_t) {
+        const std::vector<float>& b = *w[array++];
+        for (std::size_t k = 0; k < a.size(); ++k) eq = eq && std::bit_cast<std::uint32_t>(a[k]) == std::bit_cast<std::uint32_t>(b[k]);
+      });
+      return eq;
+    };
+    EXPECT_TRUE(same(p, q)) << "degree " << degree;
+    EXPECT_TRUE(same(a.m, b.m)) << "degree " << degree;
+    EXPECT_TRUE(same(a.v, b.v)) << "degree " << degree;
+  }
+}
+
 // Four Gaussians: 0 small with a large gradient (clone), 1 large with a large gradient
 // (split), 2 small gradient (kept), 3 nearly transparent (pruned).
 struct DensifyCase {
