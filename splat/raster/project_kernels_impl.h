@@ -370,8 +370,10 @@ void projectBackwardList(const ProjectIn& in, const std::uint32_t* idx, int coun
     int jx[L];
     const LaneSet ls = listLanes(idx, count, j0, jx);
     const int n = ls.n;
-    vf Pa{}, Pb{}, Pc{}, Po{}, dPo{}, dmx{}, dmy{}, dca{}, dcb{}, dcc{}, dcol[3] = {};
-    vi clamped[3] = {};
+    vf Pa{}, Pb{}, Pc{}, Po{}, dPo{}, dmx{}, dmy{}, dca{}, dcb{}, dcc{}, dcol[3];
+    vi clamped[3];
+    float dcol_l[3][L];
+    std::int32_t clamped_l[3][L];
     for (int l = 0; l < L; ++l) {
       const projection::Projected<float>& P = proj[ls.ix[l]];
       const projection::ProjectedGrad<float>& g = dP[jx[l]];
@@ -380,8 +382,8 @@ void projectBackwardList(const ProjectIn& in, const std::uint32_t* idx, int coun
       Pc[l] = P.conic[2];
       Po[l] = P.opacity;
       for (int c = 0; c < 3; ++c) {
-        clamped[c][l] = P.clamped[c] ? -1 : 0;
-        dcol[c][l] = g.color[c];
+        clamped_l[c][l] = P.clamped[c] ? -1 : 0;
+        dcol_l[c][l] = g.color[c];
       }
       dPo[l] = g.opacity;
       dmx[l] = g.mean2d[0];
@@ -389,6 +391,10 @@ void projectBackwardList(const ProjectIn& in, const std::uint32_t* idx, int coun
       dca[l] = g.conic[0];
       dcb[l] = g.conic[1];
       dcc[l] = g.conic[2];
+    }
+    for (int c = 0; c < 3; ++c) {
+      std::memcpy(&dcol[c], dcol_l[c], sizeof(vf));
+      std::memcpy(&clamped[c], clamped_l[c], sizeof(vi));
     }
 
     const FrameLanes f = frameLanes(in, ls);
@@ -502,8 +508,8 @@ void fisherChainList(const ProjectIn& in, const std::uint32_t* idx, int count, c
   const std::size_t stride = static_cast<std::size_t>(in.sh_stride);
   const int active = (in.sh_degree + 1) * (in.sh_degree + 1);
   const vf zero = vs(0.0f), one = vs(1.0f);
-  auto dv = [](vf v) { return __builtin_convertvector(v, vd); };
-  auto ds = [](double x) { return x - vd{}; };
+  // (Conversions and broadcasts written in place: a lambda returning vd, wider than the
+  // target's vectors, draws GCC's ABI note.)
   for (int j0 = 0; j0 < count; j0 += L) {
     int jx[L];
     const LaneSet ls = listLanes(idx, count, j0, jx);
@@ -579,7 +585,7 @@ void fisherChainList(const ProjectIn& in, const std::uint32_t* idx, int count, c
     vd mo[kFisherSlot];
     for (int m = 0; m < kFisherSlot; ++m)
       for (int l = 0; l < L; ++l) mo[m][l] = moments[static_cast<std::size_t>(jx[l]) * kFisherSlot + m];
-    const vd a = dv(Pa), b = dv(Pb), c = dv(Pc), o = dv(Po);
+    const vd a = __builtin_convertvector(Pa, vd), b = __builtin_convertvector(Pb, vd), c = __builtin_convertvector(Pc, vd), o = __builtin_convertvector(Po, vd);
     const vd E[5][5] = {{mo[kE20], mo[kE11], mo[kE30], mo[kE21], mo[kE12]},
                         {mo[kE11], mo[kE02], mo[kE21], mo[kE12], mo[kE03]},
                         {mo[kE30], mo[kE21], mo[kE40], mo[kE31], mo[kE22]},
@@ -588,25 +594,25 @@ void fisherChainList(const ProjectIn& in, const std::uint32_t* idx, int count, c
     const vd F[5] = {mo[kF10], mo[kF01], mo[kF20], mo[kF11], mo[kF02]};
     vd res[6];
     for (int p = 0; p < 6; ++p) {
-      const vd J0 = dv(J[0][p]), J1 = dv(J[1][p]);
-      const vd k[5] = {a * J0 + b * J1, b * J0 + c * J1, ds(-0.5) * dv(J[2][p]), -dv(J[3][p]),
-                       ds(-0.5) * dv(J[4][p])};
-      vd quad = ds(0.0), lin = ds(0.0);
+      const vd J0 = __builtin_convertvector(J[0][p], vd), J1 = __builtin_convertvector(J[1][p], vd);
+      const vd k[5] = {a * J0 + b * J1, b * J0 + c * J1, (-0.5 - vd{}) * __builtin_convertvector(J[2][p], vd), -__builtin_convertvector(J[3][p], vd),
+                       (-0.5 - vd{}) * __builtin_convertvector(J[4][p], vd)};
+      vd quad = (0.0 - vd{}), lin = (0.0 - vd{});
       for (int u = 0; u < 5; ++u) {
-        vd row = ds(0.0);
+        vd row = (0.0 - vd{});
         for (int v = 0; v < 5; ++v) row = row + E[u][v] * k[v];
         quad = quad + k[u] * row;
         lin = lin + k[u] * F[u];
       }
-      const vd jc = dv(J[5][p]);
-      const vd val = o * o * quad + ds(2.0) * o * jc * lin + jc * jc * mo[kW];
-      res[p] = ds(0.0) < val ? val : ds(0.0);  // std::max(0.0, val)
+      const vd jc = __builtin_convertvector(J[5][p], vd);
+      const vd val = o * o * quad + (2.0 - vd{}) * o * jc * lin + jc * jc * mo[kW];
+      res[p] = (0.0 - vd{}) < val ? val : (0.0 - vd{});  // std::max(0.0, val)
     }
-    const vd dlogit = o * (ds(1.0) - o);
+    const vd dlogit = o * ((1.0 - vd{}) - o);
     const vd g_opacity = dlogit * dlogit * mo[kE00];
     vd g_sh[16];
     for (int k = 0; k < active; ++k) {
-      const vd y = dv(f.basis[k]);
+      const vd y = __builtin_convertvector(f.basis[k], vd);
       g_sh[k] = mo[kW] * y * y;
     }
     for (int l = 0; l < n; ++l) {
