@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <iterator>
 #include <random>
 #include <set>
 
@@ -448,9 +449,62 @@ TEST(TrainResidual, SameGeneratorStateSameSubset) {
   EXPECT_NE(selectResidualSubset(g, o, a).random, selectResidualSubset(g, o, a).random);
 }
 
-// selectResidualSubset against a plain restatement of its definition (the partial
-// Fisher-Yates draw; the rankings as a full sort by (key, index)), on keys with many ties
-// and a NaN, negative and positive keys, both zeros and infinities, so a faster selection
+// selectResidualSubset's definition restated plainly: the partial Fisher-Yates draw, and
+// the rankings as a full stable sort by key (ties by index).
+ResidualSubset referenceSubset(const Gaussians& g, const ResidualOptions& o, std::uint64_t seed) {
+  const std::size_t n = g.size();
+  std::mt19937_64 rng(seed);
+  auto countOf = [&](double f) {
+    return std::min(n, static_cast<std::size_t>(std::llround(std::clamp(f, 0.0, 1.0) * static_cast<double>(n))));
+  };
+  ResidualSubset r;
+  std::vector<int> idx(n);
+  std::iota(idx.begin(), idx.end(), 0);
+  const std::size_t k = countOf(o.alpha);
+  for (std::size_t i = 0; i < k; ++i) {
+    std::uniform_int_distribution<std::size_t> pick(i, n - 1);
+    std::swap(idx[i], idx[pick(rng)]);
+  }
+  r.random.assign(idx.begin(), idx.begin() + static_cast<std::ptrdiff_t>(k));
+  std::sort(r.random.begin(), r.random.end());
+  auto top = [&](double fraction, auto key) {
+    std::vector<int> all(n);
+    std::iota(all.begin(), all.end(), 0);
+    std::stable_sort(all.begin(), all.end(), [&](int a, int b) { return key(a) < key(b); });
+    std::vector<int> t(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(countOf(fraction)));
+    std::sort(t.begin(), t.end());
+    return t;
+  };
+  auto opacity = [&](int i) { return std::isnan(g.opacities[i]) ? -INFINITY : g.opacities[i]; };
+  auto scale = [&](int i) {
+    const float s = std::max({g.log_scales[3 * i], g.log_scales[3 * i + 1], g.log_scales[3 * i + 2]});
+    return std::isnan(s) ? -INFINITY : -s;
+  };
+  if (o.ranking == UncertaintyRanking::kBoth) {
+    const auto a = top(o.beta, opacity), b = top(o.beta, scale);
+    std::set_union(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(r.uncertain));
+  } else if (o.ranking == UncertaintyRanking::kOpacity) {
+    r.uncertain = top(2 * o.beta, opacity);
+  } else if (o.ranking == UncertaintyRanking::kScale) {
+    r.uncertain = top(2 * o.beta, scale);
+  }
+  r.mask.assign(n, 0);
+  for (int i : r.random) r.mask[i] = 1;
+  for (int i : r.uncertain) r.mask[i] = 1;
+  return r;
+}
+
+void expectSubsetIsItsDefinition(const Gaussians& g, const ResidualOptions& o, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  const ResidualSubset s = selectResidualSubset(g, o, rng);
+  const ResidualSubset r = referenceSubset(g, o, seed);
+  EXPECT_EQ(s.random, r.random);
+  EXPECT_EQ(s.uncertain, r.uncertain);
+  EXPECT_EQ(s.mask, r.mask);
+}
+
+// selectResidualSubset against the plain restatement above, on keys with many ties and a
+// NaN, negative and positive keys, both zeros and infinities, so a faster selection
 // cannot change which Gaussians train.
 TEST(TrainResidual, SubsetEqualsItsDefinition) {
   const std::size_t n = 2000;
@@ -465,34 +519,48 @@ TEST(TrainResidual, SubsetEqualsItsDefinition) {
   g.opacities[301] = INFINITY;
   g.log_scales[3 * 400 + 1] = INFINITY;
   ResidualOptions o;
-  std::mt19937_64 rng(5), ref_rng(5);
-  const ResidualSubset s = selectResidualSubset(g, o, rng);
-
-  std::vector<int> idx(n);
-  std::iota(idx.begin(), idx.end(), 0);
-  const std::size_t k = 1800;
-  for (std::size_t i = 0; i < k; ++i) {
-    std::uniform_int_distribution<std::size_t> pick(i, n - 1);
-    std::swap(idx[i], idx[pick(ref_rng)]);
+  expectSubsetIsItsDefinition(g, o, 5);
+  for (const UncertaintyRanking r : {UncertaintyRanking::kOpacity, UncertaintyRanking::kScale}) {
+    o.ranking = r;
+    expectSubsetIsItsDefinition(g, o, 6);
   }
-  std::vector<int> random(idx.begin(), idx.begin() + k);
-  std::sort(random.begin(), random.end());
-  EXPECT_EQ(s.random, random);
-  auto top = [&](auto key) {
-    std::vector<int> all(n);
-    std::iota(all.begin(), all.end(), 0);
-    std::stable_sort(all.begin(), all.end(), [&](int a, int b) { return key(a) < key(b); });
-    std::vector<int> t(all.begin(), all.begin() + 200);
-    std::sort(t.begin(), t.end());
-    return t;
-  };
-  const auto a = top([&](int i) { return std::isnan(g.opacities[i]) ? -INFINITY : g.opacities[i]; });
-  const auto b = top([&](int i) {
-    return -std::max({g.log_scales[3 * i], g.log_scales[3 * i + 1], g.log_scales[3 * i + 2]});
-  });
-  std::vector<int> uncertain;
-  std::set_union(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(uncertain));
-  EXPECT_EQ(s.uncertain, uncertain);
+}
+
+// The ranking selects by radix digits of the keys (splat/train/residual.cpp): models past
+// 2^16 Gaussians (index digits above the lowest ones), keys all equal (the initial model's
+// opacities: every digit of the key is shared, only the index tells them apart), keys in
+// one narrow band, and fractions that select none, half and all.
+TEST(TrainResidual, SubsetEqualsItsDefinitionAtScaleAndOnEqualKeys) {
+  std::mt19937 gen(3);
+  std::normal_distribution<float> normal(0.0f, 1.0f);
+  Gaussians big = rankedModel(70000);
+  for (std::size_t i = 0; i < big.size(); ++i) {
+    big.opacities[i] = 3.0f * normal(gen);
+    for (int k = 0; k < 3; ++k) big.log_scales[3 * i + k] = -4.0f + 1.5f * normal(gen);
+  }
+  ResidualOptions o;
+  expectSubsetIsItsDefinition(big, o, 7);
+
+  Gaussians same = rankedModel(5000);
+  for (std::size_t i = 0; i < same.size(); ++i) {
+    same.opacities[i] = -2.1972246f;  // logit 0.1
+    for (int k = 0; k < 3; ++k) same.log_scales[3 * i + k] = -3.0f;
+  }
+  expectSubsetIsItsDefinition(same, o, 8);
+
+  Gaussians band = rankedModel(9000);
+  for (std::size_t i = 0; i < band.size(); ++i) {
+    band.opacities[i] = 1.0f + 1e-6f * static_cast<float>((i * 7919) % 13);  // a few ulps apart
+    for (int k = 0; k < 3; ++k) band.log_scales[3 * i + k] = std::nextafter(-1.0f, 0.0f) * ((i + k) % 2 ? 1.0f : -1.0f);
+  }
+  for (const double beta : {0.0, 0.25, 0.5, 1.0}) {
+    o.beta = beta;
+    for (const UncertaintyRanking r : {UncertaintyRanking::kBoth, UncertaintyRanking::kOpacity,
+                                       UncertaintyRanking::kScale}) {
+      o.ranking = r;
+      expectSubsetIsItsDefinition(band, o, 9);
+    }
+  }
 }
 
 }  // namespace
