@@ -254,11 +254,14 @@ void backwardTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subse
                       const std::uint32_t* entry_slot, float* slots);
 }  // namespace avx2
 
-// The AVX2 pair composite on AVX-512VL's 32 registers (raster_kernels_avx512.cpp):
-// bit-identical to avx2::compositeTilePair. The pair backward stays AVX2's.
+// The AVX2 pair kernels on AVX-512VL's 32 registers (raster_kernels_avx512.cpp):
+// bit-identical to avx2::compositeTilePair and avx2::backwardTilePair.
 namespace avx512 {
 void compositeTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0,
                        int x1, int y1, const float bg[3], const ForwardOut& full, const ForwardOut& subset);
+void backwardTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0, int x1,
+                      int y1, const float bg[3], const BackwardIn& full, const BackwardIn& subset,
+                      const std::uint32_t* entry_slot, float* slots);
 }  // namespace avx512
 
 }  // namespace raster_kernels

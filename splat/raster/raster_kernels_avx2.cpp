@@ -49,7 +49,7 @@ void compositeTilePair(const TileGaussian<float>*, const std::uint8_t*, int, int
   std::abort();
 }
 void backwardTilePair(const TileGaussian<float>*, const std::uint8_t*, int, int, int, int, int, const float*,
-                      const BackwardIn&, const BackwardIn&, const std::uint32_t*, float*, float*) {
+                      const BackwardIn&, const BackwardIn&, const std::uint32_t*, float*) {
   std::abort();
 }
 }  // namespace saresgs::raster_kernels::avx2

@@ -5,19 +5,26 @@
 // - fisherTile: the walk keeps all 19 moment accumulators in registers and sums them as
 //   it goes (SARESGS_KERNEL_FISHER_ONE_PASS in raster_kernels_impl.h), instead of storing
 //   each block's two inputs and summing them in three later passes.
-// - compositeTilePair (residual supervision's two renders in one walk): the pair loop's
-//   Gaussian constants, which spill on AVX2's 16 registers, stay in registers.
+// - compositeTilePair and backwardTilePair (residual supervision's two renders in one
+//   walk): the pair loops' Gaussian constants and the backward's nine gradient sums, which
+//   spill on AVX2's 16 registers, stay in registers. The pair backward lost on 32
+//   registers until 2026-11-27, late night (1.02-1.08x the AVX2 kernel's time): GCC built the select
+//   `gm ? G dL/dalpha : 0`, whose mask combines two compares, lane by lane in
+//   general-purpose registers (kmovw, shifts and cmov per lane) when it could use AVX-512's
+//   mask registers. The selects of backStep are now bitwise ands (maskOr0 in
+//   raster_kernels_impl.h, the same bits), and the pair backward on AVX-512VL takes
+//   0.75-0.78x the AVX2 kernel's time (bench train --residual, room360 256x192).
 // - backwardTile: since the lattice (G by products, forEachBlock) its nine gradient sums,
 //   the lattice's G, step and row factor and the Gaussian's constants outgrow AVX2's 16
 //   registers; on 32 the backward stage of bench train (room360 512x384) took 0.94-0.97x
-//   the AVX2 kernel's time (2026-11-27; before the lattice it gained nothing).
+//   the AVX2 kernel's time (2026-11-27; before the lattice it gained nothing), and since
+//   maskOr0 less again.
 // Each value sees the same operations in the same order, so the outputs are bit-identical
 // to the AVX2 kernels' (tested: Fisher.Avx512WalkEqualsAvx2BitForBit,
-// FloatPath.Avx512BackwardEqualsAvx2BitForBit, and SubsetPair.* against the single-render
-// AVX2 kernel on every kernel set). The forward kernel and the pair backward gained
-// nothing or lost from the wider register file (docs/PERFORMANCE_TRIED.md; the pair
-// backward again 1.02-1.03x on bench step --residual 256x192/40k on 2026-11-27), so the
-// avx512 kernel set uses the AVX2 ones.
+// FloatPath.Avx512BackwardEqualsAvx2BitForBit, SubsetPair.Avx512BackwardEqualsAvx2BitForBit,
+// and SubsetPair.* against the single-render AVX2 kernel on every kernel set). The forward
+// kernel gained nothing or lost from the wider register file (docs/PERFORMANCE_TRIED.md),
+// so the avx512 kernel set uses the AVX2 one.
 #include "splat/raster/raster_kernels.h"
 
 #if defined(SARESGS_RASTER_AVX512)
@@ -26,7 +33,6 @@
 #define SARESGS_KERNEL_FMA 1
 #define SARESGS_KERNEL_FISHER_ONE_PASS 1
 #define SARESGS_KERNEL_NO_COMPOSITE 1
-#define SARESGS_KERNEL_PAIR_COMPOSITE_ONLY 1
 #include "splat/raster/raster_kernels_impl.h"
 #include "splat/raster/raster_kernels_pair_impl.h"
 
@@ -48,6 +54,10 @@ void compositeTilePair(const TileGaussian<float>*, const std::uint8_t*, int, int
 }
 void backwardTile(const TileGaussian<float>*, int, int, int, int, int, const float*, const BackwardIn&,
                   const std::uint32_t*, float*) {
+  std::abort();
+}
+void backwardTilePair(const TileGaussian<float>*, const std::uint8_t*, int, int, int, int, int, const float*,
+                      const BackwardIn&, const BackwardIn&, const std::uint32_t*, float*) {
   std::abort();
 }
 }  // namespace saresgs::raster_kernels::avx512

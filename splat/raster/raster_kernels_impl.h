@@ -326,6 +326,11 @@ inline void blockRowSpans(const TileGaussian<float>& g, int x0, int y0, int rb0,
   }
 }
 
+// m ? v : +0 lane by lane (m is -1 or 0), as a bitwise and: the same bits as the select,
+// and on AVX-512VL GCC keeps it a vector operation (a select on a mask combined from two
+// compares was rebuilt lane by lane in general-purpose registers).
+inline vf maskOr0(vi m, vf v) { return reinterpret_cast<vf>(m & reinterpret_cast<vi>(v)); }
+
 inline vi absLe(vf v, vf bound) { return reinterpret_cast<vf>(reinterpret_cast<vi>(v) & 0x7fffffff) <= bound; }
 
 constexpr int kBlocks = kTile * kTile / L;  // vector blocks per tile
@@ -715,10 +720,10 @@ struct GradSums {
 // division is skipped.
 template <bool kBg>
 inline void backStep(BackwardBlock& B, const Lanes& Ln, vf jv, vf col0, vf col1, vf col2, vf& e, vf& wcol) {
-  const vf zero = vs(0.0f), one = vs(1.0f);
+  const vf one = vs(1.0f);
   const vf alpha = Ln.alpha;
   const vi valid = (jv < B.walked) & Ln.touches;
-  const vf a_eff = valid ? alpha : zero;
+  const vf a_eff = maskOr0(valid, alpha);
   const vf t = B.Tr / (one - a_eff);  // transmittance in front of jj
   B.Tr = t;
   // acc: the colour composited behind jj (normalised), updated once jj is used.
@@ -731,7 +736,7 @@ inline void backStep(BackwardBlock& B, const Lanes& Ln, vf jv, vf col0, vf col1,
   B.acc1 = fma(a_eff, d1, a1);
   B.acc2 = fma(a_eff, d2, a2);
   const vi gm = valid & (Ln.oG < vs(kMaxA));
-  e = gm ? Ln.G * dLda : zero;
+  e = maskOr0(gm, Ln.G * dLda);
   wcol = a_eff * t;  // 0 where not valid
 }
 

@@ -793,8 +793,8 @@ struct PairKernelSet {
 constexpr PairKernelSet kPairKernelSets[] = {
     {raster_kernels::base4::compositeTilePair, raster_kernels::base4::backwardTilePair},
     {raster_kernels::avx2::compositeTilePair, raster_kernels::avx2::backwardTilePair},
-    // avx512: the composite on 32 registers, the backward AVX2's (raster_kernels_avx512.cpp).
-    {raster_kernels::avx512::compositeTilePair, raster_kernels::avx2::backwardTilePair},
+    // avx512: both on 32 registers (raster_kernels_avx512.cpp).
+    {raster_kernels::avx512::compositeTilePair, raster_kernels::avx512::backwardTilePair},
 };
 
 // The public result of a float render (rasterize() and rasterizeWithSubset()), moved
