@@ -3,6 +3,7 @@
 // by one (tile, Gaussian) pair and slots are reduced per Gaussian in a fixed order, so
 // results are bit-identical for the same inputs, whatever the thread count.
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -244,7 +245,7 @@ bool evalAlpha(const TileGaussian<T>& q, T px, T py, T& dx, T& dy, T& G, T& alph
 // The scratch of binAndSort and depthOrder, kept per thread between renders
 // (splat/kept_buffers.h).
 struct BinScratch {
-  std::vector<std::uint32_t> slot_tile, fill, order, key, key2, order2;
+  std::vector<std::uint32_t> slot_tile, fill, order, key, key2, order2, chunk_fill;
 };
 
 // Rule 6 for every tile at once: the Gaussians with pairs, by camera z, ties by index.
@@ -524,31 +525,72 @@ void binAndSort(const TileCover& cover, int W, int H, RasterStateT<T>& st) {
   std::vector<std::uint32_t>& slot_tile = sc.slot_tile;
   assignKept(slot_tile, pairs, 0u);
   arena(st).execute([&] {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& r) {
-      const FloatEnvGuard fenv;  // geometry/float_env.h
-      for (std::size_t i = r.begin(); i < r.end(); ++i) {
-        if (!cover.count[i]) continue;
-        std::uint32_t k = st.gauss_start[i];
-        forEachTileMet(st.tile_data[i], cover.rect[i], W, H, [&](int tx, int ty) {
-          slot_tile[k++] = static_cast<std::uint32_t>(ty * st.tiles_x + tx);
-        });
-      }
-    });
+    // The pairs' tiles and the depth order (serial) do not depend on each other.
+    tbb::parallel_invoke([&] { depthOrder(st.proj, cover.count, sc); },
+                         [&] {
+                           tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& r) {
+                             const FloatEnvGuard fenv;  // geometry/float_env.h
+                             for (std::size_t i = r.begin(); i < r.end(); ++i) {
+                               if (!cover.count[i]) continue;
+                               std::uint32_t k = st.gauss_start[i];
+                               forEachTileMet(st.tile_data[i], cover.rect[i], W, H, [&](int tx, int ty) {
+                                 slot_tile[k++] = static_cast<std::uint32_t>(ty * st.tiles_x + tx);
+                               });
+                             }
+                           });
+                         });
   });
-  st.tile_start.assign(tiles + 1, 0);
-  for (std::uint32_t k = 0; k < pairs; ++k) ++st.tile_start[slot_tile[k] + 1];
-  for (int t = 0; t < tiles; ++t) st.tile_start[t + 1] += st.tile_start[t];
+  // A stable counting sort of the pairs by tile, the Gaussians taken in depth order, in
+  // parallel: the depth order is cut into chunks, each chunk counts its pairs per tile,
+  // and each chunk's pairs go to its tile after those of the chunks before it, which is
+  // where the serial loop put them (the same lists for any number of chunks or threads).
+  const std::vector<std::uint32_t>& order = sc.order;
+  const std::size_t m = order.size();
+  const std::size_t chunks = std::clamp<std::size_t>(m / 2048, 1, 16);
+  auto chunkRange = [&](std::size_t c) { return std::pair{c * m / chunks, (c + 1) * m / chunks}; };
+  const std::size_t nt = static_cast<std::size_t>(tiles);
+  std::vector<std::uint32_t>& cf = sc.chunk_fill;
+  cf.assign(chunks * nt, 0u);
+  auto forChunks = [&](auto&& body) {
+    arena(st).execute([&] {
+      tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
+        const auto [b, e] = chunkRange(c);
+        body(c, b, e);
+      });
+    });
+  };
+  forChunks([&](std::size_t c, std::size_t b, std::size_t e) {
+    std::uint32_t* cnt = cf.data() + c * nt;
+    for (std::size_t j = b; j < e; ++j) {
+      const std::uint32_t i = order[j];
+      for (std::uint32_t k = st.gauss_start[i]; k < st.gauss_start[i + 1]; ++k) ++cnt[slot_tile[k]];
+    }
+  });
+  // Counts to starts: the tile's start, then each chunk's place within the tile.
+  st.tile_start.assign(nt + 1, 0);
+  std::uint32_t at = 0;
+  for (std::size_t t = 0; t < nt; ++t) {
+    st.tile_start[t] = at;
+    for (std::size_t c = 0; c < chunks; ++c) {
+      const std::uint32_t k = cf[c * nt + t];
+      cf[c * nt + t] = at;
+      at += k;
+    }
+  }
+  st.tile_start[nt] = at;
   st.entry_gauss.resize(pairs);
   st.entry_slot.resize(pairs);
-  std::vector<std::uint32_t>& fill = sc.fill;
-  fill.assign(st.tile_start.begin(), st.tile_start.end() - 1);
-  depthOrder(st.proj, cover.count, sc);
-  for (const std::uint32_t i : sc.order)
-    for (std::uint32_t k = st.gauss_start[i]; k < st.gauss_start[i + 1]; ++k) {
-      const std::uint32_t e = fill[slot_tile[k]]++;
-      st.entry_gauss[e] = i;
-      st.entry_slot[e] = k;
+  forChunks([&](std::size_t c, std::size_t b, std::size_t e) {
+    std::uint32_t* fill = cf.data() + c * nt;
+    for (std::size_t j = b; j < e; ++j) {
+      const std::uint32_t i = order[j];
+      for (std::uint32_t k = st.gauss_start[i]; k < st.gauss_start[i + 1]; ++k) {
+        const std::uint32_t en = fill[slot_tile[k]]++;
+        st.entry_gauss[en] = i;
+        st.entry_slot[en] = k;
+      }
     }
+  });
 }
 
 // Composites every tile front to back (float: the SIMD kernels of st.isa) into `out`,

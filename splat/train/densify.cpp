@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <Eigen/Geometry>
 
 #include "splat/model_ops.h"
@@ -84,13 +87,17 @@ void keepLargestGradients(std::vector<int>& clone, std::vector<int>& split, cons
 void accumulateDensifyStats(DensifyStats& st, const std::vector<float>& grad_mean2d, std::span<const float> radii,
                             std::span<const std::uint8_t> visible, int width, int height) {
   const float sx = 0.5f * static_cast<float>(width), sy = 0.5f * static_cast<float>(height);
-  for (std::size_t i = 0; i < st.count.size(); ++i) {
-    if (!visible[i] || !(radii[i] > 0)) continue;
-    const float gx = grad_mean2d[2 * i] * sx, gy = grad_mean2d[2 * i + 1] * sy;
-    st.grad_accum[i] += std::sqrt(gx * gx + gy * gy);
-    st.count[i] += 1;
-    st.max_radius[i] = std::max(st.max_radius[i], radii[i]);
-  }
+  // Every Gaussian's statistics on their own, so in parallel (it ran serially every
+  // training step: about 0.4 % of the main job's samples, on one core).
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, st.count.size(), 8192), [&](const auto& r) {
+    for (std::size_t i = r.begin(); i < r.end(); ++i) {
+      if (!visible[i] || !(radii[i] > 0)) continue;
+      const float gx = grad_mean2d[2 * i] * sx, gy = grad_mean2d[2 * i + 1] * sy;
+      st.grad_accum[i] += std::sqrt(gx * gx + gy * gy);
+      st.count[i] += 1;
+      st.max_radius[i] = std::max(st.max_radius[i], radii[i]);
+    }
+  });
 }
 
 DensifyReport densifyAndPrune(Gaussians& g, AdamState& adam, DensifyStats& st, const DensifyOptions& opt,
