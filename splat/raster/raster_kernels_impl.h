@@ -504,14 +504,15 @@ struct ForwardState {
     const vf next = t * (vs(1.0f) - alpha);
     const vi stop = ok & (next < vs(kMinT));
     const vi take = ok & ~stop;
-    const vf wgt = take ? alpha * t : vs(0.0f);
+    const vf wgt = maskOr0(take, alpha * t);
     B.C0 = fma(wgt, col0, B.C0);
     B.C1 = fma(wgt, col1, B.C1);
     B.C2 = fma(wgt, col2, B.C2);
     B.D = fma(wgt, dep, B.D);
-    B.Tr = take ? next : (stop ? -t : t);
+    const vf flipped = reinterpret_cast<vf>(reinterpret_cast<vi>(t) ^ (stop & static_cast<std::int32_t>(0x80000000u)));
+    B.Tr = take ? next : flipped;  // flipped: -t where stopping, else t
     B.walked = take ? jf : B.walked;
-    B.contrib = B.contrib + (take ? vs(1.0f) : vs(0.0f));
+    B.contrib = B.contrib + maskOr0(take, vs(1.0f));
     return stop;
   }
 
