@@ -18,6 +18,7 @@
 #include "splat/raster/projection.h"
 #include "splat/raster/raster_kernels.h"
 #include "splat/raster/rasterize_detail.h"
+#include "tests/splat/gaussians_bits.h"
 
 using namespace saresgs;
 
@@ -81,32 +82,6 @@ void expectSame(const projection::Projected<float>& a, const projection::Project
   same(a.half[0], b.half[0], "half x");
   same(a.half[1], b.half[1], "half y");
   same(a.radius, b.radius, "radius");
-}
-
-// Every array of `got` equal to `want`'s bit for bit (fatal at the first difference).
-void expectArraysBitEqual(const Gaussians& got, const Gaussians& want) {
-  std::vector<const std::vector<float>*> w;
-  want.forEachArray([&](const std::vector<float>& a, std::size_t) { w.push_back(&a); });
-  std::size_t array = 0;
-  got.forEachArray([&](const std::vector<float>& a, std::size_t) {
-    const std::vector<float>& b = *w[array++];
-    ASSERT_EQ(a.size(), b.size());
-    for (std::size_t k = 0; k < a.size(); ++k)
-      ASSERT_EQ(bits(a[k]), bits(b[k])) << "array " << array - 1 << " entry " << k << ": " << a[k] << " vs " << b[k];
-  });
-}
-
-// How many values of `after` differ from `before`'s.
-int countChanged(const Gaussians& before, const Gaussians& after) {
-  std::vector<const std::vector<float>*> b;
-  before.forEachArray([&](const std::vector<float>& a, std::size_t) { b.push_back(&a); });
-  std::size_t array = 0;
-  int changed = 0;
-  after.forEachArray([&](const std::vector<float>& a, std::size_t) {
-    for (std::size_t k = 0; k < a.size(); ++k) changed += a[k] != (*b[array])[k];
-    ++array;
-  });
-  return changed;
 }
 
 struct ProjectCase {
@@ -242,11 +217,11 @@ TEST(ProjectKernels, BackwardEqualsProjectBackwardBitForBit) {
         s.execution.kernels = kernels;
         Gaussians got = start;
         projectBackwardFloat(g, pc.cam, s, idx, proj, dP, got);
-        expectArraysBitEqual(got, ref);
+        ASSERT_TRUE(test::arraysBitEqual(got, ref));
         if (::testing::Test::HasFatalFailure()) return;
         chained += static_cast<int>(idx.size());
       }
-      nonzero += countChanged(start, ref);
+      nonzero += test::countChanged(start, ref);
     }
   }
   EXPECT_GT(chained, 3000);    // the comparison saw many Gaussians
@@ -316,11 +291,11 @@ TEST(ProjectKernels, FisherChainEqualsReferenceBitForBit) {
         s.execution.kernels = kernels;
         Gaussians got = start;
         fisherChainFloat(g, pc.cam, s, sidx, proj, smo, got);
-        expectArraysBitEqual(got, ref);
+        ASSERT_TRUE(test::arraysBitEqual(got, ref));
         if (::testing::Test::HasFatalFailure()) return;
         chained += static_cast<int>(sidx.size());
       }
-      changed += countChanged(start, ref);
+      changed += test::countChanged(start, ref);
     }
   }
   EXPECT_GT(chained, 2000);

@@ -14,6 +14,7 @@
 #include <set>
 
 #include "splat/train/adam.h"
+#include "tests/splat/gaussians_bits.h"
 #include "splat/train/densify.h"
 #include "splat/train/init.h"
 #include "splat/train/residual.h"
@@ -151,14 +152,7 @@ TEST(TrainAdam, EveryValueIsTheFloatFormulaBitForBit) {
     update(want.opacities, g.opacities, ref.m.opacities, ref.v.opacities, 1, 1, lr.opacities, lr.opacities);
     update(want.sh, g.sh, ref.m.sh, ref.v.sh, 48, 3, lr.sh_dc, lr.sh_rest);
   }
-  std::vector<const std::vector<float>*> w;
-  want.forEachArray([&](const std::vector<float>& a, std::size_t) { w.push_back(&a); });
-  std::size_t array = 0;
-  p.forEachArray([&](const std::vector<float>& a, std::size_t) {
-    const std::vector<float>& b = *w[array++];
-    for (std::size_t k = 0; k < a.size(); ++k)
-      ASSERT_EQ(std::bit_cast<std::uint32_t>(a[k]), std::bit_cast<std::uint32_t>(b[k])) << "array " << array - 1 << " value " << k;
-  });
+  EXPECT_TRUE(test::arraysBitEqual(p, want));
   for (std::size_t k = 0; k < p.sh.size(); ++k) EXPECT_NE(p.sh[k], initial.sh[k]) << k;  // every value moved
 }
 
@@ -186,20 +180,9 @@ TEST(TrainAdam, ClearingStepEqualsTheStepAndZeroesTheGradient) {
         for (const float v : x) ASSERT_EQ(std::bit_cast<std::uint32_t>(v), 0u);
       });
     }
-    auto same = [](const Gaussians& x, const Gaussians& y) {
-      std::vector<const std::vector<float>*> w;
-      y.forEachArray([&](const std::vector<float>& a, std::size_t) { w.push_back(&a); });
-      std::size_t array = 0;
-      bool eq = true;
-      x.forEachArray([&](const std::vector<float>& a, std::size_t) {
-        const std::vector<float>& b = *w[array++];
-        for (std::size_t k = 0; k < a.size(); ++k) eq = eq && std::bit_cast<std::uint32_t>(a[k]) == std::bit_cast<std::uint32_t>(b[k]);
-      });
-      return eq;
-    };
-    EXPECT_TRUE(same(p, q)) << "degree " << degree;
-    EXPECT_TRUE(same(a.m, b.m)) << "degree " << degree;
-    EXPECT_TRUE(same(a.v, b.v)) << "degree " << degree;
+    EXPECT_TRUE(test::arraysBitEqual(q, p)) << "degree " << degree;
+    EXPECT_TRUE(test::arraysBitEqual(b.m, a.m)) << "degree " << degree;
+    EXPECT_TRUE(test::arraysBitEqual(b.v, a.v)) << "degree " << degree;
   }
 }
 
