@@ -768,6 +768,26 @@ float* keptGradSlots(KeptBuffers<GradSlots>& kept, std::uint32_t pairs) {
   return v.data();
 }
 
+// The Gaussians of [begin, end) that have tile pairs, listed up to kChunk at a time: for
+// each, add(i, k) sums its pair slots into the caller's k-th entry, and every full or last
+// list goes to flush(list, count), the kernel set's SIMD stage. Shared by the backward's
+// chain (chainSlots) and the Fisher pass's (squaredGradientsFloat).
+template <std::size_t kChunk, typename Add, typename Flush>
+void forListedGaussians(const std::vector<std::uint32_t>& gauss_start, std::size_t begin, std::size_t end, Add&& add,
+                        Flush&& flush) {
+  std::uint32_t list[kChunk];
+  for (std::size_t b = begin; b < end; b += kChunk) {
+    const std::size_t e = std::min(end, b + kChunk);
+    int listed = 0;
+    for (std::size_t i = b; i < e; ++i) {
+      if (gauss_start[i] == gauss_start[i + 1]) continue;
+      add(i, listed);
+      list[listed++] = static_cast<std::uint32_t>(i);
+    }
+    if (listed) flush(list, listed);
+  }
+}
+
 // The backward's last stage, shared by the single and the pair backward: each Gaussian's
 // pair slots reduced in slot order, its 2D-mean gradient added to grad_mean2d
 // (densification's statistic), and the sum chained to its parameters (projectBackward).
@@ -792,37 +812,33 @@ void chainSlots(const GaussiansT<T>& g, const Camera& cam, const RasterStateT<T>
     }
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kChunk), [&](const auto& r) {
       const FloatEnvGuard fenv;  // geometry/float_env.h
-      [[maybe_unused]] std::uint32_t list[kChunk];
       [[maybe_unused]] ProjectedGrad<T> list_dP[kChunk];
       // A range may be longer than the grain: at most kChunk Gaussians per list.
-      for (std::size_t b = r.begin(); b < r.end(); b += kChunk) {
-        const std::size_t e = std::min(r.end(), b + kChunk);
-        int listed = 0;
-        for (std::size_t i = b; i < e; ++i) {
-          if (st.gauss_start[i] == st.gauss_start[i + 1]) continue;
-          ProjectedGrad<T> dP;
-          for (std::uint32_t k = st.gauss_start[i]; k < st.gauss_start[i + 1]; ++k) {
-            const T* sl = &slots[static_cast<std::size_t>(k) * kSlot];
-            dP.opacity += sl[0];
-            dP.mean2d[0] += sl[1];
-            dP.mean2d[1] += sl[2];
-            for (int c = 0; c < 3; ++c) dP.conic[c] += sl[3 + c];
-            for (int c = 0; c < 3; ++c) dP.color[c] += sl[6 + c];
-          }
-          if (grad_mean2d) {
-            (*grad_mean2d)[2 * i] += dP.mean2d[0];
-            (*grad_mean2d)[2 * i + 1] += dP.mean2d[1];
-          }
-          if constexpr (std::is_same_v<T, float>) {
-            list[listed] = static_cast<std::uint32_t>(i);
-            list_dP[listed++] = dP;
-          } else {
-            projection::projectBackward(g, i, camT, rs, st.proj[i], dP, projection::ParamGradRef<T>::of(grad, i));
-          }
-        }
-        if constexpr (std::is_same_v<T, float>)
-          if (listed) kKernelSets[st.isa].project_backward(pin, list, listed, st.proj.data(), list_dP, pout);
-      }
+      forListedGaussians<kChunk>(
+          st.gauss_start, r.begin(), r.end(),
+          [&](std::size_t i, int k) {
+            ProjectedGrad<T> dP;
+            for (std::uint32_t s = st.gauss_start[i]; s < st.gauss_start[i + 1]; ++s) {
+              const T* sl = &slots[static_cast<std::size_t>(s) * kSlot];
+              dP.opacity += sl[0];
+              dP.mean2d[0] += sl[1];
+              dP.mean2d[1] += sl[2];
+              for (int c = 0; c < 3; ++c) dP.conic[c] += sl[3 + c];
+              for (int c = 0; c < 3; ++c) dP.color[c] += sl[6 + c];
+            }
+            if (grad_mean2d) {
+              (*grad_mean2d)[2 * i] += dP.mean2d[0];
+              (*grad_mean2d)[2 * i + 1] += dP.mean2d[1];
+            }
+            if constexpr (std::is_same_v<T, float>)
+              list_dP[k] = dP;
+            else
+              projection::projectBackward(g, i, camT, rs, st.proj[i], dP, projection::ParamGradRef<T>::of(grad, i));
+          },
+          [&]([[maybe_unused]] const std::uint32_t* list, [[maybe_unused]] int listed) {
+            if constexpr (std::is_same_v<T, float>)
+              kKernelSets[st.isa].project_backward(pin, list, listed, st.proj.data(), list_dP, pout);
+          });
     });
   });
 }
@@ -1227,21 +1243,18 @@ void squaredGradientsFloat(const Gaussians& g, const Camera& cam, const RenderOu
       // double in slot order, then the kernel set's SIMD chain (bit for bit
       // fisherChainReference: ProjectKernels.FisherChainEqualsReferenceBitForBit).
       constexpr std::size_t kChunk = 128;
-      std::uint32_t list[kChunk];
       double mo[kChunk * kFisherSlot];
-      for (std::size_t b = r.begin(); b < r.end(); b += kChunk) {
-        const std::size_t e = std::min(r.end(), b + kChunk);
-        int listed = 0;
-        for (std::size_t i = b; i < e; ++i) {
-          if (st.gauss_start[i] == st.gauss_start[i + 1]) continue;
-          double* m = &mo[static_cast<std::size_t>(listed) * kFisherSlot];
-          std::fill(m, m + kFisherSlot, 0.0);
-          for (std::uint32_t k = st.gauss_start[i]; k < st.gauss_start[i + 1]; ++k)
-            for (int p = 0; p < kFisherSlot; ++p) m[p] += slots[static_cast<std::size_t>(k) * kFisherSlot + p];
-          list[listed++] = static_cast<std::uint32_t>(i);
-        }
-        if (listed) kKernelSets[st.isa].fisher_chain(pin, list, listed, st.proj.data(), mo, out);
-      }
+      forListedGaussians<kChunk>(
+          st.gauss_start, r.begin(), r.end(),
+          [&](std::size_t i, int k) {
+            double* m = &mo[static_cast<std::size_t>(k) * kFisherSlot];
+            std::fill(m, m + kFisherSlot, 0.0);
+            for (std::uint32_t s = st.gauss_start[i]; s < st.gauss_start[i + 1]; ++s)
+              for (int p = 0; p < kFisherSlot; ++p) m[p] += slots[static_cast<std::size_t>(s) * kFisherSlot + p];
+          },
+          [&](const std::uint32_t* list, int listed) {
+            kKernelSets[st.isa].fisher_chain(pin, list, listed, st.proj.data(), mo, out);
+          });
     });
   });
 }
