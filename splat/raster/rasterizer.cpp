@@ -550,7 +550,7 @@ void binAndSort(const TileCover& cover, int W, int H, RasterStateT<T>& st) {
   auto chunkRange = [&](std::size_t c) { return std::pair{c * m / chunks, (c + 1) * m / chunks}; };
   const std::size_t nt = static_cast<std::size_t>(tiles);
   std::vector<std::uint32_t>& cf = sc.chunk_fill;
-  cf.assign(chunks * nt, 0u);
+  assignKept(cf, chunks * nt, 0u);
   auto forChunks = [&](auto&& body) {
     arena(st).execute([&] {
       tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {

@@ -55,6 +55,7 @@ std::uint64_t kthSmallest(const std::vector<std::uint64_t>& keys, std::size_t r,
   constexpr int kDigit = 12;
   constexpr std::uint64_t kMask = (std::uint64_t{1} << kDigit) - 1;
   sc.hist.resize(kMask + 1);
+  reserveKept(sc.cand, keys.size());  // the candidates never outgrow the keys: no reallocation below
   const std::uint64_t* src = keys.data();
   std::size_t len = keys.size();
   for (int shift = 64 - kDigit; shift >= 0 && len > 64; shift -= kDigit) {

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include <tbb/parallel_invoke.h>
+#include <tbb/task_arena.h>
 
 #include "geometry/error.h"
 #include "geometry/io/atomic_file.h"
@@ -179,17 +180,24 @@ ViewLoss viewLossAndGradient(const Gaussians& g, const Camera& cam, const Raster
     seconds.render += since(t0);
     t0 = Clock::now();
     // The two images' losses side by side: each is deterministic for any thread count,
-    // and on a small image one loss alone keeps two cores only partly busy.
+    // and on a small image one loss alone keeps two cores only partly busy. Each runs
+    // isolated, so that a thread waiting inside one loss does not start the other there:
+    // the nested call would find the loss's per-thread scratch busy and allocate its own
+    // (splat/kept_buffers.h).
     LossResult& Lf = buffers.loss;
     LossResult& Ls = buffers.loss_subset;
     tbb::parallel_invoke(
         [&] {
-          photometricLoss(fwd.full.rgb, target, lambda_ssim, true, Lf);
-          scaleImage(Lf.grad, static_cast<float>(res.lambda_full));
+          tbb::this_task_arena::isolate([&] {
+            photometricLoss(fwd.full.rgb, target, lambda_ssim, true, Lf);
+            scaleImage(Lf.grad, static_cast<float>(res.lambda_full));
+          });
         },
         [&] {
-          photometricLoss(fwd.subset.rgb, target, lambda_ssim, true, Ls);
-          scaleImage(Ls.grad, static_cast<float>(res.lambda_sub));
+          tbb::this_task_arena::isolate([&] {
+            photometricLoss(fwd.subset.rgb, target, lambda_ssim, true, Ls);
+            scaleImage(Ls.grad, static_cast<float>(res.lambda_sub));
+          });
         });
     seconds.loss += since(t0);
     t0 = Clock::now();
