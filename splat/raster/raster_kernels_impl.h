@@ -872,7 +872,7 @@ void fisherTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1
   auto step = [&](int k, const Lanes& Ln, vf jv, vf colsum, vf& e, vf& wc) __attribute__((always_inline)) {
     const vf alpha = Ln.alpha;
     const vi valid = (jv < load(walked + k)) & Ln.touches;
-    const vf a_eff = valid ? alpha : zero;
+    const vf a_eff = maskOr0(valid, alpha);
     const vf t = load(Tr + k) / (one - a_eff);  // transmittance in front of jj
     store(Tr + k, t);
     const vf a = load(acc + k), d = colsum - a;
@@ -880,7 +880,7 @@ void fisherTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1
     if constexpr (kBg) dLda = dLda - load(finalT + k) / (one - alpha) * bgs;
     store(acc + k, fma(a_eff, d, a));
     const vi gm = valid & (Ln.oG < vs(kMaxA));
-    e = gm ? Ln.G * dLda : zero;
+    e = maskOr0(gm, Ln.G * dLda);
     wc = a_eff * t;
   };
   for (std::uint32_t jj = jmax; jj-- > 0;) {
