@@ -1,6 +1,7 @@
 #pragma once
-// Bit-for-bit comparison of two models' arrays, shared by the tests that hold a fast path
-// to its reference value by value (the projection kernels, Adam's vector loops).
+// Bit-for-bit comparison of two models' arrays, or of two value lists, shared by the tests
+// that hold a fast path to its reference value by value (the projection kernels, Adam's
+// vector loops, the kernel sets against each other).
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -45,6 +46,25 @@ inline ::testing::AssertionResult arraysBitEqual(const Gaussians& got, const Gau
   if (!failed && array != w.size())
     result = ::testing::AssertionFailure() << array << " arrays against the reference's " << w.size();
   return result;
+}
+
+// `head` followed by every array of `g`: a backward pass's whole output as one vector.
+inline std::vector<float> flattened(std::vector<float> head, const Gaussians& g) {
+  g.forEachArray([&](const std::vector<float>& a, std::size_t) { head.insert(head.end(), a.begin(), a.end()); });
+  return head;
+}
+
+// Success when `got` has `want`'s size and bits, value by value; otherwise the first
+// difference, the two values named `got_name` and `want_name`.
+inline ::testing::AssertionResult valuesBitEqual(const std::vector<float>& got, const std::vector<float>& want,
+                                                 const char* got_name = "got", const char* want_name = "want") {
+  if (got.size() != want.size())
+    return ::testing::AssertionFailure() << "size " << got.size() << " vs " << want.size();
+  for (std::size_t k = 0; k < got.size(); ++k)
+    if (std::bit_cast<std::uint32_t>(got[k]) != std::bit_cast<std::uint32_t>(want[k]))
+      return ::testing::AssertionFailure() << "entry " << k << ": " << got_name << " " << got[k] << ", " << want_name
+                                           << " " << want[k];
+  return ::testing::AssertionSuccess();
 }
 
 // How many values of `after` differ from `before`'s (the models have the same shape).

@@ -1,13 +1,16 @@
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <functional>
 #include <random>
+#include <utility>
 
 #include "raster_test_scenes.h"
 #include "splat/raster/rasterize_detail.h"
+#include "tests/splat/gaussians_bits.h"
 
 using namespace saresgs;
 
@@ -178,18 +181,13 @@ TEST(FloatPath, Avx512BackwardEqualsAvx2BitForBit) {
           s.execution.kernels = kernels;
           const auto r = rasterizeT(g, cam, s);
           Gaussians grad = g.zerosLike();
-          std::vector<float> all(2 * g.size(), 0.0f);
-          rasterizeBackwardT(g, cam, s, r, wf.data(), grad, &all);
-          grad.forEachArray([&](const std::vector<float>& a, std::size_t) { all.insert(all.end(), a.begin(), a.end()); });
-          return all;
+          std::vector<float> mean2d(2 * g.size(), 0.0f);
+          rasterizeBackwardT(g, cam, s, r, wf.data(), grad, &mean2d);
+          return test::flattened(std::move(mean2d), grad);
         };
         const std::vector<float> a = run(RasterKernels::kAvx2), b = run(RasterKernels::kAvx512);
-        ASSERT_EQ(a.size(), b.size());
-        for (std::size_t k = 0; k < a.size(); ++k) {
-          ASSERT_EQ(std::bit_cast<std::uint32_t>(a[k]), std::bit_cast<std::uint32_t>(b[k]))
-              << "entry " << k << ": avx2 " << a[k] << ", avx512 " << b[k];
-          nonzero += a[k] != 0.0f;
-        }
+        ASSERT_TRUE(test::valuesBitEqual(b, a, "avx512", "avx2"));
+        nonzero += static_cast<int>(std::count_if(a.begin(), a.end(), [](float v) { return v != 0.0f; }));
       }
     }
   }

@@ -13,6 +13,7 @@
 #include "raster_test_scenes.h"
 #include "splat/raster/rasterize_detail.h"
 #include "splat/rasterize.h"
+#include "tests/splat/gaussians_bits.h"
 
 using namespace saresgs;
 
@@ -235,17 +236,11 @@ TEST(SubsetPair, Avx512BackwardEqualsAvx2BitForBit) {
         Grads r{c.g.zerosLike(), std::vector<float>(2 * c.g.size(), 0.0f)};
         const RenderPair p = rasterizeWithSubset(c.g, c.cam, c.s, c.mask);
         rasterizeBackwardWithSubset(c.g, c.cam, c.s, p, dl_full, dl_sub, r.grad, &r.mean2d);
-        std::vector<float> all = r.mean2d;
-        r.grad.forEachArray([&](const std::vector<float>& a, std::size_t) { all.insert(all.end(), a.begin(), a.end()); });
-        return all;
+        return test::flattened(r.mean2d, r.grad);
       };
       const std::vector<float> a = run(RasterKernels::kAvx2), b = run(RasterKernels::kAvx512);
-      ASSERT_EQ(a.size(), b.size());
-      for (std::size_t k = 0; k < a.size(); ++k) {
-        ASSERT_EQ(std::bit_cast<std::uint32_t>(a[k]), std::bit_cast<std::uint32_t>(b[k]))
-            << "entry " << k << ": avx2 " << a[k] << ", avx512 " << b[k];
-        nonzero += a[k] != 0.0f;
-      }
+      ASSERT_TRUE(test::valuesBitEqual(b, a, "avx512", "avx2"));
+      nonzero += static_cast<int>(std::count_if(a.begin(), a.end(), [](float v) { return v != 0.0f; }));
     }
   }
   EXPECT_GT(nonzero, 1000);  // the comparison saw real gradients
