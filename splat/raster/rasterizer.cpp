@@ -245,7 +245,7 @@ bool evalAlpha(const TileGaussian<T>& q, T px, T py, T& dx, T& dy, T& G, T& alph
 // The scratch of binAndSort and depthOrder, kept per thread between renders
 // (splat/kept_buffers.h).
 struct BinScratch {
-  std::vector<std::uint32_t> slot_tile, fill, order, key, key2, order2, chunk_fill;
+  std::vector<std::uint32_t> slot_tile, order, key, key2, order2, chunk_fill;
 };
 
 // Rule 6 for every tile at once: the Gaussians with pairs, by camera z, ties by index.
