@@ -526,7 +526,10 @@ void binAndSort(const TileCover& cover, int W, int H, RasterStateT<T>& st) {
   assignKept(slot_tile, pairs, 0u);
   arena(st).execute([&] {
     // The pairs' tiles and the depth order (serial) do not depend on each other.
-    tbb::parallel_invoke([&] { depthOrder(st.proj, cover.count, sc); },
+    tbb::parallel_invoke([&] {
+                           const FloatEnvGuard fenv;  // geometry/float_env.h (depths are floats)
+                           depthOrder(st.proj, cover.count, sc);
+                         },
                          [&] {
                            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& r) {
                              const FloatEnvGuard fenv;  // geometry/float_env.h
@@ -554,6 +557,7 @@ void binAndSort(const TileCover& cover, int W, int H, RasterStateT<T>& st) {
   auto forChunks = [&](auto&& body) {
     arena(st).execute([&] {
       tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t c) {
+        const FloatEnvGuard fenv;  // geometry/float_env.h (integers only, but every task body has one)
         const auto [b, e] = chunkRange(c);
         body(c, b, e);
       });

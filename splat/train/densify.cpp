@@ -8,6 +8,7 @@
 
 #include <Eigen/Geometry>
 
+#include "geometry/float_env.h"
 #include "splat/model_ops.h"
 
 namespace saresgs {
@@ -90,6 +91,7 @@ void accumulateDensifyStats(DensifyStats& st, const std::vector<float>& grad_mea
   // Every Gaussian's statistics on their own, so in parallel (it ran serially every
   // training step: about 0.4 % of the main job's samples, on one core).
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, st.count.size(), 8192), [&](const auto& r) {
+    const FloatEnvGuard fenv;  // geometry/float_env.h
     for (std::size_t i = r.begin(); i < r.end(); ++i) {
       if (!visible[i] || !(radii[i] > 0)) continue;
       const float gx = grad_mean2d[2 * i] * sx, gy = grad_mean2d[2 * i + 1] * sy;

@@ -10,6 +10,7 @@
 
 #include <tbb/parallel_invoke.h>
 
+#include "geometry/float_env.h"
 #include "splat/kept_buffers.h"
 
 namespace saresgs {
@@ -177,22 +178,32 @@ void selectResidualSubset(const Gaussians& g, const ResidualOptions& opt, std::m
   SubsetScratch& sc = kept.get();
   auto opacity = [&](int i) { return opacityKey(g, i); };
   auto scale = [&](int i) { return scaleKey(g, i); };
-  auto draw = [&] { sampleWithoutReplacement(n, countOf(opt.alpha, n), rng, sc.chosen, out.random); };
+  auto draw = [&] {
+    const FloatEnvGuard fenv;  // geometry/float_env.h (a task body of ours)
+    sampleWithoutReplacement(n, countOf(opt.alpha, n), rng, sc.chosen, out.random);
+  };
   // The draw (serial in the generator) and the rankings (no generator) touch disjoint
   // data, so they run side by side; the result does not depend on how they are scheduled.
   switch (opt.ranking) {
     case UncertaintyRanking::kBoth:
       tbb::parallel_invoke(draw, [&] {
+        const FloatEnvGuard fenv;  // the keys are floats: DAZ would read a denormal as 0
         topBy(n, opt.beta, opacity, sc, sc.a);
         topBy(n, opt.beta, scale, sc, sc.b);
       });
       std::set_union(sc.a.begin(), sc.a.end(), sc.b.begin(), sc.b.end(), std::back_inserter(out.uncertain));
       break;
     case UncertaintyRanking::kOpacity:
-      tbb::parallel_invoke(draw, [&] { topBy(n, 2 * opt.beta, opacity, sc, out.uncertain); });
+      tbb::parallel_invoke(draw, [&] {
+        const FloatEnvGuard fenv;
+        topBy(n, 2 * opt.beta, opacity, sc, out.uncertain);
+      });
       break;
     case UncertaintyRanking::kScale:
-      tbb::parallel_invoke(draw, [&] { topBy(n, 2 * opt.beta, scale, sc, out.uncertain); });
+      tbb::parallel_invoke(draw, [&] {
+        const FloatEnvGuard fenv;
+        topBy(n, 2 * opt.beta, scale, sc, out.uncertain);
+      });
       break;
     case UncertaintyRanking::kRandom:
       draw();

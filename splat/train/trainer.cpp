@@ -13,6 +13,7 @@
 #include <tbb/task_arena.h>
 
 #include "geometry/error.h"
+#include "geometry/float_env.h"
 #include "geometry/io/atomic_file.h"
 #include "splat/loss.h"
 #include "splat/metrics.h"
@@ -189,12 +190,14 @@ ViewLoss viewLossAndGradient(const Gaussians& g, const Camera& cam, const Raster
     tbb::parallel_invoke(
         [&] {
           tbb::this_task_arena::isolate([&] {
+            const FloatEnvGuard fenv;  // geometry/float_env.h: this may run on a worker
             photometricLoss(fwd.full.rgb, target, lambda_ssim, true, Lf);
             scaleImage(Lf.grad, static_cast<float>(res.lambda_full));
           });
         },
         [&] {
           tbb::this_task_arena::isolate([&] {
+            const FloatEnvGuard fenv;
             photometricLoss(fwd.subset.rgb, target, lambda_ssim, true, Ls);
             scaleImage(Ls.grad, static_cast<float>(res.lambda_sub));
           });
