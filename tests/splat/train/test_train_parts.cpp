@@ -73,13 +73,19 @@ TEST(TrainInit, GaussiansFromPointsFollowTheReferenceInit) {
   EXPECT_THROW(gaussiansFromPoints({}, 0), std::invalid_argument);
 }
 
+// n Gaussians at SH degree `degree` with every value drawn from `nd` (the Adam tests' model).
+Gaussians normalModel(int degree, std::size_t n, std::mt19937_64& rng, std::normal_distribution<float>& nd) {
+  Gaussians p;
+  p.max_sh_degree = degree;
+  p.resize(n);
+  p.forEachArray([&](std::vector<float>& a, std::size_t) { for (float& x : a) x = nd(rng); });
+  return p;
+}
+
 TEST(TrainAdam, MatchesTheScalarFormulaInDouble) {
   std::mt19937_64 rng(9);
   std::normal_distribution<float> nd(0, 1);
-  Gaussians p;
-  p.max_sh_degree = 1;
-  p.resize(7);
-  p.forEachArray([&](std::vector<float>& a, std::size_t) { for (float& x : a) x = nd(rng); });
+  Gaussians p = normalModel(1, 7, rng, nd);
   const Gaussians p0 = p;
   AdamState st;
   st.resetFor(p);
@@ -119,10 +125,7 @@ TEST(TrainAdam, MatchesTheScalarFormulaInDouble) {
 TEST(TrainAdam, EveryValueIsTheFloatFormulaBitForBit) {
   std::mt19937_64 rng(12);
   std::normal_distribution<float> nd(0, 1);
-  Gaussians p;
-  p.max_sh_degree = 3;
-  p.resize(37);
-  p.forEachArray([&](std::vector<float>& a, std::size_t) { for (float& x : a) x = nd(rng); });
+  Gaussians p = normalModel(3, 37, rng, nd);
   const Gaussians initial = p;
   Gaussians want = p;
   AdamState st, ref;
@@ -162,10 +165,7 @@ TEST(TrainAdam, ClearingStepEqualsTheStepAndZeroesTheGradient) {
   for (int degree = 0; degree <= 3; ++degree) {
     std::mt19937_64 rng(20 + degree);
     std::normal_distribution<float> nd(0, 1);
-    Gaussians p;
-    p.max_sh_degree = degree;
-    p.resize(2100);  // more than one block of the parallel loop
-    p.forEachArray([&](std::vector<float>& a, std::size_t) { for (float& x : a) x = nd(rng); });
+    Gaussians p = normalModel(degree, 2100, rng, nd);  // more than one block of the parallel loop
     Gaussians q = p;
     AdamState a, b;
     a.resetFor(p);
