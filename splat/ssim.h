@@ -27,9 +27,11 @@ struct SsimL1Sums {
 SsimL1Sums ssimL1(const float* x, const float* y, int w, int h, int channels, float* grad,
                   double l1_scale, double ssim_scale);
 
-// The loops run as AVX2 code (8 floats per instruction, no FMA) where the CPU has it,
-// otherwise as baseline SSE2; both give bit-identical results. For tests and timing:
-bool ssimAvx2Available();
-void ssimAllowAvx2(bool allow);  // false: baseline loops even where AVX2 is available
+// The loops run as the widest vector code the CPU has: AVX-512 (16 floats per
+// instruction), AVX2 (8) or baseline SSE2 (4), never with FMA; all give bit-identical
+// results. For tests and timing:
+enum class SsimIsa { kBaseline = 0, kAvx2 = 1, kAvx512 = 2 };
+SsimIsa ssimBestIsa();              // the widest this CPU (and build) offers
+void ssimLimitIsa(SsimIsa widest);  // caps the loops at `widest` (kAvx512: no cap)
 
 }  // namespace saresgs

@@ -397,25 +397,30 @@ TEST(PhotometricLoss, KeptBuffersLeakNothingBetweenCallsOrThreads) {
   for (int i = 0; i < 24; ++i) EXPECT_TRUE(sameBits(at_once[static_cast<std::size_t>(i)], i % 2 ? b1 : s1)) << i;
 }
 
-TEST(PhotometricLoss, Avx2AndBaselineLoopsGiveIdenticalBits) {
-  // The same IEEE operations in the same order per value, 8 or 4 at a time.
-  if (!ssimAvx2Available()) GTEST_SKIP() << "no AVX2 on this CPU";
-  for (const auto& [w, h] : std::vector<std::pair<int, int>>{{160, 123}, {13, 7}, {1, 1}}) {
+TEST(PhotometricLoss, EveryVectorWidthGivesIdenticalBits) {
+  // The same IEEE operations in the same order per value, 16, 8 or 4 at a time.
+  if (ssimBestIsa() == SsimIsa::kBaseline) GTEST_SKIP() << "neither AVX2 nor AVX-512 on this CPU";
+  std::vector<SsimIsa> isas = {SsimIsa::kAvx2};
+  if (ssimBestIsa() == SsimIsa::kAvx512) isas.push_back(SsimIsa::kAvx512);
+  // Widths around the vector lengths and their multiples (the loops' remainders), and 1x1.
+  for (const auto& [w, h] : std::vector<std::pair<int, int>>{{160, 123}, {13, 7}, {1, 1}, {17, 33}, {6, 5}}) {
     const ImageF render = randomImage(w, h, 111 + w, -0.1f, 1.1f);
     const ImageF target = perturbed(render, 112, 0.05f);
     for (double lambda : {0.0, 0.2}) {
-      const LossResult fast = photometricLoss(render, target, lambda);
-      ssimAllowAvx2(false);
+      ssimLimitIsa(SsimIsa::kBaseline);
       const LossResult base = photometricLoss(render, target, lambda);
       const double metric_base = ssim(render, target);
-      ssimAllowAvx2(true);
-      EXPECT_EQ(ssim(render, target), metric_base);
-      EXPECT_EQ(std::memcmp(&fast.loss, &base.loss, sizeof(double)), 0);
-      EXPECT_EQ(std::memcmp(&fast.ssim, &base.ssim, sizeof(double)), 0);
-      ASSERT_EQ(fast.grad.data.size(), base.grad.data.size());
-      EXPECT_EQ(std::memcmp(fast.grad.data.data(), base.grad.data.data(),
-                            fast.grad.data.size() * sizeof(float)),
-                0);
+      for (SsimIsa isa : isas) {
+        SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h) + " isa " + std::to_string(static_cast<int>(isa)));
+        ssimLimitIsa(isa);
+        const LossResult fast = photometricLoss(render, target, lambda);
+        EXPECT_EQ(ssim(render, target), metric_base);
+        EXPECT_EQ(std::memcmp(&fast.loss, &base.loss, sizeof(double)), 0);
+        EXPECT_EQ(std::memcmp(&fast.ssim, &base.ssim, sizeof(double)), 0);
+        ASSERT_EQ(fast.grad.data.size(), base.grad.data.size());
+        EXPECT_EQ(std::memcmp(fast.grad.data.data(), base.grad.data.data(), fast.grad.data.size() * sizeof(float)), 0);
+      }
+      ssimLimitIsa(SsimIsa::kAvx512);
     }
   }
 }
