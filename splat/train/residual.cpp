@@ -184,31 +184,24 @@ void selectResidualSubset(const Gaussians& g, const ResidualOptions& opt, std::m
   };
   // The draw (serial in the generator) and the rankings (no generator) touch disjoint
   // data, so they run side by side; the result does not depend on how they are scheduled.
-  switch (opt.ranking) {
-    case UncertaintyRanking::kBoth:
-      tbb::parallel_invoke(draw, [&] {
-        const FloatEnvGuard fenv;  // the keys are floats: DAZ would read a denormal as 0
-        topBy(n, opt.beta, opacity, sc, sc.a);
-        topBy(n, opt.beta, scale, sc, sc.b);
-      });
-      std::set_union(sc.a.begin(), sc.a.end(), sc.b.begin(), sc.b.end(), std::back_inserter(out.uncertain));
-      break;
-    case UncertaintyRanking::kOpacity:
-      tbb::parallel_invoke(draw, [&] {
-        const FloatEnvGuard fenv;
-        topBy(n, 2 * opt.beta, opacity, sc, out.uncertain);
-      });
-      break;
-    case UncertaintyRanking::kScale:
-      tbb::parallel_invoke(draw, [&] {
-        const FloatEnvGuard fenv;
-        topBy(n, 2 * opt.beta, scale, sc, out.uncertain);
-      });
-      break;
-    case UncertaintyRanking::kRandom:
-      draw();
-      sampleWithoutReplacement(n, countOf(2 * opt.beta, n), rng, sc.chosen, out.uncertain);
-      break;
+  // The random ranking uses the generator after the draw, so it runs after it.
+  if (opt.ranking == UncertaintyRanking::kRandom) {
+    draw();
+    sampleWithoutReplacement(n, countOf(2 * opt.beta, n), rng, sc.chosen, out.uncertain);
+  } else {
+    tbb::parallel_invoke(draw, [&] {
+      const FloatEnvGuard fenv;  // the keys are floats: DAZ would read a denormal as 0
+      switch (opt.ranking) {
+        case UncertaintyRanking::kBoth:
+          topBy(n, opt.beta, opacity, sc, sc.a);
+          topBy(n, opt.beta, scale, sc, sc.b);
+          std::set_union(sc.a.begin(), sc.a.end(), sc.b.begin(), sc.b.end(), std::back_inserter(out.uncertain));
+          break;
+        case UncertaintyRanking::kOpacity: topBy(n, 2 * opt.beta, opacity, sc, out.uncertain); break;
+        case UncertaintyRanking::kScale: topBy(n, 2 * opt.beta, scale, sc, out.uncertain); break;
+        case UncertaintyRanking::kRandom: break;  // above
+      }
+    });
   }
   for (int i : out.random) out.mask[static_cast<std::size_t>(i)] = 1;
   for (int i : out.uncertain) out.mask[static_cast<std::size_t>(i)] = 1;
