@@ -350,9 +350,10 @@ struct Kernels {
 SARESGS_KERNEL_SET(Base, )
 #if SARESGS_SSIM_AVX2
 SARESGS_KERNEL_SET(Avx2, __attribute__((target("avx2"))))
-// 16 floats per instruction (on the AMD EPYC VM the loss stage of `bench train --residual`,
-// room360 256x192, took 1.63-1.75 ms against 1.87-1.98 with AVX2; 256-bit AVX-512 code,
-// for its 32 registers only, 1.82-1.88).
+// 16 floats per instruction: on the AMD EPYC VM the loss stage of `bench train --residual`
+// (room360 256x192, 3 rounds alternated with the AVX2 build) took 0.89-0.91 ms against
+// 1.06-1.07. 256-bit AVX-512 code, for its 32 registers only, gained less in a first,
+// rougher comparison.
 SARESGS_KERNEL_SET(Avx512, __attribute__((target("avx512f,avx512vl,prefer-vector-width=512"))))
 #endif
 
