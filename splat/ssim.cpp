@@ -360,8 +360,8 @@ SARESGS_KERNEL_SET(Avx512, __attribute__((target("avx512f,avx512vl,prefer-vector
 std::atomic<int> g_widest{static_cast<int>(SsimIsa::kAvx512)};
 
 const Kernels& kernels() {
-  const SsimIsa isa = std::min(ssimBestIsa(), static_cast<SsimIsa>(g_widest.load(std::memory_order_relaxed)));
 #if SARESGS_SSIM_AVX2
+  const SsimIsa isa = std::min(ssimBestIsa(), static_cast<SsimIsa>(g_widest.load(std::memory_order_relaxed)));
   if (isa == SsimIsa::kAvx512) return kKernelsAvx512;
   if (isa == SsimIsa::kAvx2) return kKernelsAvx2;
 #endif

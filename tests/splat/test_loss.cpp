@@ -399,7 +399,8 @@ TEST(PhotometricLoss, KeptBuffersLeakNothingBetweenCallsOrThreads) {
 
 TEST(PhotometricLoss, EveryVectorWidthGivesIdenticalBits) {
   // The same IEEE operations in the same order per value, 16, 8 or 4 at a time.
-  if (ssimBestIsa() == SsimIsa::kBaseline) GTEST_SKIP() << "neither AVX2 nor AVX-512 on this CPU";
+  if (ssimBestIsa() == SsimIsa::kBaseline)
+    GTEST_SKIP() << "one SSIM build only: no AVX2 on this CPU, or a -march=native / non-x86 build";
   std::vector<SsimIsa> isas = {SsimIsa::kAvx2};
   if (ssimBestIsa() == SsimIsa::kAvx512) isas.push_back(SsimIsa::kAvx512);
   // Widths around the vector lengths and their multiples (the loops' remainders), and 1x1.
