@@ -114,11 +114,11 @@ double insideWeight(int p, int n) {
 
 // The loops below are written once, as always-inline bodies, and compiled three times (see
 // Kernels): for the baseline target (SSE2 on x86-64) and, where the CPU has them, for AVX2
-// and for AVX-512, with no multiply-add fused (-ffp-contract=off, splat/CMakeLists.txt:
-// GCC fuses them by default in C++ wherever the target has FMA). All perform the same IEEE
-// operations in the same order on each value (nothing is reassociated, no multiply-add is
-// fused), so they give identical bits; AVX2 and AVX-512 only do 8 or 16 values per
-// instruction instead of 4.
+// and for AVX-512. All perform the same IEEE operations in the same order on each value
+// (nothing is reassociated, and no multiply-add is fused: -ffp-contract=off in
+// splat/CMakeLists.txt, as GCC fuses them by default in C++ wherever the target has FMA),
+// so they give identical bits; AVX2 and AVX-512 only do 8 or 16 values per instruction
+// instead of 4.
 #define SARESGS_KERNEL inline __attribute__((always_inline))
 
 using Taps = std::array<float, kRadius + 1>;

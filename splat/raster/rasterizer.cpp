@@ -429,13 +429,20 @@ void forEachTileMet(const TileGaussian<T>& g, const std::array<int, 4>& rect, in
     }
 }
 
-// The tiles of rect that P's alpha ellipse meets, for binning (forEachCoveredTile): their
+// The width in tiles of rect when TileCover::met holds its tiles (kMetMaskMin..kMetMaskMax
+// tiles), else 0: the one test of coverTiles and forEachCoveredTile.
+inline int metMaskWidth(const std::array<int, 4>& rect) {
+  const int rw = rect[1] - rect[0] + 1, area = rw * (rect[3] - rect[2] + 1);
+  return area >= kMetMaskMin && area <= kMetMaskMax ? rw : 0;
+}
+
+// The tiles of rect that g's alpha ellipse meets, for binning (forEachCoveredTile): their
 // count, and their mask where rect suits one (TileCover::met).
 template <typename T>
 std::uint32_t coverTiles(const TileGaussian<T>& g, const std::array<int, 4>& rect, int W, int H,
                          std::uint64_t& met) {
-  const int rw = rect[1] - rect[0] + 1, area = rw * (rect[3] - rect[2] + 1);
-  if (area < kMetMaskMin || area > kMetMaskMax) {
+  const int rw = metMaskWidth(rect);
+  if (rw == 0) {
     std::uint32_t count = 0;
     forEachTileMet(g, rect, W, H, [&](int, int) { ++count; });
     return count;
@@ -451,8 +458,8 @@ std::uint32_t coverTiles(const TileGaussian<T>& g, const std::array<int, 4>& rec
 template <typename T, typename F>
 void forEachCoveredTile(const TileCover& cover, std::size_t i, const TileGaussian<T>& g, int W, int H, F&& f) {
   const std::array<int, 4>& rect = cover.rect[i];
-  const int rw = rect[1] - rect[0] + 1, area = rw * (rect[3] - rect[2] + 1);
-  if (area < kMetMaskMin || area > kMetMaskMax) {
+  const int rw = metMaskWidth(rect);
+  if (rw == 0) {
     forEachTileMet(g, rect, W, H, f);
     return;
   }
