@@ -39,6 +39,8 @@ struct TileGaussian {
 namespace raster_kernels {
 
 // Where the forward kernel writes a tile's pixels (whole-image arrays, row stride W).
+// depth and contributors are both given or both null: null, the kernel neither computes
+// nor writes them (a training step's render), and every other value is the same.
 struct ForwardOut {
   int W;
   float* rgb;

@@ -497,6 +497,10 @@ struct ForwardState {
   }
 
   // Rule 7 for one Gaussian (entry jf - 1) at one block; returns the lanes it stops.
+  // kAux: also the depth and contributor sums (a training step needs neither: without
+  // them a block's step is two updates, two loads and two stores shorter; every other
+  // value is computed by the same operations either way).
+  template <bool kAux>
   static inline vi step(ForwardBlock& B, const Lanes& Ln, vf col0, vf col1, vf col2, vf dep, vf jf) {
     const vf alpha = Ln.alpha;
     const vf t = B.Tr;
@@ -508,14 +512,16 @@ struct ForwardState {
     B.C0 = fma(wgt, col0, B.C0);
     B.C1 = fma(wgt, col1, B.C1);
     B.C2 = fma(wgt, col2, B.C2);
-    B.D = fma(wgt, dep, B.D);
+    if constexpr (kAux) B.D = fma(wgt, dep, B.D);
     const vf flipped = reinterpret_cast<vf>(reinterpret_cast<vi>(t) ^ (stop & static_cast<std::int32_t>(0x80000000u)));
     B.Tr = take ? next : flipped;  // flipped: -t where stopping, else t
     B.walked = take ? jf : B.walked;
-    B.contrib = B.contrib + maskOr0(take, vs(1.0f));
+    if constexpr (kAux) B.contrib = B.contrib + maskOr0(take, vs(1.0f));
     return stop;
   }
 
+  // kAux: out.depth and out.contributors are written too (else they are null and untouched).
+  template <bool kAux>
   void write(int x0, int y0, int w, int h, const float bg[3], const ForwardOut& out) const {
     if (w == kTile && h == kTile) {
       // A whole tile, a block at a time: the per-pixel loop below, lane by lane (the same
@@ -527,13 +533,15 @@ struct ForwardState {
         const vf T = reinterpret_cast<vf>(reinterpret_cast<vi>(B.Tr) & 0x7fffffff);
         const vf r = B.C0 + T * vs(bg[0]), g = B.C1 + T * vs(bg[1]), bl = B.C2 + T * vs(bg[2]);
         const vf a = vs(1.0f) - T;
-        const vi covered = a >= vs(1e-6f);
-        const vf depth = covered ? B.D / (covered ? a : vs(1.0f)) : vs(0.0f);
         for (int half = 0; half < kBH; ++half)
           interleave3(out.rgb + (pix + half * W) * 3, rowOf(r, half), rowOf(g, half), rowOf(bl, half));
         storeRows<v4f>(out.alpha + pix, W, a);
-        storeRows<v4f>(out.depth + pix, W, depth);
-        storeRows<v4i>(out.contributors + pix, W, __builtin_convertvector(B.contrib, vi));
+        if constexpr (kAux) {
+          const vi covered = a >= vs(1e-6f);
+          const vf depth = covered ? B.D / (covered ? a : vs(1.0f)) : vs(0.0f);
+          storeRows<v4f>(out.depth + pix, W, depth);
+          storeRows<v4i>(out.contributors + pix, W, __builtin_convertvector(B.contrib, vi));
+        }
         storeRows<v4f>(out.final_T + pix, W, T);
         storeRows<v4i>(reinterpret_cast<std::int32_t*>(out.n_walked + pix), W, __builtin_convertvector(B.walked, vi));
       }
@@ -550,8 +558,10 @@ struct ForwardState {
       out.rgb[pix * 3 + 1] = B.C1[i] + T * bg[1];
       out.rgb[pix * 3 + 2] = B.C2[i] + T * bg[2];
       out.alpha[pix] = 1.0f - T;
-      out.depth[pix] = (1.0f - T) >= 1e-6f ? B.D[i] / (1.0f - T) : 0.0f;
-      out.contributors[pix] = static_cast<int>(B.contrib[i]);
+      if constexpr (kAux) {
+        out.depth[pix] = (1.0f - T) >= 1e-6f ? B.D[i] / (1.0f - T) : 0.0f;
+        out.contributors[pix] = static_cast<int>(B.contrib[i]);
+      }
       out.final_T[pix] = T;
       out.n_walked[pix] = static_cast<std::uint32_t>(B.walked[i]);
     }
@@ -572,8 +582,10 @@ struct ForwardColour {
 // Front-to-back compositing, Gaussian by Gaussian over the blocks it may touch, so the
 // inner loop is branch-free vector code; each pixel sees exactly the per-pixel sequence
 // of rule 7.
-void compositeTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
-                   const ForwardOut& out) {
+namespace {
+template <bool kAux>
+void compositeTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
+                       const ForwardOut& out) {
   const int w = x1 - x0, h = y1 - y0;
   ForwardState F;
   F.init(w, h);
@@ -581,17 +593,24 @@ void compositeTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1,
     const ForwardColour fc(q[j], j);
     vi stopped = vi{} + 0;
     forEachBlock(q[j], x0, y0, x1, y1, [&](int blk, const Lanes& Ln, vf) {
-      stopped -= F.step(F.b[blk], Ln, fc.col0, fc.col1, fc.col2, fc.dep, fc.jf);  // masks are -1 where true
+      stopped -= F.step<kAux>(F.b[blk], Ln, fc.col0, fc.col1, fc.col2, fc.dep, fc.jf);  // masks are -1 where true
     });
     F.n_active -= hsumInt(stopped);
   }
-  F.write(x0, y0, w, h, bg, out);
+  F.write<kAux>(x0, y0, w, h, bg, out);
+}
+}  // namespace
+
+void compositeTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
+                   const ForwardOut& out) {
+  if (out.depth) compositeTileImpl<true>(q, nq, x0, y0, x1, y1, bg, out);
+  else compositeTileImpl<false>(q, nq, x0, y0, x1, y1, bg, out);
 }
 
 // The machine's floor for the forward kernel's arithmetic (raster_kernels.h): the same
-// per-lane work as compositeTile on the lattice (forEachBlock: G and its step factor
-// multiplied on, the opacity, the alpha clamp, the rectangle and alpha tests, and
-// ForwardState::step) on two blocks held in registers, with no tile walk, gather or
+// per-lane work as a training step's compositeTile on the lattice (forEachBlock: G and its
+// step factor multiplied on, the opacity, the alpha clamp, the rectangle and alpha tests,
+// and ForwardState::step without the depth and contributor sums) on two blocks held in registers, with no tile walk, gather or
 // memory traffic, for n rounds. Each round starts from a G that moves with the round
 // count, cycling through [0.3, 0.8) so that every value stays a normal float (offsets
 // that grew without bound sent an earlier version of this loop into denormal operands,
@@ -613,13 +632,13 @@ float compositeFloor(long n) {
     vf G = vs(0.3f + t) + lane_x * vs(0.01f), e = vs(0.9f + 0.1f * t);
     vf px = lane_x;
     for (int k = 0; k < 2; ++k, px = px + vs(static_cast<float>(kBW))) {
-      ForwardState::step(b[k], lanesOfG(px - mx, G, o, hx, row_in), col0, col1, col2, dep, jf);
+      ForwardState::step<false>(b[k], lanesOfG(px - mx, G, o, hx, row_in), col0, col1, col2, dep, jf);
       b[k].Tr = vmax(b[k].Tr, vs(0.5f));  // keeps the pixels live (the real blocks mostly are)
       G = G * e;
       e = e * kx;
     }
   }
-  return hsum(b[0].C0 + b[1].C0 + b[0].D + b[1].D + b[0].contrib + b[1].walked);
+  return hsum(b[0].C0 + b[1].C0 + b[0].C2 + b[1].C1 + b[0].walked + b[1].walked);
 }
 #endif  // !SARESGS_KERNEL_NO_COMPOSITE
 

@@ -25,8 +25,10 @@
 
 namespace saresgs::raster_kernels::SARESGS_KERNEL_NS {
 
-void compositeTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0,
-                       int x1, int y1, const float bg[3], const ForwardOut& full, const ForwardOut& subset) {
+namespace {
+template <bool kAux>
+void compositeTilePairImpl(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0,
+                           int x1, int y1, const float bg[3], const ForwardOut& full, const ForwardOut& subset) {
   const int w = x1 - x0, h = y1 - y0;
   ForwardState F, S;
   F.init(w, h);
@@ -41,14 +43,22 @@ void compositeTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subs
     vi stopped_f = vi{} + 0, stopped_s = vi{} + 0;
     forEachBlock(q[j], x0, y0, x1, y1, [&](int blk, const Lanes& Ln, vf) {
       // masks are -1 where true
-      if (do_full) stopped_f -= F.step(F.b[blk], Ln, fc.col0, fc.col1, fc.col2, fc.dep, fc.jf);
-      if (do_sub) stopped_s -= S.step(S.b[blk], Ln, fc.col0, fc.col1, fc.col2, fc.dep, fc.jf);
+      if (do_full) stopped_f -= F.step<kAux>(F.b[blk], Ln, fc.col0, fc.col1, fc.col2, fc.dep, fc.jf);
+      if (do_sub) stopped_s -= S.step<kAux>(S.b[blk], Ln, fc.col0, fc.col1, fc.col2, fc.dep, fc.jf);
     });
     F.n_active -= hsumInt(stopped_f);
     S.n_active -= hsumInt(stopped_s);
   }
-  F.write(x0, y0, w, h, bg, full);
-  S.write(x0, y0, w, h, bg, subset);
+  F.write<kAux>(x0, y0, w, h, bg, full);
+  S.write<kAux>(x0, y0, w, h, bg, subset);
+}
+}  // namespace
+
+// Depth and contributors for both renders or for neither (full.depth decides).
+void compositeTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0,
+                       int x1, int y1, const float bg[3], const ForwardOut& full, const ForwardOut& subset) {
+  if (full.depth) compositeTilePairImpl<true>(q, in_subset, nq, x0, y0, x1, y1, bg, full, subset);
+  else compositeTilePairImpl<false>(q, in_subset, nq, x0, y0, x1, y1, bg, full, subset);
 }
 
 #if !SARESGS_KERNEL_PAIR_COMPOSITE_ONLY

@@ -652,8 +652,8 @@ void compositeTiles(int W, int H, RasterStateT<T>& st, RenderOutputT<T>& out) {
     // bytes a pixel (6 MB at 512x384) every render.
     out.rgb.resize(P * 3);
     out.alpha.resize(P);
-    out.depth.resize(P);
-    out.contributors.resize(P);
+    out.depth.resize(st.settings.depth_and_contributors ? P : 0);
+    out.contributors.resize(st.settings.depth_and_contributors ? P : 0);
     st.final_T.resize(P);
     st.n_walked.resize(P);
   } else {
@@ -674,11 +674,12 @@ void compositeTiles(int W, int H, RasterStateT<T>& st, RenderOutputT<T>& out) {
       int x0, y0, x1, y1;
       tilePixels(st, tile, W, H, x0, y0, x1, y1);
       if constexpr (std::is_same_v<T, float>) {
+        const bool aux = rs.depth_and_contributors;
         const raster_kernels::ForwardOut fo{W,
                                             out.rgb.data(),
                                             out.alpha.data(),
-                                            out.depth.data(),
-                                            out.contributors.data(),
+                                            aux ? out.depth.data() : nullptr,
+                                            aux ? out.contributors.data() : nullptr,
                                             st.final_T.data(),
                                             st.n_walked.data()};
         kKernelSets[st.isa].composite(q.data(), static_cast<int>(q.size()), x0, y0, x1, y1, bg, fo);
@@ -687,6 +688,13 @@ void compositeTiles(int W, int H, RasterStateT<T>& st, RenderOutputT<T>& out) {
       }
     });
   });
+  if constexpr (!std::is_same_v<T, float>) {
+    // The generic path computes them all the same (it serves tests, not training).
+    if (!rs.depth_and_contributors) {
+      out.depth.clear();
+      out.contributors.clear();
+    }
+  }
 }
 
 }  // namespace
@@ -906,8 +914,11 @@ constexpr PairKernelSet kPairKernelSets[] = {
 // The public result of a float render (rasterize() and rasterizeWithSubset()), moved
 // into `r` (no copy, no allocation).
 void toRenderResult(RenderOutputT<float>&& o, RenderResult& r) {
-  r.rgb.width = r.alpha.width = r.depth.width = o.width;
-  r.rgb.height = r.alpha.height = r.depth.height = o.height;
+  r.rgb.width = r.alpha.width = o.width;
+  r.rgb.height = r.alpha.height = o.height;
+  // 0 x 0 when the render left it out (RasterSettings::depth_and_contributors).
+  r.depth.width = o.depth.empty() ? 0 : o.width;
+  r.depth.height = o.depth.empty() ? 0 : o.height;
   r.rgb.channels = 3;
   r.alpha.channels = r.depth.channels = 1;
   r.rgb.data = std::move(o.rgb);
@@ -942,13 +953,21 @@ RenderOutputT<float> fromRenderResult(RenderResult& r) {
 
 // Sized, not cleared: the pair kernel writes every value of every pixel of both renders
 // (ForwardState::write), as the single one does (compositeTiles).
-void allocateImages(int W, int H, RenderOutputT<float>& out) {
+void allocateImages(int W, int H, bool depth_and_contributors, RenderOutputT<float>& out) {
   out.width = W;
   out.height = H;
-  out.rgb.resize(static_cast<std::size_t>(W) * H * 3);
-  out.alpha.resize(static_cast<std::size_t>(W) * H);
-  out.depth.resize(static_cast<std::size_t>(W) * H);
-  out.contributors.resize(static_cast<std::size_t>(W) * H);
+  const std::size_t P = static_cast<std::size_t>(W) * H;
+  out.rgb.resize(P * 3);
+  out.alpha.resize(P);
+  out.depth.resize(depth_and_contributors ? P : 0);
+  out.contributors.resize(depth_and_contributors ? P : 0);
+}
+
+// The kernels' view of a render's images (depth and contributors null when left out).
+raster_kernels::ForwardOut forwardOut(int W, RenderOutputT<float>& out, float* final_T, std::uint32_t* n_walked) {
+  const bool aux = !out.depth.empty();
+  return {W, out.rgb.data(), out.alpha.data(), aux ? out.depth.data() : nullptr,
+          aux ? out.contributors.data() : nullptr, final_T, n_walked};
 }
 
 }  // namespace
@@ -984,17 +1003,15 @@ void rasterizeWithSubset(const Gaussians& g, const Camera& cam, const RasterSett
       sub.visible[i] = full.visible[i];
     }
 
-  allocateImages(W, H, full);
-  allocateImages(W, H, sub);
+  allocateImages(W, H, s.depth_and_contributors, full);
+  allocateImages(W, H, s.depth_and_contributors, sub);
   st->final_T.resize(static_cast<std::size_t>(W) * H);
   st->n_walked.resize(static_cast<std::size_t>(W) * H);
   ss->final_T.resize(static_cast<std::size_t>(W) * H);
   ss->n_walked.resize(static_cast<std::size_t>(W) * H);
   const float bg[3] = {s.background[0], s.background[1], s.background[2]};
-  const raster_kernels::ForwardOut fo_full{W, full.rgb.data(), full.alpha.data(), full.depth.data(),
-                                           full.contributors.data(), st->final_T.data(), st->n_walked.data()};
-  const raster_kernels::ForwardOut fo_sub{W, sub.rgb.data(), sub.alpha.data(), sub.depth.data(),
-                                          sub.contributors.data(), ss->final_T.data(), ss->n_walked.data()};
+  const raster_kernels::ForwardOut fo_full = forwardOut(W, full, st->final_T.data(), st->n_walked.data());
+  const raster_kernels::ForwardOut fo_sub = forwardOut(W, sub, ss->final_T.data(), ss->n_walked.data());
   const raster_kernels::CompositePairFn kernel = kPairKernelSets[st->isa].composite;
   arena(*st).execute([&] {
     tbb::parallel_for(0, st->tiles_x * st->tiles_y, [&](int tile) {

@@ -139,9 +139,14 @@ std::optional<std::pair<const char*, std::size_t>> firstNonFinite(const Gaussian
 
 }  // namespace
 
-ViewLoss viewLossAndGradient(const Gaussians& g, const Camera& cam, const RasterSettings& s, const ImageF& target,
-                             double lambda_ssim, const ResidualOptions& res, std::mt19937_64& rng, Gaussians& grad,
-                             std::vector<float>& grad_mean2d, StageSeconds& seconds, StepBuffers& buffers) {
+ViewLoss viewLossAndGradient(const Gaussians& g, const Camera& cam, const RasterSettings& settings,
+                             const ImageF& target, double lambda_ssim, const ResidualOptions& res, std::mt19937_64& rng,
+                             Gaussians& grad, std::vector<float>& grad_mean2d, StageSeconds& seconds,
+                             StepBuffers& buffers) {
+  // A step reads the renders' colours (and the state their backward keeps), never their
+  // depth or contributor counts: the kernels skip them.
+  RasterSettings s = settings;
+  s.depth_and_contributors = false;
   ViewLoss out;
   // One branch: render (optionally a subset), loss, backward scaled by `weight`.
   auto branch = [&](std::span<const std::uint8_t> mask, double weight) {

@@ -300,3 +300,85 @@ TEST(SubsetPair, RejectsBadInputs) {
   EXPECT_THROW(rasterizeBackwardWithSubset(g, cam, s, p, dl, lossImage(20, 20, 1, 1.0f), grad),
                std::invalid_argument);
 }
+
+// RasterSettings::depth_and_contributors = false (a training step's renders): depth and
+// contributors are left empty, and every other output of the single and the pair render,
+// and the gradients their backward passes give, are those of the full render bit for bit,
+// for every kernel set, one and two threads, and into reused results in either order.
+TEST(SubsetPair, LeavingOutDepthAndContributorsChangesNothingElse) {
+  for (PairCase& c : cases()) {
+    SCOPED_TRACE(c.name);
+    const int W = c.cam.K.width, H = c.cam.K.height;
+    const ImageF dl_full = lossImage(W, H, 41, 0.5f), dl_sub = lossImage(W, H, 42, 0.5f);
+    for (const auto& [kname, kernels] : test::runnableKernels()) {
+      SCOPED_TRACE(kname);
+      for (int threads : {1, 2}) {
+        SCOPED_TRACE(threads);
+        RasterSettings on = c.s;
+        on.execution.kernels = kernels;
+        on.execution.threads = threads;
+        RasterSettings off = on;
+        off.depth_and_contributors = false;
+        auto expectLeftOut = [&](const RenderResult& r) {
+          EXPECT_TRUE(r.depth.data.empty());
+          EXPECT_EQ(r.depth.width, 0);
+          EXPECT_EQ(r.depth.height, 0);
+          EXPECT_TRUE(r.contributors.empty());
+          EXPECT_EQ(r.rgb.width, W);
+          EXPECT_EQ(r.alpha.height, H);
+        };
+        auto expectSameButLeftOut = [&](const RenderResult& full, const RenderResult& lean) {
+          expectLeftOut(lean);
+          EXPECT_TRUE(full.rgb.data == lean.rgb.data);
+          EXPECT_TRUE(full.alpha.data == lean.alpha.data);
+          EXPECT_TRUE(full.radii == lean.radii);
+          EXPECT_TRUE(full.visible == lean.visible);
+          // The comparison is not vacuous: the full render has them.
+          EXPECT_EQ(full.depth.data.size(), static_cast<std::size_t>(W) * H);
+          EXPECT_EQ(full.contributors.size(), static_cast<std::size_t>(W) * H);
+        };
+        // The single render, fresh and into a result that held a full render (and back).
+        const RenderResult single_on = rasterize(c.g, c.cam, on);
+        RenderResult reused = rasterize(c.g, c.cam, on);
+        rasterize(c.g, c.cam, off, {}, reused);
+        expectSameButLeftOut(single_on, reused);
+        expectSameButLeftOut(single_on, rasterize(c.g, c.cam, off));
+        rasterize(c.g, c.cam, on, {}, reused);
+        expectSameRender(single_on, reused);
+        auto singleGrads = [&](const RasterSettings& s) {
+          Grads r{c.g.zerosLike(), std::vector<float>(2 * c.g.size(), 0.0f)};
+          const RenderResult f = rasterize(c.g, c.cam, s);
+          rasterizeBackward(c.g, c.cam, s, f, dl_full, r.grad, &r.mean2d);
+          return r;
+        };
+        EXPECT_TRUE(singleGrads(on) == singleGrads(off));
+        // The pair.
+        const RenderPair pair_on = rasterizeWithSubset(c.g, c.cam, on, c.mask);
+        RenderPair pair_reused = rasterizeWithSubset(c.g, c.cam, on, c.mask);
+        rasterizeWithSubset(c.g, c.cam, off, c.mask, pair_reused);
+        expectSameButLeftOut(pair_on.full, pair_reused.full);
+        expectSameButLeftOut(pair_on.subset, pair_reused.subset);
+        rasterizeWithSubset(c.g, c.cam, on, c.mask, pair_reused);
+        expectSameRender(pair_on.full, pair_reused.full);
+        expectSameRender(pair_on.subset, pair_reused.subset);
+        auto pairGrads = [&](const RasterSettings& s) {
+          Grads r{c.g.zerosLike(), std::vector<float>(2 * c.g.size(), 0.0f)};
+          const RenderPair p = rasterizeWithSubset(c.g, c.cam, s, c.mask);
+          rasterizeBackwardWithSubset(c.g, c.cam, s, p, dl_full, dl_sub, r.grad, &r.mean2d);
+          return r;
+        };
+        EXPECT_TRUE(pairGrads(on) == pairGrads(off));
+      }
+    }
+  }
+  // The generic (double) path leaves them out too.
+  const PairCase& c = cases().front();
+  RasterSettings off = c.s;
+  off.depth_and_contributors = false;
+  const GaussiansD gd = c.g.cast<double>();
+  const auto on_d = rasterizeT(gd, c.cam, c.s), off_d = rasterizeT(gd, c.cam, off);
+  EXPECT_TRUE(off_d.depth.empty());
+  EXPECT_TRUE(off_d.contributors.empty());
+  EXPECT_FALSE(on_d.depth.empty());
+  EXPECT_TRUE(on_d.rgb == off_d.rgb);
+}
