@@ -372,7 +372,8 @@ TEST(SubsetPair, LeavingOutDepthAndContributorsChangesNothingElse) {
     }
   }
   // The generic (double) path leaves them out too.
-  const PairCase& c = cases().front();
+  const std::vector<PairCase> all = cases();
+  const PairCase& c = all.front();
   RasterSettings off = c.s;
   off.depth_and_contributors = false;
   const GaussiansD gd = c.g.cast<double>();
