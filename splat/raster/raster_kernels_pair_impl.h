@@ -41,11 +41,18 @@ void compositeTilePairImpl(const TileGaussian<float>* q, const std::uint8_t* in_
     if (!do_full && !do_sub) continue;
     const ForwardColour fc(q[j], j);
     vi stopped_f = vi{} + 0, stopped_s = vi{} + 0;
-    forEachBlock(q[j], x0, y0, x1, y1, [&](int blk, const Lanes& Ln, vf) {
-      // masks are -1 where true
-      if (do_full) stopped_f -= F.step<kAux>(F.b[blk], Ln, fc.col0, fc.col1, fc.col2, fc.dep, fc.jf);
-      if (do_sub) stopped_s -= S.step<kAux>(S.b[blk], Ln, fc.col0, fc.col1, fc.col2, fc.dep, fc.jf);
-    });
+    // The block loop, one instantiation per set of live branches (as in the backward), so
+    // that the loop carries no per-block test of which branches run.
+    auto walk = [&]<bool kFull, bool kSub>() {
+      forEachBlock(q[j], x0, y0, x1, y1, [&](int blk, const Lanes& Ln, vf) {
+        // masks are -1 where true
+        if constexpr (kFull) stopped_f -= F.template step<kAux>(F.b[blk], Ln, fc.col0, fc.col1, fc.col2, fc.dep, fc.jf);
+        if constexpr (kSub) stopped_s -= S.template step<kAux>(S.b[blk], Ln, fc.col0, fc.col1, fc.col2, fc.dep, fc.jf);
+      });
+    };
+    if (do_full && do_sub) walk.template operator()<true, true>();
+    else if (do_full) walk.template operator()<true, false>();
+    else walk.template operator()<false, true>();
     F.n_active -= hsumInt(stopped_f);
     S.n_active -= hsumInt(stopped_s);
   }
