@@ -118,7 +118,12 @@ if [ "$mode" = accept ]; then
     bin=$new; [ $who = base ] && bin=$base
     k=$((k + 1))
     extra=""
-    if $bin active --help | grep -q -- --no-plain-refit; then extra=--no-plain-refit; fi
+    # The help is read whole before the test: under pipefail, `grep -q` leaving at its first
+    # match could end the writer by SIGPIPE and make the test false. Until 2026-11-28 it did,
+    # every time, so every sitting ran this tree's main job with the plain refit, a second
+    # 1600-iteration fit that scripts/main.sh leaves out and b0ae65c does not have.
+    help=$($bin active --help)
+    if grep -q -- --no-plain-refit <<< "$help"; then extra=--no-plain-refit; fi
     sec=$(timed $bin active --dataset out/builtin --method sa-resgs --preset quick --seed 0 $extra --out "$work/main_$k")
     psnr=$(/usr/bin/python3 -c "import json, sys; print(json.load(open(sys.argv[1]))['final_fit']['psnr'])" "$work/main_$k/results.json")
     rec $who main "{\"seconds\": $sec, \"final_fit_psnr\": $psnr, \"lines\": $(wc -l < "$work/log"), \"args\": \"$extra\"}"
