@@ -53,9 +53,10 @@ struct RasterSettings {
   std::array<float, 3> background{0.0f, 0.0f, 0.0f};
   RasterExecution execution;  // threads and SIMD kernels (splat/raster_execution.h)
   // false: RenderResult::depth (0 x 0) and contributors are left empty, neither computed
-  // nor written. A training step reads neither (viewLossAndGradient sets it), and the
-  // forward kernels' per-pixel step is shorter without them; every other output, the
-  // backward state included, is the same bit for bit.
+  // nor written. A training step and the Fisher pass's render read neither
+  // (viewLossAndGradient and addViewInformation set it), and the forward kernels'
+  // per-pixel step is shorter without them; every other output, the backward state
+  // included, is the same bit for bit.
   bool depth_and_contributors = true;
 };
 

@@ -610,8 +610,8 @@ void compositeTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1,
 // The machine's floor for the forward kernel's arithmetic (raster_kernels.h): the same
 // per-lane work as a training step's compositeTile on the lattice (forEachBlock: G and its
 // step factor multiplied on, the opacity, the alpha clamp, the rectangle and alpha tests,
-// and ForwardState::step without the depth and contributor sums) on two blocks held in registers, with no tile walk, gather or
-// memory traffic, for n rounds. Each round starts from a G that moves with the round
+// and ForwardState::step without the depth and contributor sums) on two blocks held in
+// registers, with no tile walk, gather or memory traffic, for n rounds. Each round starts from a G that moves with the round
 // count, cycling through [0.3, 0.8) so that every value stays a normal float (offsets
 // that grew without bound sent an earlier version of this loop into denormal operands,
 // whose assists made the "floor" 5-7 times slower than the kernels' arithmetic); the
