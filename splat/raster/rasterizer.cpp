@@ -641,19 +641,34 @@ void binAndSort(const TileCover& cover, int W, int H, RasterStateT<T>& st) {
   });
 }
 
+// A float render's images, sized, not cleared: the float kernels write every value of
+// every pixel of every tile (ForwardState::write), and clearing the images first cost a
+// serial memset of 32 bytes a pixel (6 MB at 512x384) every render. Depth and
+// contributors are left empty unless asked for (RasterSettings::depth_and_contributors).
+void allocateImages(int W, int H, bool depth_and_contributors, RenderOutputT<float>& out) {
+  out.width = W;
+  out.height = H;
+  const std::size_t P = static_cast<std::size_t>(W) * H;
+  out.rgb.resize(P * 3);
+  out.alpha.resize(P);
+  out.depth.resize(depth_and_contributors ? P : 0);
+  out.contributors.resize(depth_and_contributors ? P : 0);
+}
+
+// The kernels' view of a render's images (depth and contributors null when left out).
+raster_kernels::ForwardOut forwardOut(int W, RenderOutputT<float>& out, float* final_T, std::uint32_t* n_walked) {
+  const bool aux = !out.depth.empty();
+  return {W, out.rgb.data(), out.alpha.data(), aux ? out.depth.data() : nullptr,
+          aux ? out.contributors.data() : nullptr, final_T, n_walked};
+}
+
 // Composites every tile front to back (float: the SIMD kernels of st.isa) into `out`,
 // keeping each pixel's final transmittance and walk length for the backward pass.
 template <typename T>
 void compositeTiles(int W, int H, RasterStateT<T>& st, RenderOutputT<T>& out) {
   const std::size_t P = static_cast<std::size_t>(W) * H;
   if constexpr (std::is_same_v<T, float>) {
-    // Sized, not cleared: the float kernels write every value of every pixel of every tile
-    // (ForwardState::write), and clearing the six images first cost a serial memset of 32
-    // bytes a pixel (6 MB at 512x384) every render.
-    out.rgb.resize(P * 3);
-    out.alpha.resize(P);
-    out.depth.resize(st.settings.depth_and_contributors ? P : 0);
-    out.contributors.resize(st.settings.depth_and_contributors ? P : 0);
+    allocateImages(W, H, st.settings.depth_and_contributors, out);
     st.final_T.resize(P);
     st.n_walked.resize(P);
   } else {
@@ -674,14 +689,7 @@ void compositeTiles(int W, int H, RasterStateT<T>& st, RenderOutputT<T>& out) {
       int x0, y0, x1, y1;
       tilePixels(st, tile, W, H, x0, y0, x1, y1);
       if constexpr (std::is_same_v<T, float>) {
-        const bool aux = rs.depth_and_contributors;
-        const raster_kernels::ForwardOut fo{W,
-                                            out.rgb.data(),
-                                            out.alpha.data(),
-                                            aux ? out.depth.data() : nullptr,
-                                            aux ? out.contributors.data() : nullptr,
-                                            st.final_T.data(),
-                                            st.n_walked.data()};
+        const raster_kernels::ForwardOut fo = forwardOut(W, out, st.final_T.data(), st.n_walked.data());
         kKernelSets[st.isa].composite(q.data(), static_cast<int>(q.size()), x0, y0, x1, y1, bg, fo);
       } else {
         compositeTile(q, x0, y0, x1, y1, bg, W, out, st);
@@ -951,24 +959,6 @@ RenderOutputT<float> fromRenderResult(RenderResult& r) {
   return o;
 }
 
-// Sized, not cleared: the pair kernel writes every value of every pixel of both renders
-// (ForwardState::write), as the single one does (compositeTiles).
-void allocateImages(int W, int H, bool depth_and_contributors, RenderOutputT<float>& out) {
-  out.width = W;
-  out.height = H;
-  const std::size_t P = static_cast<std::size_t>(W) * H;
-  out.rgb.resize(P * 3);
-  out.alpha.resize(P);
-  out.depth.resize(depth_and_contributors ? P : 0);
-  out.contributors.resize(depth_and_contributors ? P : 0);
-}
-
-// The kernels' view of a render's images (depth and contributors null when left out).
-raster_kernels::ForwardOut forwardOut(int W, RenderOutputT<float>& out, float* final_T, std::uint32_t* n_walked) {
-  const bool aux = !out.depth.empty();
-  return {W, out.rgb.data(), out.alpha.data(), aux ? out.depth.data() : nullptr,
-          aux ? out.contributors.data() : nullptr, final_T, n_walked};
-}
 
 }  // namespace
 
