@@ -108,7 +108,12 @@ if [ "$mode" = accept ]; then
     for who in new base; do
       bin=$new; [ $who = base ] && bin=$base
       sec=$(timed $bin train --dataset out/bench_room360_512x384 --iterations 300 --threads 2 --out "$work/train_$who")
-      rec $who train "{\"seconds\": $sec, \"iterations\": 300}"
+      # Beside the command's wall time: the training's own seconds (results.json) and, for a
+      # binary that decodes the images before training (since 5627716; b0ae65c decodes each
+      # one inside the step that first reads it), that decoding's milliseconds from the log.
+      loop=$(/usr/bin/python3 -c "import json, sys; print(json.load(open(sys.argv[1]))['train_seconds_this_run'])" "$work/train_$who/results.json")
+      decode_ms=$(sed -n 's/^decoded [0-9]* images in \([0-9]*\) ms$/\1/p' "$work/log")
+      rec $who train "{\"seconds\": $sec, \"train_seconds\": $loop, \"decode_ms\": ${decode_ms:-0}, \"iterations\": 300}"
     done
   done
   # Two rounds in the order new, base, base, new: one run each swung by 10 % with the VM's
@@ -142,7 +147,10 @@ measures = [
     ("residual / plain step (20k)", "residual", lambda d: d.get("residual_to_plain_ratio", nan), "<= 1.25"),
     ("bench fisher / backward", "fisher", lambda d: d["fisher_to_backward_ratio"], "<= 1.0"),
     ("heap allocations per step", "step20k", lambda d: d.get("allocations_per_step", nan), "0 after the first"),
-    ("saresgs train room360 512x384, it/s", "train", lambda d: d["iterations"] / d["seconds"], ">= 2.17x"),
+    ("saresgs train room360 512x384, it/s of the training (its loop and the image decoding)", "train",
+     lambda d: d["iterations"] / (d["train_seconds"] + d["decode_ms"] / 1000) if "train_seconds" in d else nan, ">= 2.17x"),
+    ("saresgs train room360 512x384, it/s of the whole command", "train", lambda d: d["iterations"] / d["seconds"],
+     "(the loading, the evaluation of 19 test views and the writing too)"),
     ("main job, s", "main", lambda d: d["seconds"], "<= 0.64x"),
     ("main job final-fit PSNR, dB", "main", lambda d: d["final_fit_psnr"], ">= 25.7"),
     ("main job lines of output", "main", lambda d: d["lines"], "<= 200"),

@@ -363,8 +363,13 @@ RenderResult Trainer::render(const Camera& cam) const { return rasterize(g_, cam
 Evaluation Trainer::evaluate(const std::vector<int>& views, bool keep_renders) const {
   Evaluation e;
   ImageF gt;
+  // One render's buffers for every view, and the colour only (no depth or contributor
+  // sums: the metrics read neither).
+  RasterSettings s = rasterSettings();
+  s.depth_and_contributors = false;
+  RenderResult r;
   for (int v : views) {
-    const RenderResult r = render(scene_.views.at(static_cast<std::size_t>(v)).camera);
+    rasterize(g_, scene_.views.at(static_cast<std::size_t>(v)).camera, s, {}, r);
     toFloatInto(scene_.image(v), gt);
     e.views.push_back({v, psnr(r.rgb, gt), ssim(r.rgb, gt)});
     if (keep_renders) e.renders.push_back(toByte(r.rgb));
