@@ -63,11 +63,11 @@ struct BackwardIn {
 using CompositeFn = void (*)(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1,
                              const float bg[3], const ForwardOut& out);
 // The back-to-front walk of a tile: for each tile entry jj its 9 gradient sums
-// (opacity, mean2d 2, conic 3, colour 3) go to slots[entry_slot[jj] * 9] (every entry's
-// slot is written, zeros where no pixel reaches it).
+// (opacity, mean2d 2, conic 3, colour 3) go to slots[jj * 9], `slots` being the tile's
+// first entry's slot: slots follow the tile lists, so a tile's are one run of memory
+// (every entry's slot is written, zeros where no pixel reaches it).
 using BackwardFn = void (*)(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1,
-                            const float bg[3], const BackwardIn& in, const std::uint32_t* entry_slot,
-                            float* slots);
+                            const float bg[3], const BackwardIn& in, float* slots);
 
 // FisherRF's squared-gradient pass (splat/fisher.h) works on the per-pixel gradient of
 // C_r + C_g + C_b, which is linear in a contribution's 2D inputs: dL/dalpha times G (e,
@@ -92,10 +92,11 @@ struct FisherIn {
 };
 
 // The back-to-front walk of a tile for the objective C_r + C_g + C_b: for each tile
-// entry jj its kFisherSlot moments go to slots[entry_slot[jj] * kFisherSlot] (every
-// entry's slot is written, zeros where no pixel reaches it).
+// entry jj its kFisherSlot moments go to slots[jj * kFisherSlot], `slots` being the
+// tile's first entry's slot (every entry's slot is written, zeros where no pixel reaches
+// it).
 using FisherFn = void (*)(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1,
-                          const float bg[3], const FisherIn& in, const std::uint32_t* entry_slot, float* slots);
+                          const float bg[3], const FisherIn& in, float* slots);
 
 // What the projection kernels (splat/raster/project_kernels_impl.h) read: the model's
 // arrays (GaussiansT<float>'s storage), the camera in float (projection::CameraT<float>)
@@ -181,12 +182,12 @@ void projectRange(const ProjectIn& in, std::size_t begin, std::size_t end, proje
 
 namespace base4 {
 void fisherTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
-                const FisherIn& in, const std::uint32_t* entry_slot, float* slots);
+                const FisherIn& in, float* slots);
 }  // namespace base4
 
 namespace avx2 {
 void fisherTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
-                const FisherIn& in, const std::uint32_t* entry_slot, float* slots);
+                const FisherIn& in, float* slots);
 }  // namespace avx2
 
 // The AVX2 Fisher kernel's arithmetic on AVX-512VL's 32 registers, its moments summed in
@@ -196,9 +197,9 @@ namespace avx512 {
 // False when this build has no AVX-512 kernel (not x86-64, or not GCC/Clang).
 bool compiled();
 void fisherTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
-                const FisherIn& in, const std::uint32_t* entry_slot, float* slots);
+                const FisherIn& in, float* slots);
 void backwardTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
-                  const BackwardIn& in, const std::uint32_t* entry_slot, float* slots);
+                  const BackwardIn& in, float* slots);
 }  // namespace avx512
 
 // compositeTile's per-lane arithmetic for n rounds of two blocks in registers (no memory
@@ -214,7 +215,7 @@ namespace base4 {
 void compositeTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
                    const ForwardOut& out);
 void backwardTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
-                  const BackwardIn& in, const std::uint32_t* entry_slot, float* slots);
+                  const BackwardIn& in, float* slots);
 }  // namespace base4
 
 namespace avx2 {
@@ -223,7 +224,7 @@ bool compiled();
 void compositeTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
                    const ForwardOut& out);
 void backwardTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
-                  const BackwardIn& in, const std::uint32_t* entry_slot, float* slots);
+                  const BackwardIn& in, float* slots);
 }  // namespace avx2
 
 // A full render and the render of a subset of its Gaussians in one walk of the full tile
@@ -232,20 +233,21 @@ void backwardTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, 
 // kernel's, run on that render's own tile lists, except that the subset's n_walked counts
 // full-list entries. The backward writes the sum of the two branches' sums at the full
 // render's pair slots (every entry's slot, zeros where neither branch walks it): equal to
-// the two single backward passes' slots added, up to float rounding.
+// the two single backward passes' slots added, up to float rounding. `slots` is the tile's
+// first entry's slot, as for BackwardFn.
 using CompositePairFn = void (*)(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0,
                                  int y0, int x1, int y1, const float bg[3], const ForwardOut& full,
                                  const ForwardOut& subset);
 using BackwardPairFn = void (*)(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0,
                                 int y0, int x1, int y1, const float bg[3], const BackwardIn& full,
-                                const BackwardIn& subset, const std::uint32_t* entry_slot, float* slots);
+                                const BackwardIn& subset, float* slots);
 
 namespace base4 {
 void compositeTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0,
                        int x1, int y1, const float bg[3], const ForwardOut& full, const ForwardOut& subset);
 void backwardTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0, int x1,
                       int y1, const float bg[3], const BackwardIn& full, const BackwardIn& subset,
-                      const std::uint32_t* entry_slot, float* slots);
+                      float* slots);
 }  // namespace base4
 
 namespace avx2 {
@@ -253,7 +255,7 @@ void compositeTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subs
                        int x1, int y1, const float bg[3], const ForwardOut& full, const ForwardOut& subset);
 void backwardTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0, int x1,
                       int y1, const float bg[3], const BackwardIn& full, const BackwardIn& subset,
-                      const std::uint32_t* entry_slot, float* slots);
+                      float* slots);
 }  // namespace avx2
 
 // The AVX2 pair kernels on AVX-512VL's 32 registers (raster_kernels_avx512.cpp):
@@ -263,7 +265,7 @@ void compositeTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subs
                        int x1, int y1, const float bg[3], const ForwardOut& full, const ForwardOut& subset);
 void backwardTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0, int x1,
                       int y1, const float bg[3], const BackwardIn& full, const BackwardIn& subset,
-                      const std::uint32_t* entry_slot, float* slots);
+                      float* slots);
 }  // namespace avx512
 
 }  // namespace raster_kernels

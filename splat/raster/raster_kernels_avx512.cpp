@@ -45,7 +45,7 @@ bool compiled() { return true; }
 namespace saresgs::raster_kernels::avx512 {
 bool compiled() { return false; }
 void fisherTile(const TileGaussian<float>*, int, int, int, int, int, const float*, const FisherIn&,
-                const std::uint32_t*, float*) {
+                float*) {
   std::abort();
 }
 void compositeTilePair(const TileGaussian<float>*, const std::uint8_t*, int, int, int, int, int, const float*,
@@ -53,11 +53,11 @@ void compositeTilePair(const TileGaussian<float>*, const std::uint8_t*, int, int
   std::abort();
 }
 void backwardTile(const TileGaussian<float>*, int, int, int, int, int, const float*, const BackwardIn&,
-                  const std::uint32_t*, float*) {
+                  float*) {
   std::abort();
 }
 void backwardTilePair(const TileGaussian<float>*, const std::uint8_t*, int, int, int, int, int, const float*,
-                      const BackwardIn&, const BackwardIn&, const std::uint32_t*, float*) {
+                      const BackwardIn&, const BackwardIn&, float*) {
   std::abort();
 }
 }  // namespace saresgs::raster_kernels::avx512

@@ -805,10 +805,11 @@ struct BackwardColour {
       : col0(vs(g.col[0])), col1(vs(g.col[1])), col2(vs(g.col[2])), jv(vs(static_cast<float>(jj))) {}
 };
 
-// A pair slot no walk reaches (the kernels write every slot, so callers need no cleared
-// buffer).
-inline void zeroSlot(float* slots, std::uint32_t slot) {
-  std::memset(&slots[static_cast<std::size_t>(slot) * kSlot], 0, sizeof(float) * kSlot);
+// The slots of tile entries [from, to), which no walk reaches (the kernels write every
+// slot, so callers need no cleared buffer).
+inline void zeroSlots(float* slots, int from, int to) {
+  if (from < to)
+    std::memset(&slots[static_cast<std::size_t>(from) * kSlot], 0, sizeof(float) * kSlot * static_cast<std::size_t>(to - from));
 }
 
 inline GradSums zeroSums() {
@@ -821,10 +822,10 @@ inline GradSums zeroSums() {
 // cleared buffer.
 template <bool kBg>
 void backwardTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
-                      const BackwardIn& in, const std::uint32_t* entry_slot, float* slots) {
+                      const BackwardIn& in, float* slots) {
   BackwardState B;
   B.init(x0, y0, x1 - x0, y1 - y0, bg, in);
-  for (int jj = static_cast<int>(B.jmax); jj < nq; ++jj) zeroSlot(slots, entry_slot[jj]);
+  zeroSlots(slots, static_cast<int>(B.jmax), nq);
   for (std::uint32_t jj = B.jmax; jj-- > 0;) {
     const TileGaussian<float>& g = q[jj];
     const BackwardColour bc(g, jj);
@@ -835,19 +836,19 @@ void backwardTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int 
       addMoments(s, e, Ln.dx, dy);
       addColours(s, wcol, B.b[blk]);
     });
-    writeSums(g, s, &slots[static_cast<std::size_t>(entry_slot[jj]) * kSlot]);
+    writeSums(g, s, &slots[static_cast<std::size_t>(jj) * kSlot]);
   }
 }
 
 }  // namespace
 
 void backwardTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
-                  const BackwardIn& in, const std::uint32_t* entry_slot, float* slots) {
+                  const BackwardIn& in, float* slots) {
   if (nq == 0) return;
   if (bg[0] != 0.0f || bg[1] != 0.0f || bg[2] != 0.0f)
-    backwardTileImpl<true>(q, nq, x0, y0, x1, y1, bg, in, entry_slot, slots);
+    backwardTileImpl<true>(q, nq, x0, y0, x1, y1, bg, in, slots);
   else
-    backwardTileImpl<false>(q, nq, x0, y0, x1, y1, bg, in, entry_slot, slots);
+    backwardTileImpl<false>(q, nq, x0, y0, x1, y1, bg, in, slots);
 }
 
 // FisherRF's squared-gradient pass (FisherMoment in raster_kernels.h): the backward walk
@@ -859,7 +860,7 @@ namespace {
 
 template <bool kBg>
 void fisherTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, float bg_sum,
-                    const FisherIn& in, const std::uint32_t* entry_slot, float* slots) {
+                    const FisherIn& in, float* slots) {
   constexpr int P = kTile * kTile;
   constexpr int M = kFisherSlot;
   const int w = x1 - x0, h = y1 - y0;
@@ -882,8 +883,8 @@ void fisherTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1
   }
   // Entries no pixel walks have no information; their slots are written here all the
   // same, so that the caller needs no cleared buffer.
-  for (int jj = static_cast<int>(jmax); jj < nq; ++jj)
-    std::memset(&slots[static_cast<std::size_t>(entry_slot[jj]) * M], 0, sizeof(float) * M);
+  if (static_cast<int>(jmax) < nq)
+    std::memset(&slots[static_cast<std::size_t>(jmax) * M], 0, sizeof(float) * M * (nq - jmax));
   const vf zero = vs(0.0f), one = vs(1.0f), bgs = vs(bg_sum);
   // The walk's step at block k (pixel storage index): updates the block's transmittance
   // and colour sum, and gives e = G dL/dalpha (0 where alpha is clamped or the entry does
@@ -1022,7 +1023,7 @@ void fisherTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1
     // array and memcpy, the copy's wide loads each spanned two of the vector stores just
     // made, which a store cannot forward: the load waited for both to reach the cache,
     // about 39 % of this kernel's samples on AVX-512VL in `bench fisher`.)
-    float* sl = &slots[static_cast<std::size_t>(entry_slot[jj]) * M];
+    float* sl = &slots[static_cast<std::size_t>(jj) * M];
     int k = 0;
     for (; k + L <= M; k += L) store(sl + k, transposeSums(m + k));
     if (k < M) {
@@ -1035,13 +1036,13 @@ void fisherTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1
 }  // namespace
 
 void fisherTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
-                const FisherIn& in, const std::uint32_t* entry_slot, float* slots) {
+                const FisherIn& in, float* slots) {
   if (nq == 0) return;
   const float bg_sum = bg[0] + bg[1] + bg[2];
   if (bg_sum != 0.0f)
-    fisherTileImpl<true>(q, nq, x0, y0, x1, y1, bg_sum, in, entry_slot, slots);
+    fisherTileImpl<true>(q, nq, x0, y0, x1, y1, bg_sum, in, slots);
   else
-    fisherTileImpl<false>(q, nq, x0, y0, x1, y1, bg_sum, in, entry_slot, slots);
+    fisherTileImpl<false>(q, nq, x0, y0, x1, y1, bg_sum, in, slots);
 }
 
 }  // namespace saresgs::raster_kernels::SARESGS_KERNEL_NS

@@ -74,7 +74,7 @@ namespace {
 template <bool kBg>
 void backwardTilePairImpl(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0,
                           int x1, int y1, const float bg[3], const BackwardIn& full, const BackwardIn& subset,
-                          const std::uint32_t* entry_slot, float* slots) {
+                          float* slots) {
   const int w = x1 - x0, h = y1 - y0;
   BackwardState F, S;
   F.init(x0, y0, w, h, bg, full);
@@ -82,13 +82,13 @@ void backwardTilePairImpl(const TileGaussian<float>* q, const std::uint8_t* in_s
   const std::uint32_t jmax = F.jmax > S.jmax ? F.jmax : S.jmax;
   // Every entry's slot is written (zeros where neither branch walks it), so the caller
   // needs no cleared buffer.
-  for (int jj = static_cast<int>(jmax); jj < nq; ++jj) zeroSlot(slots, entry_slot[jj]);
+  zeroSlots(slots, static_cast<int>(jmax), nq);
   for (std::uint32_t jj = jmax; jj-- > 0;) {
     // Beyond a branch's walk, or outside the subset, its single-render kernel adds nothing
     // for this entry and its state does not change.
     const bool do_full = jj < F.jmax, do_sub = jj < S.jmax && in_subset[jj] != 0;
     if (!do_full && !do_sub) {
-      zeroSlot(slots, entry_slot[jj]);
+      zeroSlots(slots, static_cast<int>(jj), static_cast<int>(jj) + 1);
       continue;
     }
     const TileGaussian<float>& g = q[jj];
@@ -120,7 +120,7 @@ void backwardTilePairImpl(const TileGaussian<float>* q, const std::uint8_t* in_s
     if (do_full && do_sub) walk.template operator()<true, true>();
     else if (do_full) walk.template operator()<true, false>();
     else walk.template operator()<false, true>();
-    writeSums(g, s, slots + static_cast<std::size_t>(entry_slot[jj]) * kSlot);
+    writeSums(g, s, slots + static_cast<std::size_t>(jj) * kSlot);
   }
 }
 
@@ -128,12 +128,12 @@ void backwardTilePairImpl(const TileGaussian<float>* q, const std::uint8_t* in_s
 
 void backwardTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0, int x1,
                       int y1, const float bg[3], const BackwardIn& full, const BackwardIn& subset,
-                      const std::uint32_t* entry_slot, float* slots) {
+                      float* slots) {
   if (nq == 0) return;
   if (bg[0] != 0.0f || bg[1] != 0.0f || bg[2] != 0.0f)
-    backwardTilePairImpl<true>(q, in_subset, nq, x0, y0, x1, y1, bg, full, subset, entry_slot, slots);
+    backwardTilePairImpl<true>(q, in_subset, nq, x0, y0, x1, y1, bg, full, subset, slots);
   else
-    backwardTilePairImpl<false>(q, in_subset, nq, x0, y0, x1, y1, bg, full, subset, entry_slot, slots);
+    backwardTilePairImpl<false>(q, in_subset, nq, x0, y0, x1, y1, bg, full, subset, slots);
 }
 #endif  // !SARESGS_KERNEL_PAIR_COMPOSITE_ONLY
 
