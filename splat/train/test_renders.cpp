@@ -53,13 +53,19 @@ void writeTestRenders(const Trainer& t, const Evaluation& ev, const std::string&
     sheet[2 * i] = {&t.scene().image(ev.views[i].view), v.name + " truth", false};
     sheet[2 * i + 1] = {&renders[i], std::string("render ") + label, true};
   }
-  // One PNG per view (truth | render), encoded side by side: an encode is single-threaded.
+  // One PNG per view (truth | render) and the sheet of all, encoded side by side (an encode
+  // is single-threaded); the sheet, the longest, first.
   const std::vector<std::string> names = testRenderNames(t.scene(), ev);
-  tbb::parallel_for(std::size_t{0}, n, [&](std::size_t i) {
+  if (n == 0) return;
+  tbb::parallel_for(std::size_t{0}, n + 1, [&](std::size_t k) {
+    if (k == 0) {
+      writeImage(dir + "/all.png", makeContactSheet(sheet, 4, 256));
+      return;
+    }
+    const std::size_t i = k - 1;
     const std::vector<ContactSheetItem> pair(sheet.begin() + 2 * i, sheet.begin() + 2 * i + 2);
     writeImage(dir + "/" + names[i] + ".png", makeContactSheet(pair, 2, renders[i].width));
   });
-  if (!sheet.empty()) writeImage(dir + "/all.png", makeContactSheet(sheet, 4, 256));
 }
 
 }  // namespace saresgs
