@@ -28,6 +28,11 @@ namespace saresgs {
 // px0 > px1) hold every pixel whose centre can pass the float test |i + 0.5 - mean| <=
 // half: the exact bound widened by 1e-6 relative and 1e-3 px, computed once per Gaussian
 // (pixelSpan in rasterizer.cpp) so that a tile's loops start from integer clipping.
+// The kernels bound a Gaussian's block rows by its chords when its pixel span
+// (px1 - px0 + 1) is wider than this (forEachBlock); tileData computes the chords only for
+// such Gaussians and for those whose tiles tileMeets tests.
+inline constexpr int kChordMinSpan = 32;
+
 template <typename T>
 struct TileGaussian {
   T mx, my, a, b, c, o, hx, hy, depth;

@@ -334,7 +334,6 @@ inline vf maskOr0(vi m, vf v) { return reinterpret_cast<vf>(m & reinterpret_cast
 inline vi absLe(vf v, vf bound) { return reinterpret_cast<vf>(reinterpret_cast<vi>(v) & 0x7fffffff) <= bound; }
 
 constexpr int kBlocks = kTile * kTile / L;  // vector blocks per tile
-constexpr int kChordMinSpan = 32;           // pixels (see forEachBlock)
 
 // The lattice (forEachBlock): a Gaussian's base-2 exponent is a quadratic
 // p(dx, dy) = al dx^2 + be dx dy + ga dy^2, so along a row of blocks (dx += kBW) the

@@ -122,7 +122,8 @@ void pixelSpan(T mean, T half, int n, std::int32_t& lo, std::int32_t& hi) {
 // of the terms' sizes, which are at most ~4 kappa k2 with kappa = (a + c)^2 / (4 det)
 // (1 for a circle); k2 is widened by 1% + 1e-4, far more than that for kappa <= 250.
 // Beyond (needle-like Gaussians) or for anything not finite, no chord: the loops then
-// cover the whole rectangle, as they would without these terms.
+// cover the whole rectangle, as they would without these terms. tileData leaves the chords
+// out (the values of "no chord"); tileChords adds them where they will be read.
 template <typename T>
 void tileData(const Projected<T>& P, int W, int H, TileGaussian<T>& q) {
   // Written field by field in place: built on the stack and copied, its 16-byte loads
@@ -143,6 +144,10 @@ void tileData(const Projected<T>& P, int W, int H, TileGaussian<T>& q) {
   q.chord_k1 = T(0);
   pixelSpan(P.mean2d[0], P.half[0], W, q.px0, q.px1);
   pixelSpan(P.mean2d[1], P.half[1], H, q.py0, q.py1);
+}
+
+template <typename T>
+void tileChords(const Projected<T>& P, TileGaussian<T>& q) {
   const double a = P.conic[0], b = P.conic[1], c = P.conic[2], o = P.opacity;
   const double det = a * c - b * b;
   const double k2 = 2.0 * std::log(255.0 * o) * 1.01 + 1e-4;
@@ -553,7 +558,13 @@ void projectAll(const GaussiansT<T>& g, const CameraT<T>& camT, std::span<const 
         if (px0 > px1 || py0 > py1) continue;
         std::array<int, 4>& rect = cover.rect[i];
         rect = {px0 / kTileSize, px1 / kTileSize, py0 / kTileSize, py1 / kTileSize};
-        cover.count[i] = coverTiles(st.tile_data[i], rect, W, H, cover.met[i]);
+        // The chords are read by the kernels' block-row bounds (wide Gaussians) and by
+        // tileMeets (rectangles of kMetMaskMin tiles or more), and by nothing else: most
+        // Gaussians of a large model skip their double logarithm and divisions.
+        TileGaussian<T>& q = st.tile_data[i];
+        if (q.px1 - q.px0 + 1 > kChordMinSpan || (rect[1] - rect[0] + 1) * (rect[3] - rect[2] + 1) >= kMetMaskMin)
+          tileChords(P, q);
+        cover.count[i] = coverTiles(q, rect, W, H, cover.met[i]);
       }
     });
   });
