@@ -808,7 +808,8 @@ struct BackwardColour {
 // slot, so callers need no cleared buffer).
 inline void zeroSlots(float* slots, int from, int to) {
   if (from < to)
-    std::memset(&slots[static_cast<std::size_t>(from) * kSlot], 0, sizeof(float) * kSlot * static_cast<std::size_t>(to - from));
+    std::memset(&slots[static_cast<std::size_t>(from) * kSlot], 0,
+                sizeof(float) * kSlot * static_cast<std::size_t>(to - from));
 }
 
 inline GradSums zeroSums() {

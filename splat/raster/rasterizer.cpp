@@ -48,10 +48,10 @@ struct RasterStateT {
   std::vector<std::uint32_t> tile_start;   // tiles + 1
   std::vector<std::uint32_t> entry_gauss;  // per tile entry: the Gaussian
   // Per pair k (Gaussian-major): its tile entry. The backward and Fisher kernels write a
-  // pair's slot at its tile entry, so that each tile's slots are one run of memory (written
-  // at the Gaussian-major index, from one pair to the next the slots landed on scattered
-  // cache lines: the backward stage of bench step 512x384/100k took 0.8x the time without
-  // that); the per-Gaussian reductions read them through this map, in pair order.
+  // pair's slot at its tile entry, so that each tile's slots are one run of memory (at the
+  // Gaussian-major index the slots of consecutive pairs landed on scattered cache lines, and
+  // the backward stage of bench step 512x384/100k took 1.1-1.2 times as long); the
+  // per-Gaussian reductions read them through this map, in pair order.
   std::vector<std::uint32_t> pair_entry;
   std::vector<T> final_T;                  // per pixel
   std::vector<std::uint32_t> n_walked;     // per pixel: tile entries walked (last contributor + 1)
@@ -189,8 +189,9 @@ void gatherTile(const RasterStateT<T>& st, int tile, std::vector<TileGaussian<T>
   const std::uint32_t b = st.tile_start[tile], e = st.tile_start[tile + 1];
   reserveKept(out, e - b);  // per thread and kept (splat/kept_buffers.h)
   out.resize(e - b);
-  // The entries are scattered over tile_data (depth order): their loads are fetched a few
-  // entries ahead, both cache lines of each (an entry is 76 bytes).
+  // The entries are scattered over tile_data (depth order): their loads are fetched 24
+  // entries ahead, both cache lines of each (an entry is 76 bytes). By perf samples at 100k
+  // Gaussians, 8 or 48 ahead left more time here (docs/PERFORMANCE_TRIED.md).
   constexpr std::uint32_t kAhead = 24;
   const TileGaussian<T>* data = st.tile_data.data();
   for (std::uint32_t k = b; k < e; ++k) {
@@ -909,7 +910,8 @@ void chainSlots(const GaussiansT<T>& g, const Camera& cam, const RasterStateT<T>
           [&](std::size_t i, int k) {
             ProjectedGrad<T> dP;
             for (std::uint32_t s = st.gauss_start[i]; s < st.gauss_start[i + 1]; ++s) {
-              if (s + kSlotsAhead < end_pair) prefetchSlot(&slots[static_cast<std::size_t>(st.pair_entry[s + kSlotsAhead]) * kSlot], kSlot);
+              if (s + kSlotsAhead < end_pair)
+                prefetchSlot(&slots[static_cast<std::size_t>(st.pair_entry[s + kSlotsAhead]) * kSlot], kSlot);
               const T* sl = &slots[static_cast<std::size_t>(st.pair_entry[s]) * kSlot];
               dP.opacity += sl[0];
               dP.mean2d[0] += sl[1];
@@ -1333,7 +1335,9 @@ void squaredGradientsFloat(const Gaussians& g, const Camera& cam, const RenderOu
             double* m = &mo[static_cast<std::size_t>(k) * kFisherSlot];
             std::fill(m, m + kFisherSlot, 0.0);
             for (std::uint32_t s = st.gauss_start[i]; s < st.gauss_start[i + 1]; ++s) {
-              if (s + kSlotsAhead < end_pair) prefetchSlot(&slots[static_cast<std::size_t>(st.pair_entry[s + kSlotsAhead]) * kFisherSlot], kFisherSlot);
+              if (s + kSlotsAhead < end_pair)
+                prefetchSlot(&slots[static_cast<std::size_t>(st.pair_entry[s + kSlotsAhead]) * kFisherSlot],
+                             kFisherSlot);
               const float* sl = &slots[static_cast<std::size_t>(st.pair_entry[s]) * kFisherSlot];
               for (int p = 0; p < kFisherSlot; ++p) m[p] += sl[p];
             }
@@ -1477,7 +1481,8 @@ void rasterizeSquaredGradientsWalkT(const GaussiansT<T>& g, const Camera& cam, c
         if (st.gauss_start[i] == st.gauss_start[i + 1]) continue;
         T acc[kSlot] = {0, 0, 0, 0, 0, 0, 0, 0};
         for (std::uint32_t k = st.gauss_start[i]; k < st.gauss_start[i + 1]; ++k)
-          for (int p = 0; p < kSlot; ++p) acc[p] += slots[static_cast<std::size_t>(st.pair_entry[k]) * kSlot + p];
+          for (int p = 0; p < kSlot; ++p)
+            acc[p] += slots[static_cast<std::size_t>(st.pair_entry[k]) * kSlot + p];
         for (int p = 0; p < 3; ++p) sq.means[3 * i + p] += acc[p];
         for (int p = 0; p < 3; ++p) sq.log_scales[3 * i + p] += acc[3 + p];
         sq.opacities[i] += acc[6];
