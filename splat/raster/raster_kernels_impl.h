@@ -610,12 +610,12 @@ void compositeTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1,
 // per-lane work as a training step's compositeTile on the lattice (forEachBlock: G and its
 // step factor multiplied on, the opacity, the alpha clamp, the rectangle and alpha tests,
 // and ForwardState::step without the depth and contributor sums) on two blocks held in
-// registers, with no tile walk, gather or memory traffic, for n rounds. Each round starts from a G that moves with the round
-// count, cycling through [0.3, 0.8) so that every value stays a normal float (offsets
-// that grew without bound sent an earlier version of this loop into denormal operands,
-// whose assists made the "floor" 5-7 times slower than the kernels' arithmetic); the
-// checksum keeps the result alive. Before 2026-11-27 the floor was evalLanes' exponent
-// and exp2 per block, the kernels' arithmetic before the lattice.
+// registers, with no tile walk, gather or memory traffic, for n rounds. Each round starts
+// from a G that moves with the round count, cycling through [0.3, 0.8) so that every value
+// stays a normal float (offsets that grew without bound sent an earlier version of this
+// loop into denormal operands, whose assists made the "floor" 5-7 times slower than the
+// kernels' arithmetic); the checksum keeps the result alive. Before 2026-11-27 the floor
+// was evalLanes' exponent and exp2 per block, the kernels' arithmetic before the lattice.
 float compositeFloor(long n) {
   ForwardBlock b[2];
   for (ForwardBlock& B : b) {

@@ -425,14 +425,19 @@ struct TileCover {
 };
 constexpr int kMetMaskMin = 5, kMetMaskMax = 64;
 
+// Whether forEachTileMet tests rect's tiles with tileMeets (which reads the chords):
+// up to 2x2 tiles the test costs more than the pairs it saves (bench step's small
+// Gaussians: render 7% slower when every rectangle was tested), so all are kept.
+inline bool tilesTested(const std::array<int, 4>& rect) {
+  return (rect[1] - rect[0] + 1) * (rect[3] - rect[2] + 1) >= kMetMaskMin;
+}
+
 // Calls f(tx, ty) for the tiles of rect (tiles x0, x1, y0, y1, inclusive) that P's alpha
 // ellipse meets (tileMeets), row by row: projection counts them and binning lists them
 // with the same calls.
 template <typename T, typename F>
 void forEachTileMet(const TileGaussian<T>& g, const std::array<int, 4>& rect, int W, int H, F&& f) {
-  // Up to 2x2 tiles the test costs more than the pairs it saves (bench step's small
-  // Gaussians: render 7% slower when every rectangle was tested): all are kept.
-  const bool test = (rect[1] - rect[0] + 1) * (rect[3] - rect[2] + 1) >= kMetMaskMin;
+  const bool test = tilesTested(rect);
   for (int ty = rect[2]; ty <= rect[3]; ++ty)
     for (int tx = rect[0]; tx <= rect[1]; ++tx) {
       const int x0 = tx * kTileSize, y0 = ty * kTileSize;
@@ -560,11 +565,10 @@ void projectAll(const GaussiansT<T>& g, const CameraT<T>& camT, std::span<const 
         std::array<int, 4>& rect = cover.rect[i];
         rect = {px0 / kTileSize, px1 / kTileSize, py0 / kTileSize, py1 / kTileSize};
         // The chords are read by the kernels' block-row bounds (wide Gaussians) and by
-        // tileMeets (rectangles of kMetMaskMin tiles or more), and by nothing else: most
-        // Gaussians of a large model skip their double logarithm and divisions.
+        // tileMeets, and by nothing else: most Gaussians of a large model skip their
+        // double logarithm and divisions.
         TileGaussian<T>& q = st.tile_data[i];
-        if (q.px1 - q.px0 + 1 > kChordMinSpan || (rect[1] - rect[0] + 1) * (rect[3] - rect[2] + 1) >= kMetMaskMin)
-          tileChords(P, q);
+        if (q.px1 - q.px0 + 1 > kChordMinSpan || tilesTested(rect)) tileChords(P, q);
         cover.count[i] = coverTiles(q, rect, W, H, cover.met[i]);
       }
     });
@@ -849,14 +853,20 @@ float* keptGradSlots(KeptBuffers<GradSlots>& kept, std::uint32_t pairs) {
   return v.data();
 }
 
-// Fetches a pair slot of `count` values ahead of its use: the per-Gaussian reductions read
-// the slots in pair order, which scatters over the tile-ordered slot buffer.
+// Pair k's slot of `count` values in a tile-ordered slot buffer, with the slot of pair
+// k + 32 fetched ahead (both of its ends): the per-Gaussian reductions read the slots in
+// pair order, which scatters over the buffer. `pairs` bounds the lookahead.
 template <typename T>
-inline void prefetchSlot(const T* p, int count) {
-  __builtin_prefetch(p);
-  __builtin_prefetch(reinterpret_cast<const char*>(p + count) - 1);
+inline const T* pairSlot(const RasterStateT<T>& st, const T* slots, std::uint32_t k, int count,
+                         std::uint32_t pairs) {
+  constexpr std::uint32_t kAhead = 32;
+  if (k + kAhead < pairs) {
+    const T* next = &slots[static_cast<std::size_t>(st.pair_entry[k + kAhead]) * count];
+    __builtin_prefetch(next);
+    __builtin_prefetch(reinterpret_cast<const char*>(next + count) - 1);
+  }
+  return &slots[static_cast<std::size_t>(st.pair_entry[k]) * count];
 }
-constexpr std::uint32_t kSlotsAhead = 32;  // pairs
 
 // The Gaussians of [begin, end) that have tile pairs, listed up to kChunk at a time: for
 // each, add(i, k) sums its pair slots into the caller's k-th entry, and every full or last
@@ -910,9 +920,7 @@ void chainSlots(const GaussiansT<T>& g, const Camera& cam, const RasterStateT<T>
           [&](std::size_t i, int k) {
             ProjectedGrad<T> dP;
             for (std::uint32_t s = st.gauss_start[i]; s < st.gauss_start[i + 1]; ++s) {
-              if (s + kSlotsAhead < end_pair)
-                prefetchSlot(&slots[static_cast<std::size_t>(st.pair_entry[s + kSlotsAhead]) * kSlot], kSlot);
-              const T* sl = &slots[static_cast<std::size_t>(st.pair_entry[s]) * kSlot];
+              const T* sl = pairSlot(st, slots, s, kSlot, end_pair);
               dP.opacity += sl[0];
               dP.mean2d[0] += sl[1];
               dP.mean2d[1] += sl[2];
@@ -987,7 +995,6 @@ RenderOutputT<float> fromRenderResult(RenderResult& r) {
   o.state = std::move(r.state);
   return o;
 }
-
 
 }  // namespace
 
@@ -1335,10 +1342,7 @@ void squaredGradientsFloat(const Gaussians& g, const Camera& cam, const RenderOu
             double* m = &mo[static_cast<std::size_t>(k) * kFisherSlot];
             std::fill(m, m + kFisherSlot, 0.0);
             for (std::uint32_t s = st.gauss_start[i]; s < st.gauss_start[i + 1]; ++s) {
-              if (s + kSlotsAhead < end_pair)
-                prefetchSlot(&slots[static_cast<std::size_t>(st.pair_entry[s + kSlotsAhead]) * kFisherSlot],
-                             kFisherSlot);
-              const float* sl = &slots[static_cast<std::size_t>(st.pair_entry[s]) * kFisherSlot];
+              const float* sl = pairSlot(st, static_cast<const float*>(slots), s, kFisherSlot, end_pair);
               for (int p = 0; p < kFisherSlot; ++p) m[p] += sl[p];
             }
           },
@@ -1480,9 +1484,10 @@ void rasterizeSquaredGradientsWalkT(const GaussiansT<T>& g, const Camera& cam, c
       for (std::size_t i = r.begin(); i < r.end(); ++i) {
         if (st.gauss_start[i] == st.gauss_start[i + 1]) continue;
         T acc[kSlot] = {0, 0, 0, 0, 0, 0, 0, 0};
-        for (std::uint32_t k = st.gauss_start[i]; k < st.gauss_start[i + 1]; ++k)
-          for (int p = 0; p < kSlot; ++p)
-            acc[p] += slots[static_cast<std::size_t>(st.pair_entry[k]) * kSlot + p];
+        for (std::uint32_t k = st.gauss_start[i]; k < st.gauss_start[i + 1]; ++k) {
+          const T* sl = pairSlot(st, slots.data(), k, kSlot, pairs);
+          for (int p = 0; p < kSlot; ++p) acc[p] += sl[p];
+        }
         for (int p = 0; p < 3; ++p) sq.means[3 * i + p] += acc[p];
         for (int p = 0; p < 3; ++p) sq.log_scales[3 * i + p] += acc[3 + p];
         sq.opacities[i] += acc[6];
