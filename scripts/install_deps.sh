@@ -9,6 +9,8 @@ packages=(
   # libraries (one note each in third_party_notes/); OpenVDB's find module needs boost-iostreams too
   libembree-dev libopenvdb-dev libboost-iostreams-dev libtbb-dev libeigen3-dev
   libopencv-dev libcgal-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev libcli11-dev
+  # plain PNGs' inflate (geometry/image/png_decode.cpp)
+  libdeflate-dev
   # COLMAP: the tests convert our models with `colmap model_converter`; `--sfm colmap`
   colmap libsqlite3-dev
   # the Python module (python/): pybind11, Debian's Python headers, NumPy, and pytest for its tests

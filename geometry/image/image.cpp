@@ -2,13 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "geometry/error.h"
+#include "geometry/image/png_decode.h"
 #include "geometry/io/atomic_file.h"
 
 namespace saresgs {
@@ -38,8 +41,35 @@ Image8 toByte(const ImageF& img) {
   return out;
 }
 
+namespace {
+
+// The file's bytes when it starts with PNG's signature (and is under 1 GiB); else none.
+std::optional<std::vector<std::uint8_t>> pngBytes(const std::string& path) {
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (!file) return std::nullopt;
+  std::optional<std::vector<std::uint8_t>> out;
+  std::uint8_t head[8];
+  static constexpr std::uint8_t kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (std::fread(head, 1, 8, file) == 8 && std::memcmp(head, kSignature, 8) == 0 &&
+      std::fseek(file, 0, SEEK_END) == 0) {
+    const long size = std::ftell(file);
+    if (size >= 8 && size < (1L << 30) && std::fseek(file, 0, SEEK_SET) == 0) {
+      std::vector<std::uint8_t> bytes(static_cast<std::size_t>(size));
+      if (std::fread(bytes.data(), 1, bytes.size(), file) == bytes.size()) out = std::move(bytes);
+    }
+  }
+  std::fclose(file);
+  return out;
+}
+
+}  // namespace
+
 Image8 readImage(const std::string& path, bool keep_alpha) {
   if (!std::filesystem::exists(path)) throw InputError(path, "file", "image does not exist");
+  // Plain 8-bit RGB(A) PNGs, most datasets' images, by the fast path (png_decode.h); the
+  // rest, and any file it declines, by OpenCV.
+  if (const auto bytes = pngBytes(path))
+    if (auto img = decodePlainPng(*bytes, keep_alpha)) return std::move(*img);
   cv::Mat m = cv::imread(path, keep_alpha ? cv::IMREAD_UNCHANGED : cv::IMREAD_COLOR);
   if (m.empty()) throw InputError(path, "file", "not a readable PNG/JPEG image");
   if (m.depth() == CV_16U) m.convertTo(m, CV_8U, 1.0 / 257.0);
