@@ -126,6 +126,17 @@ std::optional<Image8> decodePlainPng(std::span<const std::uint8_t> file, bool ke
   }
   const std::size_t row_bytes = std::size_t{width} * bpp, stride = row_bytes + 1;
   const std::size_t raw_size = stride * height;
+  // Deflate expands at most 1032-fold (258 bytes from a 2-bit code, past a block's
+  // overhead): a header that claims more than its stream can hold is declined before the
+  // buffer is sized for it.
+  if (raw_size / 1032 > in_size) return std::nullopt;
+  // A kept buffer that grew past 32 MiB for one large image is released afterwards.
+  struct Trim {
+    ~Trim() {
+      for (std::vector<std::uint8_t>* v : {&joined, &raw})
+        if (v->capacity() > (std::size_t{1} << 25)) std::vector<std::uint8_t>().swap(*v);
+    }
+  } trim;
   raw.resize(raw_size);
   std::size_t used = 0, got = 0;
   if (libdeflate_zlib_decompress_ex(inflater.get(), in, in_size, raw.data(), raw_size, &used, &got) !=

@@ -285,6 +285,15 @@ TEST(PlainPng, DeclinesEveryDamageAndOpenCvJudgesIt) {
     for (int k = 0; k < 4; ++k) b[29 + k] = static_cast<std::uint8_t>(crc >> (24 - 8 * k));
     bad.emplace_back("4194304 x 4194304", b);
   }
+  {
+    // Under the pixel cap but past what its 300-byte stream could inflate to (11 x 600000).
+    Bytes b = good;
+    const std::uint32_t h = 600000;
+    for (int k = 0; k < 4; ++k) b[20 + k] = static_cast<std::uint8_t>(h >> (24 - 8 * k));
+    const std::uint32_t crc = crc32(&b[12], 17);
+    for (int k = 0; k < 4; ++k) b[29 + k] = static_cast<std::uint8_t>(crc >> (24 - 8 * k));
+    bad.emplace_back("11 x 600000", b);
+  }
   for (const auto& [what, b] : bad) {
     SCOPED_TRACE(what);
     EXPECT_FALSE(decodePlainPng(b, true).has_value());
