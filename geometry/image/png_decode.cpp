@@ -116,6 +116,14 @@ std::optional<Image8> decodePlainPng(std::span<const std::uint8_t> file, bool ke
   thread_local std::vector<std::uint8_t> joined, raw;
   if (!inflater) inflater.reset(libdeflate_alloc_decompressor());
   if (!inflater) return std::nullopt;
+  // A kept buffer that grew past 32 MiB for one large image is released on the way out,
+  // whichever way that is.
+  struct Trim {
+    ~Trim() {
+      for (std::vector<std::uint8_t>* v : {&joined, &raw})
+        if (v->capacity() > (std::size_t{1} << 25)) std::vector<std::uint8_t>().swap(*v);
+    }
+  } trim;
   const std::uint8_t* in = f + idat[0].first;
   std::size_t in_size = idat[0].second;
   if (idat.size() > 1) {
@@ -130,13 +138,6 @@ std::optional<Image8> decodePlainPng(std::span<const std::uint8_t> file, bool ke
   // overhead): a header that claims more than its stream can hold is declined before the
   // buffer is sized for it.
   if (raw_size / 1032 > in_size) return std::nullopt;
-  // A kept buffer that grew past 32 MiB for one large image is released afterwards.
-  struct Trim {
-    ~Trim() {
-      for (std::vector<std::uint8_t>* v : {&joined, &raw})
-        if (v->capacity() > (std::size_t{1} << 25)) std::vector<std::uint8_t>().swap(*v);
-    }
-  } trim;
   raw.resize(raw_size);
   std::size_t used = 0, got = 0;
   if (libdeflate_zlib_decompress_ex(inflater.get(), in, in_size, raw.data(), raw_size, &used, &got) !=
