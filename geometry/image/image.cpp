@@ -49,8 +49,7 @@ std::optional<std::vector<std::uint8_t>> pngBytes(const std::string& path) {
   if (!file) return std::nullopt;
   std::optional<std::vector<std::uint8_t>> out;
   std::uint8_t head[8];
-  static constexpr std::uint8_t kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-  if (std::fread(head, 1, 8, file) == 8 && std::memcmp(head, kSignature, 8) == 0 &&
+  if (std::fread(head, 1, 8, file) == 8 && std::memcmp(head, kPngSignature, 8) == 0 &&
       std::fseek(file, 0, SEEK_END) == 0) {
     const long size = std::ftell(file);
     if (size >= 8 && size < (1L << 30) && std::fseek(file, 0, SEEK_SET) == 0) {

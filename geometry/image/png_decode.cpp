@@ -66,8 +66,7 @@ bool unfilterRow(int type, std::uint8_t* row, const std::uint8_t* prev, std::siz
 }  // namespace
 
 std::optional<Image8> decodePlainPng(std::span<const std::uint8_t> file, bool keep_alpha) {
-  static constexpr std::uint8_t kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-  if (file.size() < 8 + 25 || std::memcmp(file.data(), kSignature, 8) != 0) return std::nullopt;
+  if (file.size() < 8 + 25 || std::memcmp(file.data(), kPngSignature, 8) != 0) return std::nullopt;
   const std::uint8_t* const f = file.data();
   const std::size_t size = file.size();
 

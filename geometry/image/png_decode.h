@@ -10,6 +10,9 @@
 
 namespace saresgs {
 
+// The 8 bytes every PNG file starts with.
+inline constexpr std::uint8_t kPngSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+
 // The most pixels the fast path decodes; larger files go to OpenCV, as before.
 inline constexpr std::uint64_t kPlainPngMaxPixels = std::uint64_t{1} << 26;
 
