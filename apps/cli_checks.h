@@ -7,6 +7,8 @@
 #include <cmath>
 #include <string>
 
+#include "geometry/scene/background.h"
+
 namespace saresgs::apps {
 
 // A whole number >= `min` (seeds, counts, caps).
@@ -42,5 +44,25 @@ inline CLI::Validator positiveNumber() {
       },
       "NUMBER>0");
 }
+
+// A background: white, black, random or R,G,B (geometry/scene/background.h).
+inline CLI::Validator backgroundValue() {
+  return CLI::Validator(
+      [](std::string& s) -> std::string {
+        try {
+          parseBackground(s, "--background");
+        } catch (const std::exception&) {
+          return "'" + s + "': expected " + std::string(kBackgroundForms);
+        }
+        return {};
+      },
+      "white|black|R,G,B|random");
+}
+
+// --background's help, the same for every command that takes it.
+inline constexpr const char* kBackgroundHelp =
+    "What stands behind the content: RGBA images are composited on it and every render is against it; random: a "
+    "fresh colour per training step, evaluated on white (default: what the data says: a saresgs scene manifest, "
+    "Blender's white, white for images with alpha; else none)";
 
 }  // namespace saresgs::apps

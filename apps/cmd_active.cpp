@@ -29,7 +29,7 @@ namespace fs = std::filesystem;
 
 // Options as typed; the preset's values apply where an override is not given.
 struct ActiveArgs {
-  std::string dataset, out, method = "adaptive", preset = "quick", fvs_metric = "euclidean", ranking, replay;
+  std::string dataset, out, method = "adaptive", preset = "quick", fvs_metric = "euclidean", ranking, replay, background;
   int downscale = 1, threads = 0;
   bool resume = false, continue_training = false, sub_only = false, time_exhaustive_fisher = false, no_plain_refit = false,
        final_residual = false;
@@ -113,8 +113,9 @@ int runActive(const ActiveArgs& a) {
   ActiveOptions opt = activeOptions(a);
   DatasetOptions dopt;
   dopt.load.downscale = a.downscale;
+  if (!a.background.empty()) dopt.background = parseBackground(a.background, "--background");
   const Scene scene = loadDataset(a.dataset, dopt);
-  std::cerr << formatWarnings(checkDataset(scene, opt.trainer.raster.near_plane));
+  std::cerr << formatWarnings(checkDataset(scene, opt.trainer.raster.near_plane)) << backgroundWarning(scene);
   if (!a.replay.empty()) {
     const RunReport replayed = runReportFromJson(readJsonFile(a.replay), a.replay);
     opt.replay = replaySequence(scene, replayed, a.replay);
@@ -266,6 +267,7 @@ CLI::App* addActiveOptions(CLI::App& app, const std::shared_ptr<ActiveArgs>& a) 
                   "Fixed order: train with this method's training on the views of another run's results.json, in their "
                   "order, instead of selecting (the paper's ablation)");
   sub->add_option("--downscale", a->downscale, "Image downscale factor")->check(CLI::Range(1, 64))->capture_default_str();
+  sub->add_option("--background", a->background, kBackgroundHelp)->check(backgroundValue());
   sub->add_option("--threads", a->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
   sub->add_flag("--resume", a->resume, "Continue the run in OUT from its checkpoint");
   return sub;

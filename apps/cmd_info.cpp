@@ -2,6 +2,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "apps/cli_checks.h"
 #include "apps/commands.h"
 #include "geometry/scene/dataset_checks.h"
 #include "geometry/scene/scene.h"
@@ -13,7 +14,7 @@ namespace saresgs::apps {
 namespace {
 
 struct InfoArgs {
-  std::string dataset;
+  std::string dataset, background;
   DatasetOptions opts;
 };
 
@@ -26,9 +27,21 @@ std::string frameText(const SceneFrame& f) {
   return o.str();
 }
 
+// The background line: the colour (or none), random, and where it came from.
+std::string backgroundLine(const Scene& s) {
+  std::ostringstream o;
+  if (!s.background) o << "none (opaque images; renders are on black)";
+  else if (s.random_background) o << "random per training step, evaluated on " << backgroundText(BackgroundChoice{false, *s.background});
+  else o << backgroundText(BackgroundChoice{false, *s.background});
+  o << " (" << s.background_from << ")";
+  return o.str();
+}
+
 int runInfo(const InfoArgs& a) {
-  const Scene s = loadDataset(a.dataset, a.opts);
-  std::cerr << formatWarnings(checkDataset(s));
+  DatasetOptions opts = a.opts;
+  if (!a.background.empty()) opts.background = parseBackground(a.background, "--background");
+  const Scene s = loadDataset(a.dataset, opts);
+  std::cerr << formatWarnings(checkDataset(s)) << backgroundWarning(s);
   const std::string internal = s.frame.identity() ? "" : " (internal units; the frame below maps them to the world)";
   const Intrinsics& K = s.views.front().camera.K;
   ActiveOptions adaptive;
@@ -45,6 +58,7 @@ int runInfo(const InfoArgs& a) {
             << "  aabb:    [" << s.aabb.min.transpose() << "] .. [" << s.aabb.max.transpose() << "]" << internal << "\n"
             << "  extent:  " << s.extent << internal << "\n"
             << "  frame:   " << frameText(s.frame) << "\n"
+            << "  background: " << backgroundLine(s) << "\n"
             << "  capture: clustering " << captureClustering(s) << " (" << (adaptiveKmedian ? "clustered" : "even")
             << "; `active --method adaptive` gates Fisher by " << (adaptiveKmedian ? "k-median gain" : "farthest view") << ")\n";
   // Reading one image proves the images are there and of the right size.
@@ -62,6 +76,7 @@ void addInfoCommand(CLI::App& app, Action& action) {
   sub->add_option("--dataset", args->dataset, "Dataset folder")->required();
   sub->add_option("--downscale", args->opts.load.downscale, "Image downscale factor (uses images_N if present)")
       ->check(CLI::Range(1, 64));
+  sub->add_option("--background", args->background, kBackgroundHelp)->check(backgroundValue());
   sub->add_option("--test-every", args->opts.test_every, "COLMAP: every N-th view (sorted by name) is a test view")
       ->capture_default_str();
   sub->callback([&action, args] { action = [args] { return runInfo(*args); }; });

@@ -40,7 +40,7 @@ struct TrainArgs {
   int threads = 0;
   int checkpoint_every = 1000;
   bool resume = false;
-  std::string ranking = "both", views;
+  std::string ranking = "both", views, background;
   double schedule_scale = 1.0;
   TrainerOptions opt;
   std::optional<double> memory_budget_gb;
@@ -59,8 +59,9 @@ int runTrain(TrainArgs& a) {
   a.opt.residual.ranking = parseUncertaintyRanking(a.ranking);
   DatasetOptions dopt;
   dopt.load.downscale = a.downscale;
+  if (!a.background.empty()) dopt.background = parseBackground(a.background, "--background");
   const Scene scene = loadDataset(a.dataset, dopt);
-  std::cerr << formatWarnings(checkDataset(scene, a.opt.raster.near_plane));
+  std::cerr << formatWarnings(checkDataset(scene, a.opt.raster.near_plane)) << backgroundWarning(scene);
   if (a.schedule_scale != 1.0) a.opt = scaledSchedule(a.opt, a.schedule_scale);
   const std::vector<int> views = a.views.empty() ? scene.train : parseTrainViews(a.views, scene, "--views");
   fs::create_directories(a.out);
@@ -134,6 +135,7 @@ int runTrain(TrainArgs& a) {
   j["threads"] = rasterThreadCount(a.opt.raster.execution);
   j["residual"] = a.opt.residual.enabled;
   j["frame"] = toJson(scene.frame);
+  j["background"] = backgroundJson(scene);
   const StageSeconds& s = trainer.seconds();
   j["stage_seconds"] = {{"render", s.render}, {"loss", s.loss}, {"backward", s.backward},
                         {"optimizer", s.optimizer}, {"densify", s.densify}};
@@ -157,6 +159,7 @@ void addTrainCommand(CLI::App& app, Action& action) {
   sub->add_option("--out", a->out, "Output folder")->required();
   sub->add_option("--iterations", a->iterations, "Training iterations")->check(CLI::Range(1, 10000000))->capture_default_str();
   sub->add_option("--downscale", a->downscale, "Image downscale factor")->check(CLI::Range(1, 64))->capture_default_str();
+  sub->add_option("--background", a->background, kBackgroundHelp)->check(backgroundValue());
   sub->add_option("--sh-degree", a->opt.max_sh_degree, "Maximum SH degree")->check(CLI::Range(0, 3))->capture_default_str();
   sub->add_option("--seed", a->opt.seed, "Random seed")->check(wholeNumberAtLeast(0))->capture_default_str();
   sub->add_option("--threads", a->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));

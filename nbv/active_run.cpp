@@ -167,6 +167,14 @@ int ActiveRun::selectNext(SelectionLog& log) {
       log.scores = kmedianGains(scene_, selected_, candidates, scene_.train, poseAngleScale(scene_));
       return candidates[argmaxScore(log.scores, candidates)];
     }
+    case Method::kOracle: {
+      // Told the test poses: the k-median gain over them (over the train views where the
+      // dataset has no test split, as the evaluation does).
+      log.candidates = candidates;
+      log.scores = kmedianGains(scene_, selected_, candidates, scene_.test.empty() ? scene_.train : scene_.test,
+                                poseAngleScale(scene_));
+      return candidates[argmaxScore(log.scores, candidates)];
+    }
     case Method::kKmedianFisher:
     case Method::kFvsFisher:
     case Method::kAdaptive: {
@@ -368,7 +376,10 @@ ActiveResult ActiveRun::finish() {
         last_.loss = p.loss_ema;
         report(phase, p.done, opt_.final_iterations);
       });
-      FinalFit f{opt_.final_iterations, to.residual.enabled, t->evaluate(scene_.test.empty() ? scene_.train : scene_.test)};
+      FinalFit f{opt_.final_iterations, to.residual.enabled, t->evaluate(scene_.test.empty() ? scene_.train : scene_.test), {}};
+      std::vector<int> every(scene_.views.size());
+      for (std::size_t i = 0; i < every.size(); ++i) every[i] = static_cast<int>(i);
+      f.path = t->evaluate(every, /*keep_renders=*/false, /*with_ssim=*/false).views;
       return std::make_pair(std::move(t), f);
     };
     auto [model, f] = fit(true, ActivePhase::kFinalFit);

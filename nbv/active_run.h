@@ -140,6 +140,9 @@ struct FinalFit {
   int iterations = 0;
   bool residual = false;  // trained with residual supervision
   Evaluation test;
+  // PSNR (no SSIM) of every view of the dataset, train and test, held or not: the whole
+  // path a person may look along.
+  std::vector<ViewMetrics> path;
 };
 
 struct ActiveResult {

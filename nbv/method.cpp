@@ -39,6 +39,10 @@ constexpr MethodRow kMethodTable[] = {
     // view that brings a held view nearest to the views the model is least sure of
     // (kmedianGains with weights). No setting.
     {Method::kFisherKmedian, "fisher-kmedian", {true, false, false}},
+    // Not a method for real captures: greedy k-median on pose distances over the dataset's
+    // test views, which it is told. What a selector aimed at the views people will look at
+    // could reach with the same budget; the verdict's tables measure the others against it.
+    {Method::kOracle, "oracle", {false, false, false}},
     // A selector function given by the caller (ActiveOptions::custom_selector: the Python
     // module's selectors); plain training, nothing precomputed.
     {Method::kCustom, "custom", {false, false, false}},

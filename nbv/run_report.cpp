@@ -8,6 +8,7 @@
 
 #include "geometry/error.h"
 #include "geometry/io/json_file.h"
+#include "geometry/scene/cameras_json.h"
 #include "splat/train/residual.h"
 
 namespace saresgs {
@@ -95,8 +96,9 @@ RunReport makeRunReport(const Scene& scene, const ActiveOptions& opt, const Acti
     rep.views.push_back({scene.views.at(static_cast<std::size_t>(m.view)).name, m.psnr, m.ssim});
   for (const SelectionLog& s : r.steps) rep.steps.push_back(stepReport(scene, s));
   auto fitReport = [&](const FinalFit& x) {
-    FinalFitReport f{x.iterations, x.residual, x.test.psnr, x.test.ssim, {}};
+    FinalFitReport f{x.iterations, x.residual, x.test.psnr, x.test.ssim, {}, {}};
     for (const ViewMetrics& m : x.test.views) f.views.push_back({scene.views.at(static_cast<std::size_t>(m.view)).name, m.psnr, m.ssim});
+    for (const ViewMetrics& m : x.path) f.path.push_back({scene.views.at(static_cast<std::size_t>(m.view)).name, m.psnr});
     return f;
   };
   if (r.final_fit) rep.final_fit = fitReport(*r.final_fit);
@@ -104,6 +106,7 @@ RunReport makeRunReport(const Scene& scene, const ActiveOptions& opt, const Acti
   rep.replay_of = c.replay_of;
   if (r.prefilter) rep.prefilter_regime = toJson(*r.prefilter);
   rep.frame = scene.frame;
+  rep.background = backgroundJson(scene);
   return rep;
 }
 
@@ -176,6 +179,7 @@ json toJson(const RunReport& r) {
   auto fitJson = [](const FinalFitReport& x) {
     json f = {{"iterations", x.iterations}, {"residual", x.residual}, {"psnr", x.psnr}, {"ssim", x.ssim}};
     for (const ViewReport& v : x.views) f["views"].push_back({{"name", v.name}, {"psnr", v.psnr}, {"ssim", v.ssim}});
+    for (const PathViewReport& v : x.path) f["path"].push_back({{"name", v.name}, {"psnr", v.psnr}});
     return f;
   };
   if (r.final_fit) j["final_fit"] = fitJson(*r.final_fit);
@@ -183,6 +187,7 @@ json toJson(const RunReport& r) {
   if (!r.replay_of.empty()) j["replay_of"] = r.replay_of;
   if (r.prefilter_regime) j["prefilter_regime"] = *r.prefilter_regime;
   if (r.frame) j["frame"] = toJson(*r.frame);
+  if (r.background) j["background"] = *r.background;
   return j;
 }
 
@@ -233,6 +238,12 @@ RunReport runReportFromJson(const json& j, const std::string& src) {
     ff.psnr = field<double>(f, "psnr", src, name);
     ff.ssim = field<double>(f, "ssim", src, name);
     readViews(f, src, std::string(name) + ".views", ff.views);
+    if (f.contains("path")) {
+      const std::string at = std::string(name) + ".path";
+      const json& path = jsonArray(f["path"], src, at);
+      for (std::size_t i = 0; i < path.size(); ++i)
+        ff.path.push_back({field<std::string>(path[i], "name", src, jsonPath(at, i)), field<double>(path[i], "psnr", src, jsonPath(at, i))});
+    }
     return ff;
   };
   if (j.contains("final_fit")) r.final_fit = readFit("final_fit");
@@ -241,6 +252,7 @@ RunReport runReportFromJson(const json& j, const std::string& src) {
   if (j.contains("replay_of")) r.replay_of = field<std::string>(j, "replay_of", src, "");
   if (j.contains("prefilter_regime")) r.prefilter_regime = jsonObject(j["prefilter_regime"], src, "prefilter_regime");
   if (j.contains("frame")) r.frame = sceneFrameFromJson(j["frame"], src, "frame");
+  if (j.contains("background")) r.background = jsonObject(j["background"], src, "background");
   return r;
 }
 

@@ -50,11 +50,18 @@ struct ViewReport {
 // A final fit: a fresh model trained on exactly the chosen views, with residual
 // supervision or plain 3DGS (`residual`; absent in reports written before it was
 // recorded, when every final fit was plain).
+struct PathViewReport {
+  std::string name;
+  double psnr = 0;
+};
 struct FinalFitReport {
   int iterations = 0;
   bool residual = false;
   double psnr = 0, ssim = 0;
   std::vector<ViewReport> views;
+  // PSNR of every view of the dataset (FinalFit::path), as "path": [{"name", "psnr"}];
+  // empty in reports written before it was recorded.
+  std::vector<PathViewReport> path;
 };
 
 struct RunReport {
@@ -89,6 +96,9 @@ struct RunReport {
   // The frame the run computed in (scene_frame.h); absent in reports written before it was
   // recorded, which all ran in the identity frame.
   std::optional<SceneFrame> frame;
+  // The background the run trained and evaluated against (backgroundJson); absent in
+  // reports written before it was recorded.
+  std::optional<nlohmann::json> background;
 };
 
 // Where and how the run was made, which the loop itself does not know.

@@ -83,6 +83,43 @@ Image8 readImage(const std::string& path, bool keep_alpha) {
   return out;
 }
 
+bool imageHasAlpha(const std::string& path) {
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (!file) return false;
+  std::uint8_t head[8];
+  const bool png = std::fread(head, 1, 8, file) == 8 && std::memcmp(head, kPngSignature, 8) == 0;
+  const bool jpeg = !png && head[0] == 0xff && head[1] == 0xd8;
+  bool alpha = false;
+  if (png) {
+    // Chunk headers only (length, type), skipping their data, until the image data: a few
+    // dozen bytes read for any file, however large.
+    for (int chunk = 0; chunk < 64; ++chunk) {
+      std::uint8_t h[8];
+      if (std::fread(h, 1, 8, file) != 8) break;
+      const std::uint32_t length = (std::uint32_t{h[0]} << 24) | (std::uint32_t{h[1]} << 16) | (std::uint32_t{h[2]} << 8) | h[3];
+      const std::string type(reinterpret_cast<const char*>(h + 4), 4);
+      if (type == "IHDR") {
+        std::uint8_t ihdr[13];
+        if (length != 13 || std::fread(ihdr, 1, 13, file) != 13) break;
+        const std::uint8_t colour = ihdr[9];
+        alpha = colour == 4 || colour == 6;
+        if (alpha || std::fseek(file, 4, SEEK_CUR) != 0) break;  // skips the CRC
+        continue;
+      }
+      if (type == "tRNS") alpha = true;
+      if (type == "tRNS" || type == "IDAT" || type == "IEND") break;
+      if (std::fseek(file, static_cast<long>(length) + 4, SEEK_CUR) != 0) break;
+    }
+  }
+  std::fclose(file);
+  if (png || jpeg) return alpha;
+  try {
+    return readImage(path, /*keep_alpha=*/true).channels == 4;
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
 void writeImage(const std::string& path, const Image8& img) {
   const int type = CV_8UC(img.channels);
   cv::Mat m(img.height, img.width, type, const_cast<std::uint8_t*>(img.data.data()));

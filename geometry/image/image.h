@@ -37,6 +37,10 @@ Image8 toByte(const ImageF& img);
 // Reads a PNG/JPEG as RGB or RGBA (alpha kept when `keep_alpha` and present).
 // Throws InputError naming the file when it is missing or unreadable.
 Image8 readImage(const std::string& path, bool keep_alpha = false);
+// Whether the image at `path` carries alpha, from its header when it is a PNG (colour
+// type 4 or 6, or a tRNS chunk before the image data) and false for a JPEG; any other file
+// is decoded to see. A file that cannot be read says false: reading it later gives the error.
+bool imageHasAlpha(const std::string& path);
 // Writes PNG/JPEG by extension, to a temporary name first, then renames.
 void writeImage(const std::string& path, const Image8& img);
 // Area-averaging resize to an exact size (used for downscaled loading).

@@ -1,7 +1,8 @@
 // NeRF-synthetic / Blender folders: transforms_train.json and transforms_test.json; and
 // nerfstudio folders: one transforms.json (ns-process-data's output).
 // Poses are camera-to-world in OpenGL axes (x right, y up, z backward); we flip y and
-// z to reach OpenCV axes. RGBA images are composited on the chosen background. Optional:
+// z to reach OpenCV axes. RGBA images are composited on the scene's background
+// (settleBackground). Optional:
 // points3d.ply (3DGS's point cloud), depth/<stem>.pfm, manifest.json (`saresgs scene`).
 #include <cmath>
 #include <filesystem>
@@ -174,16 +175,21 @@ Scene loadBlenderDataset(const std::string& path, const DatasetOptions& opts) {
               scene, scene.test, full_size, seen);
   if (scene.train.empty())
     throw InputError((root / "transforms_train.json").string(), "frames", "expected at least one frame");
-  scene.background = opts.load.background;
-  // A folder written by `saresgs scene --format blender`: its manifest's sizes must match,
-  // and a room's "background": null means the data has none (its split is the transforms').
+  // The format implies white (NeRF-synthetic's images are composited on it). A folder
+  // written by `saresgs scene --format blender`: its manifest's sizes must match, and a
+  // room's "background": null means the data has none (its split is the transforms').
+  BackgroundRule rule{opts.background, true, std::array<float, 3>{1, 1, 1}, "Blender (white)"};
   if (fs::exists(root / "manifest.json")) {
     const DatasetManifest m = readDatasetManifest((root / "manifest.json").string());
     std::vector<std::string> names;
     for (const SceneView& v : scene.views) names.push_back(v.name);
     checkManifestAgainstViews(m, names, full_size);
-    if (m.background_given) scene.background = m.background;
+    if (m.background_given) {
+      rule.data_color = m.background;
+      rule.data_from = "manifest";
+    }
   }
+  settleBackground(scene, rule);
   // 3DGS's points3d.ply beside the transforms, when there is one.
   if (fs::exists(root / "points3d.ply"))
     for (const PlyPoint& p : readPointsPly((root / "points3d.ply").string())) scene.points.push_back({p.xyz, p.rgb});
@@ -250,6 +256,9 @@ Scene loadNerfstudioDataset(const std::string& path, const DatasetOptions& opts)
     std::sort(scene.test.begin(), scene.test.end());
   }
   if (scene.train.empty()) throw InputError(file, "frames", "no train view left after the split");
+  // nerfstudio's transforms.json says nothing of a background: the user's, else white
+  // when the images have alpha (settleBackground), else none.
+  settleBackground(scene, BackgroundRule{opts.background, false, std::nullopt, ""});
 
   // The initial points: ply_file_path (ns-process-data's sparse_pc.ply).
   if (const json* ply = jsonFind(j, "ply_file_path", file, "")) {

@@ -31,4 +31,12 @@ void writeCamerasJson(const std::string& path, const Scene& scene) {
   writeFileAtomic(path, camerasJson(scene).dump(1) + "\n");
 }
 
+nlohmann::json backgroundJson(const Scene& scene) {
+  nlohmann::json j;
+  j["color"] = scene.background ? nlohmann::json(*scene.background) : nlohmann::json(nullptr);
+  j["random"] = scene.random_background;
+  j["from"] = scene.background_from;
+  return j;
+}
+
 }  // namespace saresgs

@@ -13,6 +13,10 @@
 namespace saresgs {
 
 nlohmann::json camerasJson(const Scene& scene);
+// The scene's background for results.json: {"color": [r, g, b] or null (none), "random":
+// bool (a fresh colour per training step; color is then evaluation's), "from": where it
+// came from (Scene::background_from)}.
+nlohmann::json backgroundJson(const Scene& scene);
 // Written atomically (a temporary name, then renamed).
 void writeCamerasJson(const std::string& path, const Scene& scene);
 

@@ -36,13 +36,18 @@ std::string modelFile(const std::string& dir, const char* stem) {
 // {"train": [names], "test": [names]}); it wins over the every-N-th rule. Its background
 // (null: none) and its size and view count, which the model's cameras must match, are
 // read too. Returns whether it named the split.
-bool applyManifest(const fs::path& manifest, const std::vector<Intrinsics>& full_size, Scene& scene) {
+bool applyManifest(const fs::path& manifest, const std::vector<Intrinsics>& full_size, Scene& scene,
+                   BackgroundRule& background) {
   if (!fs::exists(manifest)) return false;
   const DatasetManifest m = readDatasetManifest(manifest.string());
   std::vector<std::string> names;
   for (const SceneView& v : scene.views) names.push_back(v.name);
   checkManifestAgainstViews(m, names, full_size);
-  if (m.background) scene.background = m.background;
+  if (m.background_given) {
+    background.data_said = true;
+    background.data_color = m.background;
+    background.data_from = "manifest";
+  }
   if (!m.train) return false;
   std::map<std::string, int> index;
   for (int i = 0; i < static_cast<int>(scene.views.size()); ++i) index[scene.views[i].name] = i;
@@ -148,11 +153,15 @@ Scene loadColmapDataset(const std::string& path, const DatasetOptions& opts) {
     if (fs::exists(depth)) v.depth_path = depth.string();
     scene.views.push_back(std::move(v));
   }
-  if (!applyManifest(root / "manifest.json", full_size, scene)) {
+  // The background: the user's, the manifest's, else white when the images have alpha
+  // (settleBackground), else none.
+  BackgroundRule background{opts.background, false, std::nullopt, ""};
+  if (!applyManifest(root / "manifest.json", full_size, scene, background)) {
     for (int i = 0; i < static_cast<int>(scene.views.size()); ++i)
       ((opts.test_every > 0 && i % opts.test_every == 0) ? scene.test : scene.train).push_back(i);
     if (scene.train.empty()) scene.train.swap(scene.test);  // a single view trains
   }
+  settleBackground(scene, background);
 
   scene.points.reserve(model.points.size());
   for (const auto& [id, p] : model.points) scene.points.push_back({p.xyz, p.rgb});

@@ -17,10 +17,15 @@ namespace fs = std::filesystem;
 
 // Images are read on first use and kept as 8-bit; the mutex guards the slots, and a
 // slot once filled is never replaced, so returned references stay valid.
+struct CachedImage {
+  Image8 rgb;
+  Image8 alpha;  // empty unless the file has alpha and the scene keeps it
+};
+
 class ImageCache {
  public:
   std::mutex mutex;
-  std::vector<std::unique_ptr<Image8>> slots;
+  std::vector<std::unique_ptr<CachedImage>> slots;
 };
 
 Scene::Scene() : cache_(std::make_shared<ImageCache>()) {}
@@ -30,15 +35,25 @@ namespace {
 // Reads view `v`'s image at the size its camera expects. A folder such as images_4 is
 // already downscaled (Scene loaders point image_path at it); otherwise the image is
 // resized on load. A size that matches neither is an error naming the file.
-Image8 loadViewImage(const SceneView& v, const ImageLoadOptions& load) {
+std::unique_ptr<CachedImage> loadViewImage(const SceneView& v, const ImageLoadOptions& load) {
+  auto out = std::make_unique<CachedImage>();
   Image8 img = readImage(v.image_path, /*keep_alpha=*/true);
+  if (img.channels == 4 && load.keep_alpha) {
+    out->alpha = Image8(img.width, img.height, 1);
+    for (std::size_t p = 0; p < out->alpha.data.size(); ++p) out->alpha.data[p] = img.data[4 * p + 3];
+  }
   if (img.channels == 4) img = compositeOnBackground(img, load.background.data());
   const int w = v.camera.K.width, h = v.camera.K.height;
-  if (img.width == w && img.height == h) return img;
+  out->rgb = std::move(img);
+  if (out->rgb.width == w && out->rgb.height == h) return out;
   // Accept a source that is `downscale` times larger (rounding either way).
   const int f = std::max(1, load.downscale);
-  if (std::abs(img.width - w * f) <= f && std::abs(img.height - h * f) <= f && f > 1)
-    return resizeImage(img, w, h);
+  if (std::abs(out->rgb.width - w * f) <= f && std::abs(out->rgb.height - h * f) <= f && f > 1) {
+    out->rgb = resizeImage(out->rgb, w, h);
+    if (!out->alpha.empty()) out->alpha = resizeImage(out->alpha, w, h);
+    return out;
+  }
+  img = std::move(out->rgb);
   throw InputError(v.image_path, "image size",
                    "expected " + std::to_string(w * f) + "x" + std::to_string(h * f) +
                        " (the camera's size) but the file is " + std::to_string(img.width) +
@@ -51,8 +66,15 @@ const Image8& Scene::image(int i) const {
   std::lock_guard<std::mutex> lock(cache_->mutex);
   if (cache_->slots.size() < views.size()) cache_->slots.resize(views.size());
   auto& slot = cache_->slots.at(static_cast<size_t>(i));
-  if (!slot) slot = std::make_unique<Image8>(loadViewImage(views.at(i), load));
-  return *slot;
+  if (!slot) slot = loadViewImage(views.at(i), load);
+  return slot->rgb;
+}
+
+const Image8* Scene::alpha(int i) const {
+  image(i);
+  std::lock_guard<std::mutex> lock(cache_->mutex);
+  const CachedImage& slot = *cache_->slots.at(static_cast<size_t>(i));
+  return slot.alpha.empty() ? nullptr : &slot.alpha;
 }
 
 std::size_t Scene::preloadImages(const std::vector<int>& which) const {
@@ -65,11 +87,11 @@ std::size_t Scene::preloadImages(const std::vector<int>& which) const {
   }
   std::sort(missing.begin(), missing.end());
   missing.erase(std::unique(missing.begin(), missing.end()), missing.end());
-  std::vector<std::unique_ptr<Image8>> loaded(missing.size());
+  std::vector<std::unique_ptr<CachedImage>> loaded(missing.size());
   std::vector<std::exception_ptr> failed(missing.size());
   tbb::parallel_for(std::size_t{0}, missing.size(), [&](std::size_t k) {
     try {
-      loaded[k] = std::make_unique<Image8>(loadViewImage(views.at(static_cast<size_t>(missing[k])), load));
+      loaded[k] = loadViewImage(views.at(static_cast<size_t>(missing[k])), load);
     } catch (...) {
       failed[k] = std::current_exception();
     }
@@ -87,6 +109,8 @@ std::size_t Scene::preloadImages(const std::vector<int>& which) const {
   }
   return missing.size();
 }
+
+void Scene::resetImageCache() { cache_ = std::make_shared<ImageCache>(); }
 
 void Scene::releaseImages() const {
   std::lock_guard<std::mutex> lock(cache_->mutex);
@@ -129,6 +153,51 @@ void Scene::finalize() {
   if (points.empty())
     for (int i : train) aabb.extend(views[i].camera.center());
   extent = sceneExtent(cameras(train));
+}
+
+namespace {
+constexpr const char* kAlphaNoneSaid = "alpha in the images, none said (white)";
+}
+
+void settleBackground(Scene& scene, const BackgroundRule& rule) {
+  scene.random_background = false;
+  if (rule.said) {
+    scene.background = rule.said->color;
+    scene.random_background = rule.said->random;
+    scene.background_from = "--background";
+  } else if (rule.data_said) {
+    scene.background = rule.data_color;
+    scene.background_from = rule.data_color ? rule.data_from : rule.data_from + ": none";
+  } else {
+    scene.background.reset();
+    scene.background_from = "none";
+  }
+  // Images with alpha need a background to be composited on, and training must render on
+  // the same one: where nothing said one, white (the compositing default of every loader).
+  // A manifest's null is a word too: the data is opaque (rooms written as RGBA).
+  if (!rule.said && !rule.data_said) {
+    for (const SceneView& v : scene.views)
+      if (imageHasAlpha(v.image_path)) {
+        scene.background = std::array<float, 3>{1, 1, 1};
+        scene.background_from = kAlphaNoneSaid;
+        break;
+      }
+  }
+  scene.load.background = scene.background.value_or(std::array<float, 3>{1, 1, 1});
+  scene.load.keep_alpha = scene.random_background;
+}
+
+void setBackground(Scene& scene, const BackgroundChoice& choice) {
+  BackgroundRule rule;
+  rule.said = choice;
+  settleBackground(scene, rule);
+  scene.resetImageCache();
+}
+
+std::string backgroundWarning(const Scene& scene) {
+  if (scene.background_from != kAlphaNoneSaid) return {};
+  return scene.source + ": background: the images have alpha but nothing says what stands behind them; they are "
+                        "composited on white and trained against white (say --background white|black|R,G,B|random)\n";
 }
 
 void moveToOwnFrame(Scene& scene) {

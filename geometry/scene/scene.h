@@ -13,6 +13,7 @@
 
 #include "geometry/camera/camera.h"
 #include "geometry/image/image.h"
+#include "geometry/scene/background.h"
 #include "geometry/scene/scene_frame.h"
 
 namespace saresgs {
@@ -42,10 +43,12 @@ struct AABB {
 };
 
 // How images are read: from `images/` (factor 1), from `images_<f>` when that folder
-// exists, or resized on load by 1/f. Background is used for RGBA (Blender) images.
+// exists, or resized on load by 1/f. RGBA images are composited on `background`, which
+// the loaders set to the scene's (Scene::background; white where it has none).
 struct ImageLoadOptions {
   int downscale = 1;  // 1, 2, 4, 8, ...
   std::array<float, 3> background{1.0f, 1.0f, 1.0f};
+  bool keep_alpha = false;  // also keep each RGBA image's alpha (Scene::alpha)
 };
 
 class ImageCache;  // defined in scene.cpp; shared by copies of a Scene
@@ -63,9 +66,16 @@ class Scene {
   // (scene_frame.h): world = frame.toWorld(internal). The loaders choose it; a Scene built
   // in memory is in world coordinates (the identity frame) until moveToOwnFrame.
   SceneFrame frame;
-  // The colour behind the content when the dataset knows it (Blender: the compositing
-  // background; synthetic scenes: the manifest's), for training against the same one.
+  // The colour behind the content, which RGBA images are composited on and which training,
+  // evaluation, Fisher scoring and the final fit render against (settleBackground below
+  // says where it comes from). Unset: the data has none (opaque images; renders on black).
   std::optional<std::array<float, 3>> background;
+  // Training draws a fresh background colour per step (`--background random`); everything
+  // else renders against `background`. The images' alpha is then kept (alpha()).
+  bool random_background = false;
+  // Where the background came from, for `saresgs info` and results.json: "--background",
+  // "manifest", "Blender (white)", "alpha in the images, none said (white)", or "none".
+  std::string background_from = "none";
   ImageLoadOptions load;
 
   Scene();
@@ -75,6 +85,9 @@ class Scene {
   // per image), and returns how many it read; on an unreadable one, throws the error of
   // the first in `which`'s order.
   std::size_t preloadImages(const std::vector<int>& which) const;
+  // View i's alpha (1 channel, the image's size), when it has one and the scene keeps it
+  // (random_background); else nullptr. Read with the image.
+  const Image8* alpha(int i) const;
   // The same as float RGB in [0,1], converted on each call.
   ImageF imageFloat(int i) const { return toFloat(image(i)); }
   bool hasDepth(int i) const { return !views.at(i).depth_path.empty(); }
@@ -86,6 +99,9 @@ class Scene {
   void finalize();
   // Drops every cached image (memory back).
   void releaseImages() const;
+  // Detaches this scene from the image cache it shares with its copies (a fresh, empty
+  // one): for a copy whose images are read otherwise (setBackground).
+  void resetImageCache();
 
  private:
   std::shared_ptr<ImageCache> cache_;
@@ -96,8 +112,32 @@ class Scene {
 // loader below ends with it; a frame that is the identity changes nothing.
 void moveToOwnFrame(Scene& scene);
 
+// The one rule for every loader's background. In order: the user's `said` choice (the
+// `--background` option); the data's own word (`data_said`: a manifest's colour or null, or
+// Blender's white), `data_from` naming it; when neither said anything, white if any image
+// has alpha (backgroundWarning then says so), else none. It sets
+// background, random_background, background_from and load (the compositing colour and
+// whether to keep alpha) before any image is read.
+struct BackgroundRule {
+  std::optional<BackgroundChoice> said;
+  bool data_said = false;
+  std::optional<std::array<float, 3>> data_color;
+  std::string data_from;
+};
+void settleBackground(Scene& scene, const BackgroundRule& rule);
+
+// Gives a loaded scene another background (Python's Trainer(background=...)): the same as
+// the loader's rule with `choice` said, and the images read again on their next use.
+void setBackground(Scene& scene, const BackgroundChoice& choice);
+
+// The warning settleBackground found, if any (the images have alpha and nothing said what
+// stands behind them), for `saresgs info`, train and active to print.
+std::string backgroundWarning(const Scene& scene);
+
 struct DatasetOptions {
   ImageLoadOptions load;
+  // The user's background (`--background`); unset: what the data says (settleBackground).
+  std::optional<BackgroundChoice> background;
   int test_every = 8;     // COLMAP: sorted by name, index % test_every == 0 is a test view
                           // (0 puts every view in train)
   std::string model_dir;  // COLMAP: sparse model folder; empty searches sparse/0, sparse, .

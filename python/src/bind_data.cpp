@@ -139,7 +139,9 @@ void bindData(py::module_& m) {
       .def_property_readonly("background", [](const Scene& s) -> py::object {
         if (!s.background) return py::none();
         return py::make_tuple((*s.background)[0], (*s.background)[1], (*s.background)[2]);
-      }, "the colour behind the content, when the dataset knows it")
+      }, "the colour behind the content (RGBA images are composited on it, renders are against it); None: the data has none")
+      .def_readonly("random_background", &Scene::random_background, "training draws a fresh background colour per step")
+      .def_readonly("background_from", &Scene::background_from, "where the background came from")
       .def("warnings", [](const Scene& s) {
         std::vector<std::string> v;
         for (const DatasetWarning& w : checkDataset(s)) v.push_back(w.view + ": " + w.field + ": " + w.message);
@@ -152,10 +154,11 @@ void bindData(py::module_& m) {
 
   m.def(
       "load_dataset",
-      [](const std::string& path, int downscale, int test_every) {
+      [](const std::string& path, int downscale, int test_every, const py::object& background) {
         DatasetOptions o;
         o.load.downscale = downscale;
         o.test_every = test_every;
+        o.background = backgroundArg(background);
         std::shared_ptr<Scene> s;
         std::vector<DatasetWarning> warnings;
         {
@@ -166,10 +169,14 @@ void bindData(py::module_& m) {
         // As the command line prints them: implausible intrinsics, views that see no point.
         if (!warnings.empty() && PyErr_WarnEx(PyExc_UserWarning, (path + ":\n" + formatWarnings(warnings)).c_str(), 1) != 0)
           throw py::error_already_set();
+        if (const std::string w = backgroundWarning(*s); !w.empty() && PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) != 0)
+          throw py::error_already_set();
         return s;
       },
-      py::arg("path"), py::arg("downscale") = 1, py::arg("test_every") = 8,
-      "Loads a COLMAP, Blender (transforms_train.json), nerfstudio (transforms.json) or `saresgs scene` folder.");
+      py::arg("path"), py::arg("downscale") = 1, py::arg("test_every") = 8, py::arg("background") = py::none(),
+      "Loads a COLMAP, Blender (transforms_train.json), nerfstudio (transforms.json) or `saresgs scene` folder. "
+      "background: None (what the data says: a manifest, Blender's white, white for images with alpha), 'white', "
+      "'black', 'random' (a fresh colour per training step, evaluated on white), 'R,G,B' or three numbers in 0..1.");
 
   m.def(
       "make_scene",
@@ -192,6 +199,28 @@ void bindData(py::module_& m) {
       py::arg("views") = 0,
       "Writes a built-in synthetic scene (`saresgs scene`: object, room360, unbalanced or tworooms) as a COLMAP "
       "folder at `out` and loads it.");
+}
+
+std::optional<BackgroundChoice> backgroundArg(const py::object& value) {
+  if (value.is_none()) return std::nullopt;
+  if (py::isinstance<py::str>(value)) return parseBackground(value.cast<std::string>(), "background");
+  std::vector<double> c;
+  try {
+    c = value.cast<std::vector<double>>();
+  } catch (const py::cast_error&) {
+    throw py::type_error("background: expected None, a string (" + std::string(kBackgroundForms) + ") or three numbers");
+  }
+  if (c.size() != 3 || !(c[0] >= 0 && c[0] <= 1 && c[1] >= 0 && c[1] <= 1 && c[2] >= 0 && c[2] <= 1))
+    throw py::value_error("background: expected three numbers in 0..1");
+  return BackgroundChoice{false, {static_cast<float>(c[0]), static_cast<float>(c[1]), static_cast<float>(c[2])}};
+}
+
+std::shared_ptr<Scene> withBackground(const std::shared_ptr<Scene>& dataset, const py::object& background) {
+  const std::optional<BackgroundChoice> b = backgroundArg(background);
+  if (!b) return dataset;
+  auto copy = std::make_shared<Scene>(*dataset);
+  setBackground(*copy, *b);
+  return copy;
 }
 
 }  // namespace saresgs::python

@@ -269,9 +269,9 @@ void bindNbv(py::module_& m) {
                        const std::string& preset, int threads, std::optional<int> max_views, std::optional<int> interval,
                        std::optional<int> min_iterations, std::optional<int> final_iterations,
                        std::optional<std::size_t> max_gaussians, const std::string& prefilter_scene, const std::string& checkpoint,
-                       bool plain_refit, bool final_residual) {
+                       bool plain_refit, bool final_residual, const py::object& background) {
              auto r = std::make_unique<PyActiveRun>();
-             r->dataset = dataset;
+             r->dataset = withBackground(dataset, background);
              r->preset = preset;
              ActiveOptions& o = r->opt;
              o = presetOptions(parsePreset(preset));
@@ -296,17 +296,17 @@ void bindNbv(py::module_& m) {
                o.custom_selector = [self](const SelectionContext& c, SelectionLog& log) { return self->select(c, log); };
              }
              py::gil_scoped_release nogil;
-             r->run = std::make_unique<ActiveRun>(*dataset, o, checkpoint);
+             r->run = std::make_unique<ActiveRun>(*r->dataset, o, checkpoint);
              return r;
            }),
            py::arg("dataset"), py::arg("method") = "adaptive", py::arg("selector") = py::none(), py::arg("seed") = 0,
            py::arg("preset") = "quick", py::arg("threads") = 0, py::arg("max_views") = py::none(),
            py::arg("interval") = py::none(), py::arg("min_iterations") = py::none(), py::arg("final_iterations") = py::none(),
            py::arg("max_gaussians") = py::none(), py::arg("prefilter_scene") = "auto", py::arg("checkpoint") = "",
-           py::arg("plain_refit") = true, py::arg("final_residual") = false,
+           py::arg("plain_refit") = true, py::arg("final_residual") = false, py::arg("background") = py::none(),
            "Options as `saresgs active`'s (the preset's where not given); `checkpoint` names a checkpoint file "
            "written after every added view and resumed when present; plain_refit=False is --no-plain-refit, "
-           "final_residual=True is --final-residual.")
+           "final_residual=True is --final-residual; background as load_dataset's (None: the dataset's own).")
       .def_property_readonly("method", [](const PyActiveRun& r) { return std::string(toString(r.opt.method)); })
       .def_property_readonly("held", [](const PyActiveRun& r) { return r.run->held(); }, "the views held, in order")
       .def_property_readonly("finished", [](const PyActiveRun& r) { return r.run->finished(); },

@@ -51,7 +51,7 @@ void bindTrain(py::module_& m) {
                       "3DGS training (3DGS's schedule, densification and Adam) on a dataset's views, from its SfM "
                       "points; optionally with SA-ResGS's residual supervision.")
       .def(py::init([](const std::shared_ptr<Scene>& scene, std::uint64_t seed, double schedule_scale, std::size_t max_gaussians,
-                       int max_sh_degree, bool residual, int threads) {
+                       int max_sh_degree, bool residual, int threads, const py::object& background) {
              TrainerOptions o;
              o.seed = seed;
              o.max_sh_degree = max_sh_degree;
@@ -59,13 +59,16 @@ void bindTrain(py::module_& m) {
              o.residual.enabled = residual;
              o.raster.execution.threads = threads;
              if (schedule_scale != 1.0) o = scaledSchedule(o, schedule_scale);
+             const std::shared_ptr<Scene> dataset = withBackground(scene, background);
              py::gil_scoped_release nogil;
-             return std::make_unique<Trainer>(*scene, o);
+             return std::make_unique<Trainer>(*dataset, o);
            }),
            py::arg("dataset"), py::arg("seed") = 0, py::arg("schedule_scale") = 1.0, py::arg("max_gaussians") = 0,
            py::arg("max_sh_degree") = 3, py::arg("residual") = false, py::arg("threads") = 0,
+           py::arg("background") = py::none(),
            "As `saresgs train`: schedule_scale scales the densification, opacity-reset and SH schedules (the quick "
-           "preset's is 0.25); max_gaussians caps the model (0: none); threads 0 uses every core.")
+           "preset's is 0.25); max_gaussians caps the model (0: none); threads 0 uses every core; background as "
+           "load_dataset's (None: the dataset's own).")
       .def(
           "train",
           [](Trainer& t, const std::vector<int>& views, int iterations, py::object callback, int every) {

@@ -9,10 +9,14 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "geometry/image/image.h"
+#include "geometry/scene/background.h"
+#include "geometry/scene/scene.h"
 
 namespace saresgs::python {
 
@@ -42,6 +46,14 @@ py::array_t<T> imageArray(ImageT<T>&& img) {
 // A float image from an H x W x C or H x W array (C = `channels`); throws ValueError
 // naming `what` and the shape expected.
 ImageF imageFromArray(const py::array& a, int channels, const std::string& what);
+
+// The `background=` keyword: None (what the data says), "white", "black", "random", an
+// "R,G,B" string, or three numbers in 0..1; anything else raises naming "background".
+std::optional<BackgroundChoice> backgroundArg(const py::object& value);
+
+// `dataset` itself without `background`, else a copy of it with that background (its
+// images read again, composited on it): what Trainer and ActiveRun hold.
+std::shared_ptr<Scene> withBackground(const std::shared_ptr<Scene>& dataset, const py::object& background);
 
 // Raises the pending Python exception (KeyboardInterrupt on Ctrl-C) in C++, so that a long
 // call stops at its next progress point. Call with the GIL held.

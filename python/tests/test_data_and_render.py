@@ -152,3 +152,37 @@ def test_a_dataset_in_millimetres_is_computed_in_its_own_frame(room, tmp_path):
     np.testing.assert_allclose(world.log_scales, internal.log_scales + np.log(1e3), atol=1e-5)
     np.testing.assert_allclose(world.from_world(mm).means, internal.means, rtol=1e-6, atol=1e-9)
     np.testing.assert_array_equal(internal.to_world(room).means, internal.means)  # the identity frame
+
+
+def test_background_is_said_once_for_the_images_and_the_renders(tmp_path):
+    """An RGBA object (Blender folder): its images are composited on the background asked
+    for, and a Trainer renders against that same one."""
+    folder = tmp_path / "object"
+    run_cli("scene", "--layout", "object", "--views", 16, "--width", 32, "--height", 24, "--format", "blender",
+            "--out", folder)
+    white = saresgs.load_dataset(str(folder))
+    assert white.background == (1.0, 1.0, 1.0) and white.background_from == "manifest" and not white.random_background
+    black = saresgs.load_dataset(str(folder), background="black")
+    assert black.background == (0.0, 0.0, 0.0) and black.background_from == "--background"
+    tinted = saresgs.load_dataset(str(folder), background=(0.2, 0.4, 0.6))
+    v = white.train[0]
+    iw, ib, it = white.image(v).astype(int), black.image(v).astype(int), tinted.image(v).astype(int)
+    # Pixels the object does not cover show the background; covered ones are the same.
+    empty = (iw == 255).all(axis=2) & (ib == 0).all(axis=2)
+    assert empty.sum() > 50 and (iw != ib).any(axis=2).sum() >= empty.sum()
+    np.testing.assert_array_equal(it[empty], np.tile([51, 102, 153], (int(empty.sum()), 1)))
+    assert saresgs.load_dataset(str(folder), background="random").random_background
+    for bad in ("purple", "1,1", (1, 2), (0, 0, 2)):
+        with pytest.raises((ValueError, TypeError), match="background"):
+            saresgs.load_dataset(str(folder), background=bad)
+    # A Trainer given a background renders against it: white minus black is the uncovered
+    # share of each pixel, 1 - alpha.
+    tw = saresgs.Trainer(white, seed=0, threads=1)
+    tb = saresgs.Trainer(white, seed=0, threads=1, background="black")
+    cam = white.camera(v)
+    rw, _, alpha = tw.render(cam)
+    rb, _, _ = tb.render(cam)
+    np.testing.assert_allclose(rw - rb, np.repeat((1 - alpha)[..., None], 3, axis=2), atol=1e-5)
+    assert (1 - alpha).max() > 0.5
+    # The dataset it was given keeps its own.
+    assert white.background == (1.0, 1.0, 1.0)

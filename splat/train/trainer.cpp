@@ -266,6 +266,26 @@ const ImageF& Trainer::target(int view) {
   return target_;
 }
 
+const ImageF& Trainer::randomBackgroundTarget(int view, RasterSettings& s) {
+  // A fresh colour for this step, rendered behind the model and put behind the image:
+  // the image was composited on scene.load.background, so where alpha is a the target is
+  // image + (1 - a) (colour - load.background). An opaque image stays as it is.
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  for (float& c : s.background) c = unit(rng_);
+  const ImageF& composited = target(view);
+  const Image8* alpha = scene_.alpha(view);
+  random_target_ = composited;
+  if (alpha) {
+    float shift[3];
+    for (int c = 0; c < 3; ++c) shift[c] = s.background[static_cast<std::size_t>(c)] - scene_.load.background[static_cast<std::size_t>(c)];
+    for (std::size_t p = 0; p < alpha->data.size(); ++p) {
+      const float clear = 1.0f - alpha->data[p] * (1.0f / 255.0f);
+      for (int c = 0; c < 3; ++c) random_target_.data[3 * p + static_cast<std::size_t>(c)] += clear * shift[c];
+    }
+  }
+  return random_target_;
+}
+
 int Trainer::nextView(const std::vector<int>& views) {
   if (views != view_set_) {
     view_set_ = views;
@@ -307,10 +327,10 @@ void Trainer::checkFinite(int view) const {
 double Trainer::step(int view) {
   ++iteration_;
   const Camera& cam = scene_.views.at(static_cast<std::size_t>(view)).camera;
-  const ImageF& gt = target(view);
+  RasterSettings s = rasterSettings();
+  const ImageF& gt = scene_.random_background ? randomBackgroundTarget(view, s) : target(view);
   if (adam_.m.size() != g_.size()) adam_.resetFor(g_);
   if (stats_.count.size() != g_.size()) stats_.resize(g_.size());
-  const RasterSettings s = rasterSettings();
   // The gradient is zero here: the last step's Adam cleared it as it read it
   // (adamStepClearingGradient), unless that step stopped before Adam or the model changed.
   if (grad_.size() != g_.size() || grad_.max_sh_degree != g_.max_sh_degree) grad_ = g_.zerosLike();
@@ -360,7 +380,7 @@ double Trainer::step(int view) {
 
 RenderResult Trainer::render(const Camera& cam) const { return rasterize(g_, cam, rasterSettings()); }
 
-Evaluation Trainer::evaluate(const std::vector<int>& views, bool keep_renders) const {
+Evaluation Trainer::evaluate(const std::vector<int>& views, bool keep_renders, bool with_ssim) const {
   Evaluation e;
   ImageF gt;
   // One render's buffers for every view, and the colour only (no depth or contributor
@@ -371,7 +391,7 @@ Evaluation Trainer::evaluate(const std::vector<int>& views, bool keep_renders) c
   for (int v : views) {
     rasterize(g_, scene_.views.at(static_cast<std::size_t>(v)).camera, s, {}, r);
     toFloatInto(scene_.image(v), gt);
-    e.views.push_back({v, psnr(r.rgb, gt), ssim(r.rgb, gt)});
+    e.views.push_back({v, psnr(r.rgb, gt), with_ssim ? ssim(r.rgb, gt) : 0.0});
     if (keep_renders) e.renders.push_back(toByte(r.rgb));
     e.psnr += e.views.back().psnr;
     e.ssim += e.views.back().ssim;

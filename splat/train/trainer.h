@@ -147,7 +147,9 @@ class Trainer {
   void checkFinite(int view) const;
 
   RenderResult render(const Camera& cam) const;
-  Evaluation evaluate(const std::vector<int>& views, bool keep_renders = false) const;
+  // PSNR and SSIM of each view against its image; without `with_ssim` PSNR only (ssim 0),
+  // for evaluations over many views (an active run's whole path).
+  Evaluation evaluate(const std::vector<int>& views, bool keep_renders = false, bool with_ssim = true) const;
   // The model, optimiser and schedules as after construction; the random generator
   // continues (so that repeated resets do not replay the same views).
   void reset();
@@ -176,6 +178,9 @@ class Trainer {
 
  private:
   const ImageF& target(int view);
+  // Scene::random_background: draws this step's colour into s.background and returns the
+  // view's image with that colour behind it.
+  const ImageF& randomBackgroundTarget(int view, RasterSettings& s);
   int nextView(const std::vector<int>& views);
 
   Scene scene_;
@@ -198,6 +203,7 @@ class Trainer {
   // at 512x384) cost more in first-touch page faults than the conversion costs per step.
   ImageF target_;
   int target_view_ = -1;
+  ImageF random_target_;  // randomBackgroundTarget's image
   StageSeconds seconds_;
   StepBuffers step_buffers_;  // a step's renders and loss images, reused
 };

@@ -160,7 +160,7 @@ TEST(Cli, ActiveAcceptsEveryMethodOfTheList) {
     EXPECT_NE(r.output.find(d.file("missing")), std::string::npos) << name << ": " << r.output;
     EXPECT_EQ(r.output.find("--method"), std::string::npos) << name << ": " << r.output;
   }
-  const Result bad = run("active --method oracle --dataset " + d.file("missing") + " --out " + d.file("o"));
+  const Result bad = run("active --method clairvoyant --dataset " + d.file("missing") + " --out " + d.file("o"));
   EXPECT_NE(bad.code, 0);
   EXPECT_NE(bad.output.find("--method"), std::string::npos) << bad.output;
   const Result help = run("active --help");

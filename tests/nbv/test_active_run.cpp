@@ -86,7 +86,7 @@ TEST(ActiveRun, OnlyWhatAMethodNeedsIsComputed) {
     EXPECT_EQ(l.seconds.lifting, 0.0);
     EXPECT_EQ(l.seconds.prefilter, 0.0);
   }
-  EXPECT_THROW(parseMethod("oracle"), std::invalid_argument);
+  EXPECT_THROW(parseMethod("clairvoyant"), std::invalid_argument);
 }
 
 // total_iterations is the loop's least total: when the phases' own k x interval add up to
@@ -624,6 +624,36 @@ TEST(ActiveRun, AdaptiveGatesByTheCapturesClustering) {
   EXPECT_TRUE(usesKmedianGate(s, tinyOptions(Method::kKmedianFisher)));
   EXPECT_FALSE(usesKmedianGate(s, tinyOptions(Method::kFvsFisher)));
   EXPECT_THROW(usesKmedianGate(s, tinyOptions(Method::kFisher)), std::invalid_argument);
+}
+
+// The oracle is told the test poses: each step's scores are the k-median gains over the
+// test views (not the train views kmedian uses), and it takes the best. Its final fit, as
+// every method's, also reports the PSNR of every view of the path, which for the test views
+// is the final fit's own evaluation.
+TEST(ActiveRun, OracleIsTheKmedianGainOverTheTestPosesAndTheFinalFitCoversThePath) {
+  const Scene& s = tinyDataset();
+  ASSERT_FALSE(s.test.empty());
+  ActiveOptions o = tinyOptions(Method::kOracle);
+  o.final_iterations = 30;
+  const ActiveResult r = ActiveRun(s, o).run();
+  int selections = 0;
+  for (const SelectionLog& st : r.steps) {
+    if (st.selected < 0) continue;
+    const std::vector<int> held(r.selected_views.begin(), r.selected_views.begin() + st.views_before);
+    EXPECT_EQ(st.scores, kmedianGains(s, held, st.candidates, s.test, poseAngleScale(s)));
+    EXPECT_NE(st.scores, kmedianGains(s, held, st.candidates, s.train, poseAngleScale(s)))
+        << "the tiny dataset must tell the two populations apart for this test to mean anything";
+    EXPECT_EQ(st.selected, st.candidates[argmaxScore(st.scores, st.candidates)]);
+    ++selections;
+  }
+  EXPECT_EQ(selections, 3);
+  ASSERT_TRUE(r.final_fit.has_value());
+  ASSERT_EQ(r.final_fit->path.size(), s.views.size());
+  for (std::size_t i = 0; i < s.views.size(); ++i) {
+    EXPECT_EQ(r.final_fit->path[i].view, static_cast<int>(i));
+    EXPECT_TRUE(std::isfinite(r.final_fit->path[i].psnr));
+  }
+  for (const ViewMetrics& m : r.final_fit->test.views) EXPECT_EQ(r.final_fit->path[static_cast<std::size_t>(m.view)].psnr, m.psnr);
 }
 
 }  // namespace

@@ -34,11 +34,11 @@ TEST(Method, WhatEachMethodComputes) {
 
 TEST(Method, UnknownNameListsTheChoices) {
   try {
-    parseMethod("oracle");
+    parseMethod("clairvoyant");
     FAIL() << "no error";
   } catch (const std::invalid_argument& e) {
     const std::string msg = e.what();
-    EXPECT_NE(msg.find("'oracle'"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("'clairvoyant'"), std::string::npos) << msg;
     for (Method m : allMethods()) EXPECT_NE(msg.find(toString(m)), std::string::npos) << msg;
   }
 }

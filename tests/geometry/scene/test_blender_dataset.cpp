@@ -61,7 +61,7 @@ TEST(BlenderDataset, ConvertsOpenGLPosesToOpenCV) {
   writeSplit(d, "transforms_train.json", "train", 5);
   writeSplit(d, "transforms_test.json", "test", 2);
   DatasetOptions opts;
-  opts.load.background = {0.0f, 0.0f, 1.0f};
+  opts.background = BackgroundChoice{false, {0.0f, 0.0f, 1.0f}};
   const Scene s = loadDataset(d.str(), opts);
   ASSERT_EQ(s.views.size(), 7u);
   EXPECT_EQ(s.train.size(), 5u);

@@ -94,7 +94,7 @@ TEST(Ablation, MethodSeedsNarrowOneMethodsSeeds) {
   j["method_seeds"]["fisher"] = {1, 7};
   writeBytes(d.file("g.json"), j.dump());
   EXPECT_TRUE(throwsInputError([&] { readAblationGrid(d.file("g.json")); }, d.file("g.json"), "method_seeds.fisher"));
-  j["method_seeds"] = {{"oracle", {1}}};
+  j["method_seeds"] = {{"clairvoyant", {1}}};
   writeBytes(d.file("g.json"), j.dump());
   EXPECT_TRUE(throwsInputError([&] { readAblationGrid(d.file("g.json")); }, d.file("g.json"), "method_seeds"));
 }

@@ -83,7 +83,7 @@ TEST(PairedStats, TableRowsPerSceneMethodBaselineAndMetric) {
   const AblationGrid g = randomAndFisher({0, 1});
   auto job = [](const std::string& m, std::uint64_t seed, double psnr, double final_psnr) {
     JobResult r = finishedRun(m, seed, psnr);
-    r.run.final_fit = FinalFitReport{100, false, final_psnr, 0.8, {{"t0", final_psnr, 0.8}}};
+    r.run.final_fit = FinalFitReport{100, false, final_psnr, 0.8, {{"t0", final_psnr, 0.8}}, {}};
     return r;
   };
   // fisher - random, final fit: seed 0: 27 - 26 = 1, seed 1: 26 - 26 = 0 (a tie).

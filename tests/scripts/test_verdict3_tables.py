@@ -1,0 +1,98 @@
+"""verdict3_tables.py's statistics and tables on runs made up here: the two-level bootstrap
+counts the variance of scenes, a pair is judged over the views neither run held, the better
+baseline is chosen per capture type, and --check fails on a stale table."""
+import importlib.util
+import json
+import os
+import random
+import subprocess
+import sys
+
+import pytest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SCRIPT = os.path.join(HERE, "..", "..", "scripts", "experiments", "verdict3_tables.py")
+spec = importlib.util.spec_from_file_location("verdict3_tables", SCRIPT)
+v3 = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(v3)
+
+
+def test_a_constant_difference_has_a_point_interval():
+    m, lo, hi = v3.two_level_bootstrap({"a": [0.3, 0.3], "b": [0.3, 0.3, 0.3]}, random.Random(1))
+    assert m == pytest.approx(0.3) and lo == pytest.approx(0.3) and hi == pytest.approx(0.3)
+
+
+def test_one_scene_one_seed_has_no_interval():
+    m, lo, hi = v3.two_level_bootstrap({"a": [0.5]}, random.Random(1))
+    assert m == 0.5 and lo != lo and hi != hi
+
+
+def test_the_variance_of_scenes_widens_the_interval():
+    # Seeds agree within each scene, scenes disagree: a seed-only interval would be tight,
+    # the two-level one spans the scenes' spread.
+    by_scene = {"a": [1.0, 1.01, 0.99], "b": [-1.0, -1.01, -0.99], "c": [0.1, 0.11, 0.09]}
+    m, lo, hi = v3.two_level_bootstrap(by_scene, random.Random(1))
+    assert m == pytest.approx(0.1 / 3 + 0.0, abs=1e-9)
+    assert lo < -0.5 and hi > 0.5
+    # The same scenes' own seed spread alone is small.
+    _, lo1, hi1 = v3.two_level_bootstrap({"a": by_scene["a"]}, random.Random(1))
+    assert hi1 - lo1 < 0.05
+
+
+def run(views, held, psnrs, test_psnr=25.0):
+    return {"selected_views": held, "final_fit": {"psnr": test_psnr, "ssim": 0.9,
+            "path": [{"name": v, "psnr": p} for v, p in zip(views, psnrs)]}}
+
+
+def write_grid(tmp, methods, jobs):
+    grid = {"scenes": [{"name": "o-s2", "layout": "object"}, {"name": "o-s3", "layout": "object"}],
+            "methods": methods, "seeds": [0, 1]}
+    for job, r in jobs.items():
+        os.makedirs(os.path.join(tmp, "runs", job))
+        with open(os.path.join(tmp, "runs", job, "results.json"), "w") as fh:
+            json.dump(r, fh)
+    with open(os.path.join(tmp, "grid.json"), "w") as fh:
+        json.dump(grid, fh)
+    return grid
+
+
+def test_pairs_are_judged_over_the_views_neither_run_held(tmp_path):
+    views = ["a", "b", "c", "d"]
+    jobs = {}
+    for s in ("o-s2", "o-s3"):
+        for seed in (0, 1):
+            # fvs holds a, fisher holds b: over c and d fvs is 1 dB ahead; on its own held
+            # view fisher would look 10 dB better, which must not count.
+            jobs[f"{s}__fvs__default__s{seed}"] = run(views, ["a"], [40, 20, 21, 21])
+            jobs[f"{s}__fisher__default__s{seed}"] = run(views, ["b"], [20, 30, 20, 20])
+            jobs[f"{s}__random__default__s{seed}"] = run(views, ["a"], [40, 19, 19, 19])
+            jobs[f"{s}__oracle__default__s{seed}"] = run(views, ["a"], [40, 23, 23, 23])
+    grid = write_grid(str(tmp_path), ["random", "fisher", "fvs", "oracle"], jobs)
+    md, csv_text = v3.tables(grid, str(tmp_path))
+    # fvs along its unheld path: (20+21+21)/3; fisher: (20+20+20)/3: fvs is the better baseline.
+    assert "Against the better baseline, **fvs**" in md
+    methods, paired = md.split("Against the better baseline")
+    # Paired over c and d: fisher 20 against fvs 21, in both scenes and seeds.
+    row = [l for l in paired.splitlines() if l.startswith("| fisher | 4 | 2 |")][0]
+    assert "| -1.000 | -1.000 | -1.000 |" in row and "below, clear of 0" in row
+    # The oracle's share: random 19, oracle 23, fvs (20+21+21)/3 -> 0.42.
+    assert [l for l in methods.splitlines() if l.startswith("| fvs | 4 |")][0].endswith("| 0.42 |")
+    assert "(16 finished runs, 0 missing)" in md
+
+
+def test_check_fails_on_a_stale_table_and_passes_on_a_fresh_one(tmp_path):
+    views = ["a", "b"]
+    jobs = {f"{s}__{m}__default__s{seed}": run(views, ["a"], [30, 20 + seed])
+            for s in ("o-s2", "o-s3") for m in ("fisher", "fvs") for seed in (0, 1)}
+    write_grid(str(tmp_path), ["fisher", "fvs"], jobs)
+    cmd = [sys.executable, SCRIPT, "--grid", str(tmp_path / "grid.json"), "--out", str(tmp_path)]
+    assert subprocess.run(cmd + ["--check"], capture_output=True).returncode == 1  # nothing written yet
+    assert subprocess.run(cmd, capture_output=True).returncode == 0
+    assert subprocess.run(cmd + ["--check"], capture_output=True).returncode == 0
+    # One run's number changes: the committed table is stale.
+    p = tmp_path / "runs" / "o-s2__fvs__default__s0" / "results.json"
+    r = json.loads(p.read_text())
+    r["final_fit"]["path"][1]["psnr"] += 0.5
+    p.write_text(json.dumps(r))
+    out = subprocess.run(cmd + ["--check"], capture_output=True, text=True)
+    assert out.returncode == 1 and "stale" in out.stdout
