@@ -37,7 +37,7 @@ struct ActiveArgs {
   double fisher_lambda = 1e-6;
   std::optional<int> max_views, interval, total, final_iterations, renamed_iterations;
   std::optional<long long> max_gaussians;
-  std::optional<double> beta, prefilter_keep, hybrid_weight, gate_keep, adaptive_clustering, memory_budget_gb;
+  std::optional<double> beta, prefilter_keep, hybrid_weight, gate_keep, adaptive_clustering, memory_budget_gb, path_variance_kappa;
   std::string hybrid_fisher = "logdet", hybrid_coverage = "facility";
   PrefilterFlags prefilter;
 };
@@ -74,6 +74,7 @@ ActiveOptions activeOptions(const ActiveArgs& a) {
   if (a.prefilter_keep) o.prefilter.keep_fraction = *a.prefilter_keep;
   if (a.hybrid_weight) o.hybrid_weight = *a.hybrid_weight;
   if (a.gate_keep) o.gate_keep = *a.gate_keep;
+  if (a.path_variance_kappa) o.path_variance_kappa = *a.path_variance_kappa;
   if (a.adaptive_clustering) o.adaptive_clustering = *a.adaptive_clustering;
   o.hybrid_criterion = a.hybrid_fisher == "trace" ? FisherCriterion::kTrace : FisherCriterion::kLogDet;
   o.hybrid_coverage = a.hybrid_coverage == "views"      ? HybridCoverage::kViewDistance
@@ -253,6 +254,10 @@ CLI::App* addActiveOptions(CLI::App& app, const std::shared_ptr<ActiveArgs>& a) 
                   "nearest held camera) | facility (the facility-location gain over the train views, by the overlap of their visible "
                   "surface)")
       ->check(CLI::IsMember({"surface", "views", "facility"}))->capture_default_str();
+  sub->add_option("--path-variance-kappa", a->path_variance_kappa,
+                  "path-variance: each parameter group's damping, as a multiple of the median of its nonzero held "
+                  "information (0: --fisher-lambda alone; default 0.01)")
+      ->check(CLI::Range(0.0, 1e6));
   sub->add_option("--gate-keep", a->gate_keep,
                   "kmedian-fisher, fvs-fisher, adaptive: fraction of the candidates, best by the gate's spread score (k-median "
                   "gain or distance to the nearest held view), that Fisher ranks (default 0.2)")

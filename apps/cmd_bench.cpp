@@ -687,6 +687,7 @@ void addBenchCommand(CLI::App& app, Action& action) {
   occ->add_option("--threads", o->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
   occ->add_option("--seed", o->seed, "Scene and SfM seed")->check(wholeNumberAtLeast(0))->capture_default_str();
   occ->callback([&action, o] { action = [o] { return runOccupancyBench(*o); }; });
+  addSelectBenchCommand(*bench, action);
 }
 
 }  // namespace saresgs::apps

@@ -15,6 +15,7 @@
 #include "geometry/io/json_file.h"
 #include "nbv/ause.h"
 #include "nbv/initial_views.h"
+#include "nbv/path_variance.h"
 #include "nbv/run_report.h"
 #include "splat/fisher.h"
 
@@ -173,6 +174,15 @@ int ActiveRun::selectNext(SelectionLog& log) {
       log.candidates = candidates;
       log.scores = kmedianGains(scene_, selected_, candidates, scene_.test.empty() ? scene_.train : scene_.test,
                                 poseAngleScale(scene_));
+      return candidates[argmaxScore(log.scores, candidates)];
+    }
+    case Method::kPathVariance: {
+      const auto t0 = Clock::now();
+      log.candidates = candidates;
+      log.scores = pathVarianceScores(trainer_->gaussians(), trainer_->rasterSettings(), scene_, selected_, candidates,
+                                      {opt_.fisher_lambda, opt_.path_variance_kappa},
+                                      [this](int done, int total) { report(ActivePhase::kFisher, done, total); });
+      log.seconds.fisher += since(t0);
       return candidates[argmaxScore(log.scores, candidates)];
     }
     case Method::kKmedianFisher:

@@ -71,6 +71,9 @@ struct ActiveOptions {
   // candidates, best by the gate's spread score, that Fisher ranks (the paper's prefilter
   // keeps its top 20 %; the same cut here).
   double gate_keep = 0.2;
+  // path-variance: each parameter group's damping is this times the median of its nonzero
+  // held information (PathVarianceOptions::kappa; fisher_lambda is the floor).
+  double path_variance_kappa = 0.01;
   // adaptive: a capture whose captureClustering (selectors.h) exceeds this is clustered
   // and gets the k-median gate, any other the farthest-view gate. Set between the
   // statistics of the tuning scenes (results/grid_tuning_scenes.json, scene seed 1): the

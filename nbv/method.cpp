@@ -43,6 +43,9 @@ constexpr MethodRow kMethodTable[] = {
     // test views, which it is told. What a selector aimed at the views people will look at
     // could reach with the same budget; the verdict's tables measure the others against it.
     {Method::kOracle, "oracle", {false, false, false}},
+    // The view that most reduces the predicted variance summed over the pool of path views
+    // (nbv/path_variance.h), each parameter group damped relative to its held information.
+    {Method::kPathVariance, "path-variance", {true, false, false}},
     // A selector function given by the caller (ActiveOptions::custom_selector: the Python
     // module's selectors); plain training, nothing precomputed.
     {Method::kCustom, "custom", {false, false, false}},

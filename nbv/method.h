@@ -8,7 +8,7 @@
 
 namespace saresgs {
 
-enum class Method { kRandom, kFvs, kFisher, kCoverage, kSaHash, kSaResgs, kResgs, kFisherLogDet, kHybrid, kKmedian, kKmedianFisher, kFvsFisher, kAdaptive, kFisherKmedian, kOracle, kCustom };
+enum class Method { kRandom, kFvs, kFisher, kCoverage, kSaHash, kSaResgs, kResgs, kFisherLogDet, kHybrid, kKmedian, kKmedianFisher, kFvsFisher, kAdaptive, kFisherKmedian, kOracle, kPathVariance, kCustom };
 
 // What a method computes; everything else is left out of its run.
 struct MethodNeeds {

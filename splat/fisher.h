@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <vector>
 
 #include "geometry/camera/camera.h"
@@ -54,6 +55,86 @@ double fisherLogDetScore(const GaussiansT<T>& Hv, const GaussiansT<T>& Htrain, d
   add(Hv.log_scales, Htrain.log_scales);
   add(Hv.opacities, Htrain.opacities);
   add(Hv.sh, Htrain.sh);
+  return score;
+}
+
+// The damping of each parameter group (means, log-scales, opacity logits, SH), for scores
+// that damp groups apart: their information differs by orders of magnitude (a mean's is
+// in 1/length^2, an opacity's is dimensionless), so one lambda is tiny for one group and
+// large for another.
+struct GroupDamping {
+  double means = 1e-6, log_scales = 1e-6, opacities = 1e-6, sh = 1e-6;
+};
+
+// lambda_g = max(floor, kappa x the median of group g's nonzero entries of H): a parameter
+// no held view has seen then counts as one seen kappa times as well as the typical one,
+// not 1/floor times. kappa 0 gives floor everywhere (FisherRF's single lambda).
+template <typename T>
+GroupDamping relativeDamping(const GaussiansT<T>& H, double kappa, double floor) {
+  auto median = [&](const std::vector<T>& v) {
+    std::vector<double> nz;
+    for (T x : v)
+      if (x > T(0)) nz.push_back(static_cast<double>(x));
+    if (nz.empty() || kappa <= 0) return floor;
+    std::nth_element(nz.begin(), nz.begin() + static_cast<std::ptrdiff_t>(nz.size() / 2), nz.end());
+    return std::max(floor, kappa * nz[nz.size() / 2]);
+  };
+  return {median(H.means), median(H.log_scales), median(H.opacities), median(H.sh)};
+}
+
+// FisherRF's damping examined: the share of a candidate's trace score (fisherScore with
+// `lambda`) that comes from parameters whose held information H is below `rel` x the
+// median of their group's nonzero held information, i.e. from what no held view has
+// really seen. Near 1, the score counts unseen parameters at about 1/lambda each and says
+// little about anything else. 0 when the score is 0.
+template <typename T>
+double unseenShare(const GaussiansT<T>& Hv, const GaussiansT<T>& H, double lambda, double rel = 1e-3) {
+  // rel x the group's nonzero median (relativeDamping with no floor); a group nobody has
+  // seen at all is unseen throughout.
+  auto cutOf = [&](const std::vector<T>& h, double c) {
+    return std::any_of(h.begin(), h.end(), [](T x) { return x > T(0); }) ? c : std::numeric_limits<double>::infinity();
+  };
+  GroupDamping cut = relativeDamping(H, rel, 0.0);
+  cut = {cutOf(H.means, cut.means), cutOf(H.log_scales, cut.log_scales), cutOf(H.opacities, cut.opacities), cutOf(H.sh, cut.sh)};
+  double unseen = 0, all = 0;
+  auto add = [&](const std::vector<T>& v, const std::vector<T>& h, double threshold) {
+    for (std::size_t k = 0; k < v.size(); ++k)
+      if (v[k] != T(0)) {
+        const double x = static_cast<double>(v[k]) / (static_cast<double>(h[k]) + lambda);
+        all += x;
+        if (static_cast<double>(h[k]) < threshold) unseen += x;
+      }
+  };
+  add(Hv.means, H.means, cut.means);
+  add(Hv.log_scales, H.log_scales, cut.log_scales);
+  add(Hv.opacities, H.opacities, cut.opacities);
+  add(Hv.sh, H.sh, cut.sh);
+  return all > 0 ? unseen / all : 0.0;
+}
+
+// The path-variance score of a candidate view with information Hc, given the held views'
+// H and a pool of views (the path a person will look along) whose summed information is
+// W: under the diagonal Laplace posterior each parameter's variance 1/(H + l) falls to
+// 1/(H + Hc + l), and the pool's predicted variance sum_t sum_p H_tp / (H_p + l_p) falls by
+//   sum_p W_p Hc_p / ((H_p + l_p)(H_p + Hc_p + l_p)).
+// A parameter counts by how much of the pool depends on it (W), and its gain saturates
+// where the held views already tell it (H) or where the candidate says a lot (Hc), so
+// near-duplicates of held views and views of what nobody will look at score low.
+// Rotations excluded, as in fisherScore; double, fixed order.
+template <typename T>
+double pathVarianceScore(const GaussiansT<T>& Hc, const GaussiansT<T>& H, const GaussiansT<T>& W, const GroupDamping& l) {
+  double score = 0;
+  auto add = [&](const std::vector<T>& c, const std::vector<T>& h, const std::vector<T>& w, double lambda) {
+    for (std::size_t k = 0; k < c.size(); ++k)
+      if (c[k] != T(0)) {
+        const double hk = static_cast<double>(h[k]) + lambda;
+        score += static_cast<double>(w[k]) * static_cast<double>(c[k]) / (hk * (hk + static_cast<double>(c[k])));
+      }
+  };
+  add(Hc.means, H.means, W.means, l.means);
+  add(Hc.log_scales, H.log_scales, W.log_scales, l.log_scales);
+  add(Hc.opacities, H.opacities, W.opacities, l.opacities);
+  add(Hc.sh, H.sh, W.sh, l.sh);
   return score;
 }
 

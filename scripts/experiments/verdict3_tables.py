@@ -33,14 +33,26 @@ DRAWS = 10000
 BASELINES = ("fisher", "fvs")
 
 
+def labels(grid):
+    """[(label, method, variant)] in the grid's order: a method's default variant is named
+    by the method, any other as "method (variant)"."""
+    out = []
+    for m in grid["methods"]:
+        for v in grid.get("variants", [{"name": "default"}]):
+            if v.get("methods") and m not in v["methods"]:
+                continue
+            out.append((m if v["name"] == "default" else f"{m} ({v['name']})", m, v["name"]))
+    return out
+
+
 def load_runs(grid, out):
-    """{(layout, scene, method, seed): results.json} of the finished default-variant jobs, and
-    the list of job ids still missing."""
+    """{(layout, scene, label, seed): results.json} of the finished jobs, and the list of job
+    ids still missing."""
     runs, missing = {}, []
     for sc in grid["scenes"]:
-        for m in grid["methods"]:
+        for label, m, variant in labels(grid):
             for seed in grid.get("method_seeds", {}).get(m, grid["seeds"]):
-                job = f"{sc['name']}__{m}__default__s{seed}"
+                job = f"{sc['name']}__{m}__{variant}__s{seed}"
                 path = os.path.join(out, "runs", job, "results.json")
                 if not os.path.exists(path):
                     missing.append(job)
@@ -49,7 +61,7 @@ def load_runs(grid, out):
                     r = json.load(fh)
                 if "final_fit" not in r or "path" not in r["final_fit"]:
                     raise SystemExit(f"{path}: final_fit.path: missing (the run predates path evaluation)")
-                runs[(sc["layout"], sc["name"], m, seed)] = r
+                runs[(sc["layout"], sc["name"], label, seed)] = r
     return runs, missing
 
 
@@ -89,7 +101,8 @@ def fmt(x, digits=3):
 def tables(grid, out):
     runs, missing = load_runs(grid, out)
     layouts = list(dict.fromkeys(sc["layout"] for sc in grid["scenes"]))
-    methods = grid["methods"]
+    methods = [label for label, _, _ in labels(grid)]
+    method_of = {label: m for label, m, _ in labels(grid)}
     md, rows = [], []
     md.append("# Verdict 3: selectors judged across scenes")
     md.append("")
@@ -140,7 +153,7 @@ def tables(grid, out):
                 continue
             path_by, test_by, pairs = {}, {}, 0
             for s in scenes:
-                for seed in grid.get("method_seeds", {}).get(m, grid["seeds"]):
+                for seed in grid.get("method_seeds", {}).get(method_of[m], grid["seeds"]):
                     a, b = have.get((s, m, seed)), have.get((s, better, seed))
                     if a is None or b is None:
                         continue
@@ -187,12 +200,13 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--grid", default="results/grid_verdict3.json")
     ap.add_argument("--out", default="results/verdict3")
+    ap.add_argument("--name", default="verdict3", help="the tables' file name under OUT/tables (.md, .csv)")
     ap.add_argument("--check", action="store_true", help="compare with the committed tables; write nothing")
     a = ap.parse_args()
     with open(a.grid) as fh:
         grid = json.load(fh)
     md, csv_text = tables(grid, a.out)
-    files = {os.path.join(a.out, "tables", "verdict3.md"): md + "\n", os.path.join(a.out, "tables", "verdict3.csv"): csv_text}
+    files = {os.path.join(a.out, "tables", a.name + ".md"): md + "\n", os.path.join(a.out, "tables", a.name + ".csv"): csv_text}
     if a.check:
         stale = []
         for path, text in files.items():
