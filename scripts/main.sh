@@ -9,7 +9,7 @@ cd "$(dirname "$0")/.."
 scene=out/builtin
 run=out/active_sa-resgs
 bash scripts/install_deps.sh
-bash scripts/build.sh
+bash scripts/build.sh --target saresgs  # the program alone: the tests and fuzzers are test.sh's
 [ -f "$scene/manifest.json" ] || ./build/apps/saresgs scene --layout room360 --out "$scene"
 ./build/apps/saresgs info --dataset "$scene"
 # A finished run is replaced; an interrupted one continues from its checkpoint.
