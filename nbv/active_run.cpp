@@ -13,6 +13,7 @@
 #include "geometry/error.h"
 #include "geometry/io/atomic_file.h"
 #include "geometry/io/json_file.h"
+#include "geometry/scene/cameras_json.h"
 #include "nbv/ause.h"
 #include "nbv/initial_views.h"
 #include "nbv/path_variance.h"
@@ -417,6 +418,9 @@ void ActiveRun::saveCheckpoint() const {
   j["method"] = toString(opt_.method);
   j["seed"] = opt_.seed;
   j["views"] = scene_.views.size();
+  // The colour and kind only: where it came from may be said another way on resume.
+  j["background"] = backgroundJson(scene_);
+  j["background"].erase("from");
   j["initial"] = initial_;
   j["selected"] = selected_;
   j["iterations_done"] = iterations_done_;
@@ -479,6 +483,13 @@ bool ActiveRun::loadCheckpoint() {
     throw InputError(f, "seed", "written with seed " + j["seed"].dump());
   if (jsonInteger(field("views"), f, "views", 0, kMaxCount) != static_cast<long long>(scene_.views.size()))
     throw InputError(f, "views", "written for another scene");
+  if (j.contains("background")) {
+    nlohmann::json mine = backgroundJson(scene_);
+    mine.erase("from");
+    if (j["background"] != mine)
+      throw InputError(f, "background", "written with background " + j["background"].dump() + ", this run's is " +
+                                            mine.dump() + ": resume with the same --background");
+  }
   // View indices are read in range of this scene's views; checkLoadedState checks the rest.
   const long long last_view = static_cast<long long>(scene_.views.size()) - 1;
   auto views = [&](const char* name) {

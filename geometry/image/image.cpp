@@ -86,7 +86,7 @@ Image8 readImage(const std::string& path, bool keep_alpha) {
 bool imageHasAlpha(const std::string& path) {
   std::FILE* file = std::fopen(path.c_str(), "rb");
   if (!file) return false;
-  std::uint8_t head[8];
+  std::uint8_t head[8]{};
   const bool png = std::fread(head, 1, 8, file) == 8 && std::memcmp(head, kPngSignature, 8) == 0;
   const bool jpeg = !png && head[0] == 0xff && head[1] == 0xd8;
   bool alpha = false;
@@ -118,6 +118,18 @@ bool imageHasAlpha(const std::string& path) {
   } catch (const std::exception&) {
     return false;
   }
+}
+
+bool imageHasTransparency(const std::string& path) {
+  if (!imageHasAlpha(path)) return false;
+  try {
+    const Image8 img = readImage(path, /*keep_alpha=*/true);
+    if (img.channels != 4) return false;
+    for (std::size_t p = 3; p < img.data.size(); p += 4)
+      if (img.data[p] != 255) return true;
+  } catch (const std::exception&) {
+  }
+  return false;
 }
 
 void writeImage(const std::string& path, const Image8& img) {

@@ -41,6 +41,10 @@ Image8 readImage(const std::string& path, bool keep_alpha = false);
 // type 4 or 6, or a tRNS chunk before the image data) and false for a JPEG; any other file
 // is decoded to see. A file that cannot be read says false: reading it later gives the error.
 bool imageHasAlpha(const std::string& path);
+// Whether the image at `path` has a pixel that is not opaque: imageHasAlpha, then a decode
+// of the file to look (many tools write opaque images as RGBA). False for a file that
+// cannot be read.
+bool imageHasTransparency(const std::string& path);
 // Writes PNG/JPEG by extension, to a temporary name first, then renames.
 void writeImage(const std::string& path, const Image8& img);
 // Area-averaging resize to an exact size (used for downscaled loading).

@@ -178,7 +178,11 @@ Scene loadBlenderDataset(const std::string& path, const DatasetOptions& opts) {
   // The format implies white (NeRF-synthetic's images are composited on it). A folder
   // written by `saresgs scene --format blender`: its manifest's sizes must match, and a
   // room's "background": null means the data has none (its split is the transforms').
-  BackgroundRule rule{opts.background, true, std::array<float, 3>{1, 1, 1}, "Blender (white)"};
+  BackgroundRule rule;
+  rule.said = opts.background;
+  rule.data_said = true;
+  rule.data_color = std::array<float, 3>{1, 1, 1};
+  rule.data_from = "Blender (white)";
   if (fs::exists(root / "manifest.json")) {
     const DatasetManifest m = readDatasetManifest((root / "manifest.json").string());
     std::vector<std::string> names;
@@ -258,7 +262,9 @@ Scene loadNerfstudioDataset(const std::string& path, const DatasetOptions& opts)
   if (scene.train.empty()) throw InputError(file, "frames", "no train view left after the split");
   // nerfstudio's transforms.json says nothing of a background: the user's, else white
   // when the images have alpha (settleBackground), else none.
-  settleBackground(scene, BackgroundRule{opts.background, false, std::nullopt, ""});
+  BackgroundRule rule;
+  rule.said = opts.background;
+  settleBackground(scene, rule);
 
   // The initial points: ply_file_path (ns-process-data's sparse_pc.ply).
   if (const json* ply = jsonFind(j, "ply_file_path", file, "")) {

@@ -155,7 +155,8 @@ Scene loadColmapDataset(const std::string& path, const DatasetOptions& opts) {
   }
   // The background: the user's, the manifest's, else white when the images have alpha
   // (settleBackground), else none.
-  BackgroundRule background{opts.background, false, std::nullopt, ""};
+  BackgroundRule background;
+  background.said = opts.background;
   if (!applyManifest(root / "manifest.json", full_size, scene, background)) {
     for (int i = 0; i < static_cast<int>(scene.views.size()); ++i)
       ((opts.test_every > 0 && i % opts.test_every == 0) ? scene.test : scene.train).push_back(i);

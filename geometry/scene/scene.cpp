@@ -63,18 +63,20 @@ std::unique_ptr<CachedImage> loadViewImage(const SceneView& v, const ImageLoadOp
 }  // namespace
 
 const Image8& Scene::image(int i) const {
+  return cachedImage(i).rgb;
+}
+
+const Image8* Scene::alpha(int i) const {
+  const CachedImage& c = cachedImage(i);
+  return c.alpha.empty() ? nullptr : &c.alpha;
+}
+
+const CachedImage& Scene::cachedImage(int i) const {
   std::lock_guard<std::mutex> lock(cache_->mutex);
   if (cache_->slots.size() < views.size()) cache_->slots.resize(views.size());
   auto& slot = cache_->slots.at(static_cast<size_t>(i));
   if (!slot) slot = loadViewImage(views.at(i), load);
-  return slot->rgb;
-}
-
-const Image8* Scene::alpha(int i) const {
-  image(i);
-  std::lock_guard<std::mutex> lock(cache_->mutex);
-  const CachedImage& slot = *cache_->slots.at(static_cast<size_t>(i));
-  return slot.alpha.empty() ? nullptr : &slot.alpha;
+  return *slot;
 }
 
 std::size_t Scene::preloadImages(const std::vector<int>& which) const {
@@ -157,6 +159,8 @@ void Scene::finalize() {
 
 namespace {
 constexpr const char* kAlphaNoneSaid = "alpha in the images, none said (white)";
+// Images with an alpha channel decoded to find one that is not opaque, at most.
+constexpr int kAlphaImagesDecoded = 8;
 }
 
 void settleBackground(Scene& scene, const BackgroundRule& rule) {
@@ -164,7 +168,7 @@ void settleBackground(Scene& scene, const BackgroundRule& rule) {
   if (rule.said) {
     scene.background = rule.said->color;
     scene.random_background = rule.said->random;
-    scene.background_from = "--background";
+    scene.background_from = rule.said_by;
   } else if (rule.data_said) {
     scene.background = rule.data_color;
     scene.background_from = rule.data_color ? rule.data_from : rule.data_from + ": none";
@@ -175,21 +179,30 @@ void settleBackground(Scene& scene, const BackgroundRule& rule) {
   // Images with alpha need a background to be composited on, and training must render on
   // the same one: where nothing said one, white (the compositing default of every loader).
   // A manifest's null is a word too: the data is opaque (rooms written as RGBA).
+  // Many tools write opaque images as RGBA: alpha counts where a pixel is not opaque, in
+  // one of the first few images whose header says alpha (each of those is decoded).
   if (!rule.said && !rule.data_said) {
-    for (const SceneView& v : scene.views)
-      if (imageHasAlpha(v.image_path)) {
+    int decoded = 0;
+    for (const SceneView& v : scene.views) {
+      if (decoded >= kAlphaImagesDecoded) break;
+      if (!imageHasAlpha(v.image_path)) continue;
+      ++decoded;
+      if (imageHasTransparency(v.image_path)) {
         scene.background = std::array<float, 3>{1, 1, 1};
         scene.background_from = kAlphaNoneSaid;
         break;
       }
+    }
   }
-  scene.load.background = scene.background.value_or(std::array<float, 3>{1, 1, 1});
+  // With none, renders are on black: so is any alpha a file still has.
+  scene.load.background = scene.background.value_or(std::array<float, 3>{0, 0, 0});
   scene.load.keep_alpha = scene.random_background;
 }
 
-void setBackground(Scene& scene, const BackgroundChoice& choice) {
+void setBackground(Scene& scene, const BackgroundChoice& choice, const std::string& said_by) {
   BackgroundRule rule;
   rule.said = choice;
+  rule.said_by = said_by;
   settleBackground(scene, rule);
   scene.resetImageCache();
 }

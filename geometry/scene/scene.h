@@ -44,7 +44,8 @@ struct AABB {
 
 // How images are read: from `images/` (factor 1), from `images_<f>` when that folder
 // exists, or resized on load by 1/f. RGBA images are composited on `background`, which
-// the loaders set to the scene's (Scene::background; white where it has none).
+// the loaders set to the scene's (settleBackground: a caller's value is replaced; say a
+// background with DatasetOptions::background).
 struct ImageLoadOptions {
   int downscale = 1;  // 1, 2, 4, 8, ...
   std::array<float, 3> background{1.0f, 1.0f, 1.0f};
@@ -52,6 +53,7 @@ struct ImageLoadOptions {
 };
 
 class ImageCache;  // defined in scene.cpp; shared by copies of a Scene
+struct CachedImage;
 
 class Scene {
  public:
@@ -104,6 +106,8 @@ class Scene {
   void resetImageCache();
 
  private:
+  // View i's cache slot, read on first use (one lock for the read and the lookup).
+  const CachedImage& cachedImage(int i) const;
   std::shared_ptr<ImageCache> cache_;
 };
 
@@ -115,11 +119,12 @@ void moveToOwnFrame(Scene& scene);
 // The one rule for every loader's background. In order: the user's `said` choice (the
 // `--background` option); the data's own word (`data_said`: a manifest's colour or null, or
 // Blender's white), `data_from` naming it; when neither said anything, white if any image
-// has alpha (backgroundWarning then says so), else none. It sets
+// has pixels that are not opaque (backgroundWarning then says so), else none. It sets
 // background, random_background, background_from and load (the compositing colour and
 // whether to keep alpha) before any image is read.
 struct BackgroundRule {
   std::optional<BackgroundChoice> said;
+  std::string said_by = "--background";  // what said it, for background_from
   bool data_said = false;
   std::optional<std::array<float, 3>> data_color;
   std::string data_from;
@@ -128,7 +133,7 @@ void settleBackground(Scene& scene, const BackgroundRule& rule);
 
 // Gives a loaded scene another background (Python's Trainer(background=...)): the same as
 // the loader's rule with `choice` said, and the images read again on their next use.
-void setBackground(Scene& scene, const BackgroundChoice& choice);
+void setBackground(Scene& scene, const BackgroundChoice& choice, const std::string& said_by = "--background");
 
 // The warning settleBackground found, if any (the images have alpha and nothing said what
 // stands behind them), for `saresgs info`, train and active to print.

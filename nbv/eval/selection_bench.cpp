@@ -40,12 +40,18 @@ SelectionBenchResult benchSelection(const Scene& scene, const SelectionBenchOpti
   using Clock = std::chrono::steady_clock;
   auto seconds = [](Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); };
   for (int round = 0; round < opt.rounds; ++round) {
-    auto t0 = Clock::now();
-    const std::vector<double> f = fisherScores(g, s, scene, held, candidates, lambda);
-    r.fisher_seconds.push_back(seconds(t0));
-    t0 = Clock::now();
-    const std::vector<double> p = pathVarianceScores(g, s, scene, held, candidates, {lambda, opt.kappa});
-    r.path_variance_seconds.push_back(seconds(t0));
+    // The order alternates: FisherRF first in even rounds, path-variance first in odd ones.
+    std::vector<double> f, p;
+    for (int k = 0; k < 2; ++k) {
+      const auto t0 = Clock::now();
+      if ((k == 0) == (round % 2 == 0)) {
+        f = fisherScores(g, s, scene, held, candidates, lambda);
+        r.fisher_seconds.push_back(seconds(t0));
+      } else {
+        p = pathVarianceScores(g, s, scene, held, candidates, {lambda, opt.kappa});
+        r.path_variance_seconds.push_back(seconds(t0));
+      }
+    }
     r.fisher_choice = candidates[argmaxScore(f, candidates)];
     r.path_variance_choice = candidates[argmaxScore(p, candidates)];
   }

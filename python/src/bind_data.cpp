@@ -164,6 +164,7 @@ void bindData(py::module_& m) {
         {
           py::gil_scoped_release nogil;
           s = std::make_shared<Scene>(loadDataset(path, o));
+          if (o.background) s->background_from = "background=";  // said here, not by the CLI's option
           warnings = checkDataset(*s);  // refuses a dataset that no train view sees (InputError)
         }
         // As the command line prints them: implausible intrinsics, views that see no point.
@@ -219,7 +220,7 @@ std::shared_ptr<Scene> withBackground(const std::shared_ptr<Scene>& dataset, con
   const std::optional<BackgroundChoice> b = backgroundArg(background);
   if (!b) return dataset;
   auto copy = std::make_shared<Scene>(*dataset);
-  setBackground(*copy, *b);
+  setBackground(*copy, *b, "background=");
   return copy;
 }
 

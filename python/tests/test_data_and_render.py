@@ -163,7 +163,7 @@ def test_background_is_said_once_for_the_images_and_the_renders(tmp_path):
     white = saresgs.load_dataset(str(folder))
     assert white.background == (1.0, 1.0, 1.0) and white.background_from == "manifest" and not white.random_background
     black = saresgs.load_dataset(str(folder), background="black")
-    assert black.background == (0.0, 0.0, 0.0) and black.background_from == "--background"
+    assert black.background == (0.0, 0.0, 0.0) and black.background_from == "background="
     tinted = saresgs.load_dataset(str(folder), background=(0.2, 0.4, 0.6))
     v = white.train[0]
     iw, ib, it = white.image(v).astype(int), black.image(v).astype(int), tinted.image(v).astype(int)

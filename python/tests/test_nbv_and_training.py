@@ -54,7 +54,7 @@ def test_python_random_selector_is_the_builtin_random_bit_for_bit(room, tmp_path
     assert len(builtin["final_fit"]["path"]) == len(room)
     # Said black, the run renders against black and records it.
     black = saresgs.ActiveRun(room, method="random", background="black", **SHORT).run()
-    assert black["background"] == {"color": [0.0, 0.0, 0.0], "random": False, "from": "--background"}
+    assert black["background"] == {"color": [0.0, 0.0, 0.0], "random": False, "from": "background="}
 
 
 def test_final_residual_is_the_clis_and_keeps_the_selection(room, tmp_path):

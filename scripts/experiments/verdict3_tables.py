@@ -6,7 +6,8 @@ Reads a grid config (results/grid_verdict3.json: scenes with their capture type,
 methods, trainer seeds) and each finished job's results.json under OUT/runs/, and writes
 OUT/tables/verdict3.md (and .csv). With --check it writes nothing and fails (exit 1) when the
 committed tables differ from what the runs give: the test command runs it that way, so a
-stale number cannot stay.
+stale number cannot stay. It reads the runs git tracks then (a grid still running leaves
+others on disk); commit new runs with the tables they give.
 
 Measures, all of the final fit (the method's own training on its chosen views):
 - along the path: the mean PSNR over every view of the dataset that the run did not hold
@@ -27,6 +28,7 @@ import io
 import json
 import os
 import random
+import subprocess
 import sys
 
 DRAWS = 10000
@@ -45,16 +47,28 @@ def labels(grid):
     return out
 
 
-def load_runs(grid, out):
+def tracked_files(out):
+    """The results.json files under OUT/runs that git tracks (the committed runs), or None
+    outside a git work tree."""
+    try:
+        listed = subprocess.run(["git", "ls-files", "--", os.path.join(out, "runs")], capture_output=True, text=True,
+                                check=True).stdout
+    except (OSError, subprocess.CalledProcessError):
+        return None
+    return {os.path.normpath(p) for p in listed.splitlines() if p.endswith("results.json")}
+
+
+def load_runs(grid, out, only=None):
     """{(layout, scene, label, seed): results.json} of the finished jobs, and the list of job
-    ids still missing."""
+    ids still missing. `only`: a set of the files to read (the committed runs); others count
+    as missing."""
     runs, missing = {}, []
     for sc in grid["scenes"]:
         for label, m, variant in labels(grid):
             for seed in grid.get("method_seeds", {}).get(m, grid["seeds"]):
                 job = f"{sc['name']}__{m}__{variant}__s{seed}"
                 path = os.path.join(out, "runs", job, "results.json")
-                if not os.path.exists(path):
+                if not os.path.exists(path) or (only is not None and os.path.normpath(path) not in only):
                     missing.append(job)
                     continue
                 with open(path) as fh:
@@ -66,7 +80,8 @@ def load_runs(grid, out):
 
 
 def held(r):
-    return set(r["selected_views"])
+    """Every view the run trained on: its initial views and the ones it chose."""
+    return set(r.get("initial_views", [])) | set(r["selected_views"])
 
 
 def path_psnr(r, exclude):
@@ -98,8 +113,8 @@ def fmt(x, digits=3):
     return "n/a" if x != x else f"{x:.{digits}f}"
 
 
-def tables(grid, out):
-    runs, missing = load_runs(grid, out)
+def tables(grid, out, only=None):
+    runs, missing = load_runs(grid, out, only)
     layouts = list(dict.fromkeys(sc["layout"] for sc in grid["scenes"]))
     methods = [label for label, _, _ in labels(grid)]
     method_of = {label: m for label, m, _ in labels(grid)}
@@ -167,8 +182,8 @@ def tables(grid, out):
             # move when another method's runs land.
             d, lo, hi = two_level_bootstrap(path_by, random.Random(f"{lay}/{m}/path"))
             td, tlo, thi = two_level_bootstrap(test_by, random.Random(f"{lay}/{m}/test"))
-            if lo != lo:
-                verdict = "one scene and seed: no interval"
+            if len(path_by) < 2:
+                verdict = "one scene: no verdict across scenes"
             elif lo > 0:
                 verdict = "above, clear of 0"
             elif hi < 0:
@@ -205,7 +220,10 @@ def main():
     a = ap.parse_args()
     with open(a.grid) as fh:
         grid = json.load(fh)
-    md, csv_text = tables(grid, a.out)
+    # --check judges the committed runs alone (a grid still running leaves others on disk);
+    # writing uses every finished run, to be committed with the tables.
+    only = tracked_files(a.out) if a.check else None
+    md, csv_text = tables(grid, a.out, only)
     files = {os.path.join(a.out, "tables", a.name + ".md"): md + "\n", os.path.join(a.out, "tables", a.name + ".csv"): csv_text}
     if a.check:
         stale = []

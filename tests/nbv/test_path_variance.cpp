@@ -130,9 +130,10 @@ TEST(PathVariance, ScoreEqualsTheDoublePrecisionReference) {
   const std::vector<int> held{0, 3}, candidates{1, 2, 4, 5, 6};
   for (double kappa : {0.0, 0.01, 1.0}) {
     const std::vector<double> ref = referenceScores(gd, s, scene, held, candidates, 1e-6, kappa);
-    for (std::size_t keep : {std::size_t{1} << 30, std::size_t{0}, std::size_t{1}}) {
-      // Kept between the passes, computed again, or the first one kept (a byte budget of
-      // one Gaussian's information keeps none; 0 keeps none either).
+    // The candidates' information: all kept between the passes, none (computed again), or
+    // the first two kept and the rest computed again (a budget of two models' information).
+    const std::size_t one = (g.means.size() + g.log_scales.size() + g.opacities.size() + g.sh.size()) * sizeof(float);
+    for (std::size_t keep : {std::size_t{1} << 30, std::size_t{0}, 2 * one}) {
       const std::vector<double> got = pathVarianceScores(g, s, scene, held, candidates, {1e-6, kappa, keep});
       ASSERT_EQ(got.size(), ref.size());
       for (std::size_t i = 0; i < ref.size(); ++i) {

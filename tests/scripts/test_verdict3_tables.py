@@ -39,8 +39,8 @@ def test_the_variance_of_scenes_widens_the_interval():
     assert hi1 - lo1 < 0.05
 
 
-def run(views, held, psnrs, test_psnr=25.0):
-    return {"selected_views": held, "final_fit": {"psnr": test_psnr, "ssim": 0.9,
+def run(views, held, psnrs, test_psnr=25.0, initial=()):
+    return {"initial_views": list(initial), "selected_views": held, "final_fit": {"psnr": test_psnr, "ssim": 0.9,
             "path": [{"name": v, "psnr": p} for v, p in zip(views, psnrs)]}}
 
 
@@ -57,16 +57,17 @@ def write_grid(tmp, methods, jobs):
 
 
 def test_pairs_are_judged_over_the_views_neither_run_held(tmp_path):
-    views = ["a", "b", "c", "d"]
+    views = ["i", "a", "b", "c", "d"]
     jobs = {}
     for s in ("o-s2", "o-s3"):
         for seed in (0, 1):
-            # fvs holds a, fisher holds b: over c and d fvs is 1 dB ahead; on its own held
-            # view fisher would look 10 dB better, which must not count.
-            jobs[f"{s}__fvs__default__s{seed}"] = run(views, ["a"], [40, 20, 21, 21])
-            jobs[f"{s}__fisher__default__s{seed}"] = run(views, ["b"], [20, 30, 20, 20])
-            jobs[f"{s}__random__default__s{seed}"] = run(views, ["a"], [40, 19, 19, 19])
-            jobs[f"{s}__oracle__default__s{seed}"] = run(views, ["a"], [40, 23, 23, 23])
+            # Every run starts from the initial view i; fvs then holds a, fisher b: over c
+            # and d fvs is 1 dB ahead; on its own held view (and i) fisher would look 10 dB
+            # better, which must not count.
+            jobs[f"{s}__fvs__default__s{seed}"] = run(views, ["a"], [20, 40, 20, 21, 21], initial=["i"])
+            jobs[f"{s}__fisher__default__s{seed}"] = run(views, ["b"], [30, 20, 30, 20, 20], initial=["i"])
+            jobs[f"{s}__random__default__s{seed}"] = run(views, ["a"], [40, 40, 19, 19, 19], initial=["i"])
+            jobs[f"{s}__oracle__default__s{seed}"] = run(views, ["a"], [40, 40, 23, 23, 23], initial=["i"])
     grid = write_grid(str(tmp_path), ["random", "fisher", "fvs", "oracle"], jobs)
     md, csv_text = v3.tables(grid, str(tmp_path))
     # fvs along its unheld path: (20+21+21)/3; fisher: (20+20+20)/3: fvs is the better baseline.
@@ -78,6 +79,16 @@ def test_pairs_are_judged_over_the_views_neither_run_held(tmp_path):
     # The oracle's share: random 19, oracle 23, fvs (20+21+21)/3 -> 0.42.
     assert [l for l in methods.splitlines() if l.startswith("| fvs | 4 |")][0].endswith("| 0.42 |")
     assert "(16 finished runs, 0 missing)" in md
+
+
+def test_one_scene_gets_no_verdict_across_scenes(tmp_path):
+    views = ["a", "b", "c"]
+    jobs = {f"o-s2__{m}__default__s{seed}": run(views, ["a"], [30, 20 + (m == "fvs"), 20])
+            for m in ("fisher", "fvs") for seed in (0, 1)}
+    grid = write_grid(str(tmp_path), ["fisher", "fvs"], jobs)
+    md, _ = v3.tables(grid, str(tmp_path))
+    row = [l for l in md.split("Against the better baseline")[1].splitlines() if l.startswith("| fisher |")][0]
+    assert "one scene: no verdict across scenes" in row and "clear of 0" not in row
 
 
 def test_check_fails_on_a_stale_table_and_passes_on_a_fresh_one(tmp_path):

@@ -150,3 +150,32 @@ TEST(Background, OpaqueImagesWithNothingSaidHaveNone) {
   EXPECT_EQ(s.background_from, "none");
   EXPECT_EQ(backgroundWarning(s), "");
 }
+
+// Many tools write opaque images as RGBA: an alpha channel that is 255 everywhere is no
+// alpha, and the data keeps no background (as 3DGS trains such data, on black).
+TEST(Background, OpaqueRgbaImagesHaveNone) {
+  TempDir d;
+  writeNerfstudio(d, 255, false);
+  EXPECT_TRUE(imageHasAlpha(d.file("images/f0.png")));
+  EXPECT_FALSE(imageHasTransparency(d.file("images/f0.png")));
+  const Scene s = loadDataset(d.str());
+  EXPECT_FALSE(s.background.has_value());
+  EXPECT_EQ(backgroundWarning(s), "");
+}
+
+// A manifest that says the data has no background wins; any alpha a file still has is
+// composited on black, the colour the renders are against.
+TEST(Background, WithNoneAnyAlphaIsCompositedOnBlack) {
+  TempDir d;
+  writeNerfstudio(d, 128, false);
+  Scene s = loadDataset(d.str());
+  BackgroundRule rule;
+  rule.data_said = true;
+  rule.data_from = "manifest";
+  settleBackground(s, rule);
+  s.resetImageCache();
+  EXPECT_FALSE(s.background.has_value());
+  EXPECT_EQ(s.background_from, "manifest: none");
+  EXPECT_EQ(s.image(0).at(0, 0, 0), 100);  // 200 x 128/255 over black
+  EXPECT_EQ(s.image(0).at(0, 0, 2), 0);
+}
