@@ -131,7 +131,7 @@ def tables(grid, out, only=None):
         have = {(s, m, seed): r for (l, s, m, seed), r in runs.items() if l == lay}
         if not have:
             continue
-        md.append(f"## {lay} ({len(scenes)} scenes: {', '.join(scenes)})")
+        md.append(f"## {lay} ({len(scenes)} scene{'' if len(scenes) == 1 else 's'}: {', '.join(scenes)})")
         md.append("")
         md.append("| method | runs | along path, dB | test PSNR, dB | test SSIM | oracle's share |")
         md.append("|---|---:|---:|---:|---:|---:|")
