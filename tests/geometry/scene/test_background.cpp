@@ -6,6 +6,7 @@
 
 #include <fstream>
 
+#include "common/gl_pose.h"
 #include "common/test_support.h"
 #include "geometry/error.h"
 #include "geometry/image/image.h"
@@ -14,6 +15,7 @@
 
 using namespace saresgs;
 using saresgs::test::TempDir;
+using saresgs::test::glPose;
 using nlohmann::json;
 
 TEST(Background, ParsesTheNamedColoursRandomAndRgb) {
@@ -57,16 +59,6 @@ TEST(Background, AlphaIsToldFromTheHeader) {
 }
 
 namespace {
-
-json glPose(const Eigen::Vector3d& eye) {
-  const Eigen::Vector3d back = eye.normalized();
-  const Eigen::Vector3d right = Eigen::Vector3d::UnitZ().cross(back).normalized();
-  const Eigen::Vector3d up = back.cross(right);
-  json m = json::array();
-  for (int r = 0; r < 3; ++r) m.push_back({right[r], up[r], back[r], eye[r]});
-  m.push_back({0, 0, 0, 1});
-  return m;
-}
 
 // A nerfstudio folder of 4 views, 8x6, each pixel (200, 100, 0) with alpha `a` (RGB when
 // a is 255 and `rgb`).

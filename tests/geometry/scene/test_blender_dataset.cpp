@@ -5,6 +5,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "common/gl_pose.h"
 #include "common/test_support.h"
 #include "geometry/error.h"
 #include "geometry/image/image.h"
@@ -12,21 +13,12 @@
 
 using namespace saresgs;
 using saresgs::test::TempDir;
+using saresgs::test::glPose;
 using nlohmann::json;
 
 namespace {
 
 // A camera-to-world matrix in OpenGL axes: camera at `eye` looking at the origin.
-json glPose(const Eigen::Vector3d& eye) {
-  const Eigen::Vector3d back = eye.normalized();  // OpenGL +z points away from the view
-  const Eigen::Vector3d right = Eigen::Vector3d::UnitZ().cross(back).normalized();
-  const Eigen::Vector3d up = back.cross(right);
-  json m = json::array();
-  for (int r = 0; r < 3; ++r) m.push_back({right[r], up[r], back[r], eye[r]});
-  m.push_back({0, 0, 0, 1});
-  return m;
-}
-
 void writeRgba(const std::string& path, int w, int h, std::uint8_t alpha) {
   Image8 img(w, h, 4);
   for (int y = 0; y < h; ++y)

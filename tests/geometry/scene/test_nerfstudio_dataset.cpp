@@ -7,6 +7,7 @@
 #include <functional>
 #include <fstream>
 
+#include "common/gl_pose.h"
 #include "common/test_support.h"
 #include "geometry/error.h"
 #include "geometry/image/image.h"
@@ -15,19 +16,10 @@
 
 using namespace saresgs;
 using saresgs::test::TempDir;
+using saresgs::test::glPose;
 using nlohmann::json;
 
 namespace {
-
-json glPose(const Eigen::Vector3d& eye) {
-  const Eigen::Vector3d back = eye.normalized();
-  const Eigen::Vector3d right = Eigen::Vector3d::UnitZ().cross(back).normalized();
-  const Eigen::Vector3d up = back.cross(right);
-  json m = json::array();
-  for (int r = 0; r < 3; ++r) m.push_back({right[r], up[r], back[r], eye[r]});
-  m.push_back({0, 0, 0, 1});
-  return m;
-}
 
 // n frames named frame_00001.jpg ... (JPEG, 40x30) with top-level intrinsics.
 json writeFolder(const TempDir& d, int n) {
