@@ -7,7 +7,7 @@
 #    sanitizers, accepted or refused with an InputError;
 # 3. RUNS inputs mutated from both, fixed random seed, in a fresh copy of the corpus.
 # A crash, sanitizer report, leak, timeout, foreign exception or refused seed fails the
-# test; the input that did it is left in WORK_DIR/artifacts (README "Fuzzing").
+# test; the input that did it is left in WORK_DIR/artifacts (docs/FUZZING.md).
 set -euo pipefail
 bin=$1 seeds=$2 tests=$3 work=$4 runs=$5
 target=$(basename "$bin")

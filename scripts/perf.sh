@@ -3,7 +3,7 @@
 #
 #   bash scripts/perf.sh table   [BASE]   step time against Gaussians, resolution and threads,
 #                                         this tree and BASE alternated; writes
-#                                         results/perf/table.jsonl and docs/PERFORMANCE.md
+#                                         results/perf/table.jsonl and docs/RESULTS.md's tables
 #   bash scripts/perf.sh regress [BASE]   bench step 512x384/20k, this tree and BASE
 #                                         alternated (5 rounds); exits 1, loudly, when
 #                                         this tree is more than 10% slower
@@ -189,59 +189,5 @@ for c in "${configs[@]}"; do
   done
 done
 mv "$tmp" results/perf/table.jsonl
-/usr/bin/python3 - "$sha" "$(git rev-parse --short=7 HEAD)" "$machine" "$load_before" "$(load)" <<'EOF'
-import json, sys
-base_sha, head, machine, load0, load1 = sys.argv[1:6]
-rows = [json.loads(l) for l in open("results/perf/table.jsonl")]
-def key(r):
-    d = r["result"]
-    return (d["width"], d["height"], d["gaussians"], d["threads"])
-new = {key(r): r["result"] for r in rows if r["who"] == "new"}
-base = {key(r): r["result"] for r in rows if r["who"] == "base"}
-ref = new[(512, 384, 20000, 1)]
-out = []
-w = out.append
-w("# Performance: how a training step grows\n")
-w(f"Made by `bash scripts/perf.sh table` (this tree {head} against {base_sha}, built beside it and run")
-w(f"alternately in the same sitting). Machine: {machine}; load {load0} before, {load1} after.")
-w("Times on these VMs vary up to 3x from day to day (and the machine itself has changed between")
-w("sessions: an Intel Xeon, an AMD EPYC): compare columns of one table, not tables.\n")
-w("`bench step` on its random scene (16 mean 3-sigma ellipses per pixel, SH degree 3: the Gaussians")
-w("shrink as their number grows, so the Gaussian-pixel pairs stay proportional to the pixels). The")
-w("expected growth is from the reference row (512x384, 20k, 1 thread): pairs grow with the pixels,")
-w("per-Gaussian work (projection, sort, Adam) with the count, and the threads divide both.\n")
-w("| pixels | Gaussians | threads | step ms | base ms | ratio | pairs/px | expected x | measured x | render ns/pair·core | floor ns/pair | fraction of floor |")
-w("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
-ref_pairs = ref["pairs_per_step"]
-ref_adam = ref["stage_ms"]["adam"]
-for k in sorted(new, key=lambda k: (k[0] * k[1], k[2], k[3])):
-    n, b = new[k], base.get(k)
-    # Expected: the per-pair part scales with pairs, the Adam part with Gaussians; both / threads.
-    per_pair = ref["median_ms"] - ref_adam
-    expected = (per_pair * n["pairs_per_step"] / ref_pairs + ref_adam * k[2] / 20000) / k[3] / ref["median_ms"]
-    w(f"| {k[0]}x{k[1]} | {k[2]} | {k[3]} | {n['median_ms']:.1f} | {b['median_ms'] if b else float('nan'):.1f} | "
-      f"{n['median_ms'] / b['median_ms'] if b else float('nan'):.2f} | {n['mean_contributors_per_pixel']:.1f} | "
-      f"{expected:.2f} | {n['median_ms'] / ref['median_ms']:.2f} | {n['ns_per_pair_core']['render']:.2f} | "
-      f"{n['floor_ns_per_pair']:.2f} | {n['render_fraction_of_floor']:.2f} |")
-w("")
-w("Columns: *step ms* and *base ms* are medians over the timed steps; *ratio* this tree / base;")
-w("*pairs/px* contributing Gaussians per pixel; *expected x* / *measured x* the step time over the")
-w("reference row's; *render ns/pair·core* the forward pass's time times its threads over the")
-w("contributing pairs; *floor* the forward arithmetic alone on one core with no memory traffic")
-w("(`rasterForwardFloorNsPerPair`); *fraction of floor* floor / render (1 would be the floor).")
-w("The floor counts every lane the kernel evaluates, the render only the contributing pairs (on")
-w("room360 at 256x192, 80 % of the evaluated lanes contribute), and it leaves out the render's")
-w("projection, binning, sorting and gathering. Since f92ebb8 the kernels take G from a lattice")
-w("of products (two multiplications per block, splat/raster/raster_kernels_impl.h), and so does")
-w("the floor: earlier floors timed an exponent and exp2 per block, about twice the arithmetic")
-w("(1.0-1.1 ns per lane against 0.46 on the AMD EPYC VM of 2026-11-27), and before 96095fc")
-w("they also timed denormal assists. Earlier tables' floors and fractions are not comparable.")
-w("One thread: since 9089c7f `--threads` holds all of the step's TBB work (SSIM, Adam) at its")
-w("value; b0ae65c's `--threads 1` limited only the rasterizer, so its one-thread rows ran the")
-w("loss and Adam on both cores (at 1024x768 the loss alone is about 20 ms on one, 10 on two).")
-w("The raw lines: results/perf/table.jsonl. Kernel changes tried and not kept, with their numbers:")
-w("docs/PERFORMANCE_TRIED.md.")
-open("docs/PERFORMANCE.md.tmp", "w").write("\n".join(out) + "\n")
-EOF
-mv docs/PERFORMANCE.md.tmp docs/PERFORMANCE.md
-echo "wrote docs/PERFORMANCE.md and results/perf/table.jsonl; load after $(load)" >&2
+/usr/bin/python3 scripts/experiments/results_doc.py  # its speed section reads results/perf/table.jsonl
+echo "wrote results/perf/table.jsonl (this tree $(git rev-parse --short=7 HEAD) against $sha, load $load_before before) and docs/RESULTS.md; load after $(load)" >&2

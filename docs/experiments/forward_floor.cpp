@@ -1,4 +1,4 @@
-// How far the forward tile kernel is from its own arithmetic (docs/PERFORMANCE_TRIED.md,
+// How far the forward tile kernel is from its own arithmetic (docs/DECISIONS.md,
 // "0.6x on a step"). A developer's experiment, not part of the build or the tests:
 //
 //   g++ -std=c++20 -O3 -mavx2 -mfma -ffp-contract=off -DNDEBUG -I. \
@@ -8,7 +8,7 @@
 // namespace and times, in ns per evaluated pixel lane:
 //   reg2  - compositeFloor: the kernel's per-lane arithmetic on two blocks held in registers
 //           (since the lattice of 2026-11-27 this is the lattice's arithmetic, G by products;
-//           the exponent and exp2 per block that the numbers in docs/PERFORMANCE_TRIED.md
+//           the exponent and exp2 per block that the numbers in docs/DECISIONS.md
 //           were measured with are evalLanes, still used off the lattice);
 //   mem17 - the same arithmetic with each block's state loaded and stored every step, over
 //           17 blocks of a tile (what a block-major loop order would save is mem17 - reg2);

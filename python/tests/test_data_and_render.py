@@ -131,9 +131,9 @@ def test_loss_and_gradient_is_consistent():
 
 
 def test_a_dataset_in_millimetres_is_computed_in_its_own_frame(room, tmp_path):
-    """The room written in millimetres (scripts/frame_trials.py's frames) loads into the
+    """The room written in millimetres (scripts/experiments/frame_trials.py's frames) loads into the
     room's own coordinates; a trained model's .ply holds millimetres and maps back."""
-    spec = importlib.util.spec_from_file_location("frame_trials", REPO / "scripts" / "frame_trials.py")
+    spec = importlib.util.spec_from_file_location("frame_trials", REPO / "scripts" / "experiments" / "frame_trials.py")
     frames = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(frames)
     frames.write_frame(room.source, str(tmp_path / "mm"), [(1e3, (0.0, 0.0, 0.0))])

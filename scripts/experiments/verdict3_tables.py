@@ -1,13 +1,12 @@
 #!/usr/bin/env python3
-"""Verdict 3's tables (issue 49), from the committed runs alone: every selector judged across
-scenes, by the PSNR of its final fit along the whole camera path.
+"""Verdict 3's tables (issue 49): every selector judged across scenes by its final fit's along-path PSNR.
 
-Reads a grid config (results/grid_verdict3.json: scenes with their capture type, "layout",
-methods, trainer seeds) and each finished job's results.json under OUT/runs/, and writes
-OUT/tables/verdict3.md (and .csv). With --check it writes nothing and fails (exit 1) when the
-committed tables differ from what the runs give: the test command runs it that way, so a
-stale number cannot stay. It reads the runs git tracks then (a grid still running leaves
-others on disk); commit new runs with the tables they give.
+From the committed runs alone. Reads a grid config (results/grid_verdict3.json: scenes with
+their capture type, "layout", methods, trainer seeds) and each finished job's results.json
+under OUT/runs/, and writes OUT/tables/verdict3.md (and .csv). With --check it writes nothing
+and fails (exit 1) when the committed tables differ from what the runs give: the test command
+runs it that way, so a stale number cannot stay. It reads the runs git tracks then (a grid
+still running leaves others on disk); commit new runs with the tables they give.
 
 Measures, all of the final fit (the method's own training on its chosen views):
 - along the path: the mean PSNR over every view of the dataset that the run did not hold

@@ -23,7 +23,7 @@
 // to the AVX2 kernels' (tested: Fisher.Avx512WalkEqualsAvx2BitForBit,
 // FloatPath.Avx512BackwardEqualsAvx2BitForBit, SubsetPair.Avx512BackwardEqualsAvx2BitForBit,
 // and SubsetPair.* against the single-render AVX2 kernel on every kernel set). The forward
-// kernel gained nothing or lost from the wider register file (docs/PERFORMANCE_TRIED.md),
+// kernel gained nothing or lost from the wider register file (docs/DECISIONS.md),
 // so the avx512 kernel set uses the AVX2 one.
 #include "splat/raster/raster_kernels.h"
 

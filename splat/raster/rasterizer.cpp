@@ -191,7 +191,7 @@ void gatherTile(const RasterStateT<T>& st, int tile, std::vector<TileGaussian<T>
   out.resize(e - b);
   // The entries are scattered over tile_data (depth order): their loads are fetched 24
   // entries ahead, both cache lines of each (an entry is 76 bytes). By perf samples at 100k
-  // Gaussians, 8 or 48 ahead left more time here (docs/PERFORMANCE_TRIED.md).
+  // Gaussians, 8 or 48 ahead left more time here (docs/DECISIONS.md).
   constexpr std::uint32_t kAhead = 24;
   const TileGaussian<T>* data = st.tile_data.data();
   for (std::uint32_t k = b; k < e; ++k) {

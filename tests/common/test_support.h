@@ -55,7 +55,7 @@ inline std::string readBytes(const std::string& path) {
 }
 
 // A committed input that a fuzz target once failed on: tests/<room folder>/fuzz_regressions/
-// <target>/<name>, given from tests/ (README, "Fuzzing").
+// <target>/<name>, given from tests/ (docs/FUZZING.md).
 inline std::string fuzzRegression(const std::string& path_in_tests) {
   return std::string(SARESGS_SOURCE_DIR) + "/tests/" + path_in_tests;
 }

@@ -148,7 +148,7 @@ bool isTranslation(std::size_t k) { return fiveFrames()[k].s == 1.0 && !fiveFram
 
 // `saresgs train`'s experiment (the table): the same views, 300 iterations. Without
 // the frame: 21.8 and 19.2 dB moved 1e5 and 1e6 away and 10.9 dB in kilometres (every
-// Gaussian inside the near plane) against 25.7 as made (scripts/frame_trials.py).
+// Gaussian inside the near plane) against 25.7 as made (scripts/experiments/frame_trials.py).
 TEST(SceneFrames, FiveFramesTrainToTheSamePsnr) {
   TempDir d;
   const std::vector<Scene> scenes = fiveScenes(d);

@@ -4,15 +4,15 @@
 The verdict's test views are every 8th view of a capture path (on `object`, a separate
 ring: views 100-149, which no selector can hold), so a selector whose held
 views happen to fall next to them scores higher than one whose views fall between them,
-whatever their spacing (scripts/nearest_view_analysis.py measures that phase). The final
+whatever their spacing (scripts/experiments/nearest_view_analysis.py measures that phase). The final
 fit trains on the held views alone, so every other view of the path is as unseen as a test
 view. This script renders each run's final-fit model (final_fit.ply, kept in the run's
-folder, not committed; scripts/refit_final_fit.sh rebuilds it byte for byte for runs of
+folder, not committed; scripts/experiments/refit_final_fit.sh rebuilds it byte for byte for runs of
 864af66 or later) at every view of the path and compares two methods, paired by seed,
 on the views neither of them held: all phases at once. It checks first that its PSNR at the
 test views equals the run's results.json (the same render, to the printed digits).
 
-  PYTHONPATH=build/python python3 scripts/path_psnr.py results/verdict2 GRID.json [A B] ...
+  PYTHONPATH=build/python python3 scripts/experiments/path_psnr.py results/verdict2 GRID.json [A B] ...
 
 A B: method pairs to compare (default: adaptive fvs, adaptive fisher, fisher fvs, sa-resgs fisher,
 random fvs). Writes
@@ -68,7 +68,7 @@ def main():
              "Each run's final-fit model rendered at every view of the path. *test*: the test views, every 8th",
              "view of the path (`object`: its separate test ring, views 100-149; the verdict's metric); *path*: the views neither method held (unseen by both final fits, every",
              "phase of the path). Paired by seed: mean difference [95 % Student-t interval] (seeds). Only runs",
-             "whose final_fit.ply is in their folder count. From `scripts/path_psnr.py`.", "",
+             "whose final_fit.ply is in their folder count. From `scripts/experiments/path_psnr.py`.", "",
              "| scene | A | B | seeds | A - B, test views | A - B, path views | path views per seed |",
              "|---|---|---|---:|---:|---:|---:|"]
     panels = []
@@ -110,7 +110,7 @@ def main():
     writeTable(out, "path_psnr.md", lines)
     if panels:
         writeSvg(f"{out}/plots/path_psnr.svg", panels,
-                 "Final-fit PSNR at every view of the capture path (scripts/path_psnr.py); dashed: the test views")
+                 "Final-fit PSNR at every view of the capture path (scripts/experiments/path_psnr.py); dashed: the test views")
         print(f"path_psnr: drew {out}/plots/path_psnr.svg")
 
 

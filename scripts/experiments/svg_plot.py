@@ -1,6 +1,7 @@
-"""A per-view line figure as SVG, for the analysis scripts beside it (no plotting library
-on the project's machines: the C++ side draws its PNGs with OpenCV, these scripts write
-SVG text). One panel per row; each panel has polylines (NaN breaks a line), faint vertical
+"""Helper module: a per-view line figure as SVG, for the analysis scripts beside it.
+
+No plotting library on the project's machines: the C++ side draws its PNGs with OpenCV, these
+scripts write SVG text. One panel per row; each panel has polylines (NaN breaks a line), faint vertical
 marks (the test views, say) and a strip of ticks under the axis per named series (the views
 each method held, with the fraction of seeds as opacity). Written atomically."""
 import math

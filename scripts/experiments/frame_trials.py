@@ -1,5 +1,7 @@
 #!/usr/bin/env python3
-"""The same COLMAP dataset in five world frames, trained by one or more saresgs binaries.
+"""Train one COLMAP dataset in several world frames (moved, scaled) with one or more saresgs binaries.
+
+The same dataset in six world frames and a control, trained by each binary given.
 
 x' = s x + d is applied to the points and camera centres (rotations, intrinsics and images
 unchanged), as COLMAP's model_transformer or a georeference does. Each frame is written as
@@ -10,8 +12,8 @@ the same COLMAP dataset but for the frame), then
 on it and the test PSNR (active: the final fit's, and the selected views) is printed as a
 Markdown table, one column per binary.
 
-    python3 scripts/frame_trials.py DATASET OUT --bin build/apps/saresgs [--bin OLD] [--iterations 300]
-    python3 scripts/frame_trials.py DATASET OUT --bin build/apps/saresgs --active fisher --active-args '--max-views 10'
+    python3 scripts/experiments/frame_trials.py DATASET OUT --bin build/apps/saresgs [--bin OLD] [--iterations 300]
+    python3 scripts/experiments/frame_trials.py DATASET OUT --bin build/apps/saresgs --active fisher --active-args '--max-views 10'
 
 
 DATASET holds images/ and sparse/0/*.txt (what `saresgs scene` writes).

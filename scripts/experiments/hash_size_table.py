@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
-"""The PSNR half of the paper's hash-size claim: final-fit PSNR of each hash size of a
-grid like results/grid_hash.json, paired by seed against its `default` variant (hash:auto),
-with each size's table and load as the runs recorded them (results.json's
-prefilter_regime).
+"""Final-fit PSNR per hash size, paired by seed against hash:auto (the paper's hash-size claim).
 
-  python3 scripts/hash_size_table.py results/verdict2 results/grid_hash.json
+The PSNR half of the claim: each hash size of a grid like results/grid_hash.json, paired by
+seed against its `default` variant (hash:auto), with each size's table and load as the runs
+recorded them (results.json's prefilter_regime).
+
+  python3 scripts/experiments/hash_size_table.py results/verdict2 results/grid_hash.json
 
 Writes OUT/tables/hash_size_psnr.md and prints it. Only finished runs count; a size
 missing a seed that its reference has is paired over the seeds both have.
@@ -28,7 +29,7 @@ def main():
     grid = json.load(open(grid_path))
     variants = [v["name"] for v in grid["variants"]]
     lines = ["# Final-fit PSNR per hash size, paired against hash:auto", "",
-             f"From `{os.path.basename(grid_path)}` ({', '.join(grid['methods'])}); `scripts/hash_size_table.py`. "
+             f"From `{os.path.basename(grid_path)}` ({', '.join(grid['methods'])}); `scripts/experiments/hash_size_table.py`. "
              "Differences: this size minus the `default` variant (hash:auto) on the same seed; "
              "mean [95 % Student-t interval] over seeds, and each seed's.", "",
              "| scene | variant | encoding | load | seeds | final-fit PSNR | minus hash:auto | per seed |",

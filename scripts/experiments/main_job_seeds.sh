@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# The main job's command over several seeds, for two binaries, paired by seed: does a
-# change cost quality, or is one seed's final-fit PSNR the luck of its selection?
+# The main job's run over several seeds with two binaries, paired by seed (final-fit PSNR).
+# Does a change cost quality, or is one seed's final-fit PSNR the luck of its selection?
 #
-#   bash scripts/main_job_seeds.sh NEW_BIN BASE_BIN [SEEDS] [OUT]
+#   bash scripts/experiments/main_job_seeds.sh NEW_BIN BASE_BIN [SEEDS] [OUT]
 #
 # Runs `active --dataset out/builtin --method sa-resgs --preset quick --seed S` (with
 # --no-plain-refit where the binary has it, as scripts/main.sh does) for every seed in
@@ -14,7 +14,7 @@
 set -euo pipefail
 new=$(realpath "$1"); base=$(realpath "$2"); seeds=${3:-"0 1 2 3 4 5 6 7"}
 out=${4:-results/perf/main_job_seeds}
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 [ -d out/builtin ] || { echo "main_job_seeds.sh: out/builtin is missing; run bash scripts/main.sh first" >&2; exit 1; }
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
@@ -35,7 +35,7 @@ mkdir -p "$out"
 cat "$work"/*.json > "$out/seeds.jsonl.tmp" && mv "$out/seeds.jsonl.tmp" "$out/seeds.jsonl"
 python3 - "$out/seeds.jsonl" <<'PY'
 import json, sys
-sys.path.insert(0, "scripts")
+sys.path.insert(0, "scripts/experiments")
 from table_io import interval95
 rows = [json.loads(l) for l in open(sys.argv[1])]
 by = {(r["who"], r["seed"]): r for r in rows}

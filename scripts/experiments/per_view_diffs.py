@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
-"""Per-test-view final-fit PSNR of one method minus another, paired by seed, from an
-ablation output folder: where a selector wins or loses, and which train views each chose.
+"""Per-test-view final-fit PSNR of one method minus another, paired by seed, in an ablation folder.
 
-  python3 scripts/per_view_diffs.py results/verdict2 unbalanced hybrid fisher
+Where a selector wins or loses, and which train views each chose.
+
+  python3 scripts/experiments/per_view_diffs.py results/verdict2 unbalanced hybrid fisher
 """
 import glob
 import json

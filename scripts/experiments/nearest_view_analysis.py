@@ -7,7 +7,7 @@ and of the angle between their viewing directions (degrees), beside the run's fi
 PSNR; per scene, the Pearson correlation of each with the PSNR over all runs. It needs no
 training: the cameras come from the datasets (through the saresgs Python module).
 
-  PYTHONPATH=build/python python3 scripts/nearest_view_analysis.py results/verdict2 GRID.json
+  PYTHONPATH=build/python python3 scripts/experiments/nearest_view_analysis.py results/verdict2 GRID.json
 
 Writes OUT/tables/nearest_view.md and prints it. Per scene it also measures how much of a
 spread selection's result is its phase against the test views (phaseComparison), and compares fvs's held views

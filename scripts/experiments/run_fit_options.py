@@ -1,13 +1,14 @@
 #!/usr/bin/env python3
-"""Print what a refit of a finished active run needs, on one line, for the refit scripts
-(scripts/refit_final_fit.sh, scripts/residual_refit.sh):
+"""Print a finished active run's final-fit options on one line, for the refit scripts beside it.
+
+Read by scripts/experiments/refit_final_fit.sh and scripts/experiments/residual_refit.sh:
 
     dataset views seed final_fit_psnr final_fit_residual final_fit_iterations preset max_gaussians
 
 views: the run's initial then selected views, comma-separated; the PSNR as repr(), so that a
 refit can be compared to the last digit. Exits non-zero when the run has no final fit.
 
-    python3 scripts/run_fit_options.py RUN/results.json
+    python3 scripts/experiments/run_fit_options.py RUN/results.json
 """
 import json
 import sys

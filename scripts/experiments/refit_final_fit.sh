@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Rebuild the final-fit model (final_fit.ply) of finished active runs whose folder lacks it
-# (the models are not committed: results/ keeps each run's results.json and cameras.png).
+# Rebuild the final-fit model (final_fit.ply) of finished active runs, checked against their PSNR.
+# The models are not committed (results/ keeps each run's results.json and cameras.png).
 # For each RUN folder: `saresgs train` on exactly the run's views (initial, then selected)
 # with the final fit's options (the quick preset's: its iterations, the run's Gaussian cap,
 # SH degree 0, the run's seed, one thread), kept only when it gives the run's final-fit
@@ -11,12 +11,12 @@
 # without a model. Plain-training methods only (fisher, fvs, random, adaptive, ...): a
 # residual method's final fit would need --residual and the binary of its grid.
 #
-#   BIN=path/to/saresgs bash scripts/refit_final_fit.sh results/verdict2/runs/JOB ...
+#   BIN=path/to/saresgs bash scripts/experiments/refit_final_fit.sh results/verdict2/runs/JOB ...
 #
 # BIN: the binary that ran the runs (default ./build/apps/saresgs). Used by
-# scripts/path_psnr.py, which renders these models along the whole capture path.
+# scripts/experiments/path_psnr.py, which renders these models along the whole capture path.
 set -uo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 bin=${BIN:-./build/apps/saresgs}
 [ -x "$bin" ] || { echo "refit_final_fit: no binary $bin" >&2; exit 2; }
 tmp=$(mktemp -d)
@@ -27,7 +27,7 @@ for run in "$@"; do
   job=$(basename "$run")
   [ -f "$run/results.json" ] || { echo "skip $job: no results.json"; continue; }
   [ -f "$run/final_fit.ply" ] && { echo "skip $job: has final_fit.ply"; continue; }
-  read -r ds views seed psnr residual iters preset cap < <(/usr/bin/python3 scripts/run_fit_options.py "$run/results.json") || { echo "FAIL $job: results.json has no final fit"; status=1; continue; }
+  read -r ds views seed psnr residual iters preset cap < <(/usr/bin/python3 scripts/experiments/run_fit_options.py "$run/results.json") || { echo "FAIL $job: results.json has no final fit"; status=1; continue; }
   [ "$residual" = False ] || { echo "skip $job: its final fit trains with residual supervision"; continue; }
   [ "$preset" = quick ] || { echo "skip $job: preset $preset (only the quick preset's final fit is rebuilt here)"; continue; }
   out=$tmp/$job

@@ -1,6 +1,7 @@
-"""Shared by the analysis scripts beside it: a 95 % Student-t interval over seeds, and a
-Markdown table written to OUT/tables/NAME atomically (a temporary name, then renamed) and
-printed."""
+"""Helper module: a 95 % Student-t interval over seeds and an atomically written Markdown table.
+
+Shared by the analysis scripts beside it; the table goes to OUT/tables/NAME (a temporary name,
+then renamed) and is printed."""
 import math
 import os
 

@@ -1,21 +1,21 @@
 #!/usr/bin/env bash
-# Refit the views of finished active runs with residual supervision: `saresgs train
-# --residual` on exactly a run's views (initial, then selected) with its final fit's options
+# Refit the views of finished active runs with the paper's residual supervision (train --residual).
+# `saresgs train --residual` on exactly a run's views (initial, then selected) with its final fit's options
 # (the quick preset's iterations, the run's Gaussian cap, SH degree 0, the run's seed, one
 # thread), the fit `saresgs active` would have made had the method trained residually (the
 # test Cli.FinalFitEqualsTrainOnTheChosenViews holds the two equal). It asks what a
 # plain-training selector's views are worth with the paper's training, so that a selection
 # and a training can be paired apart from each other.
 #
-#   BIN=path/to/saresgs bash scripts/residual_refit.sh OUTDIR results/verdict2/runs/JOB ...
+#   BIN=path/to/saresgs bash scripts/experiments/residual_refit.sh OUTDIR results/verdict2/runs/JOB ...
 #
 # Writes OUTDIR/JOB/refit.json (train's results.json, with "source_run" and "source_final_fit_psnr"
 # added) through a temporary name; a JOB that has one is skipped, so it can be stopped and
 # started again. BIN: the binary that ran the runs (default ./build/apps/saresgs); the runs'
 # own plain final fit must reproduce with it (checked: a plain refit of the first run is
-# made too and compared to the last digit, as scripts/refit_final_fit.sh does).
+# made too and compared to the last digit, as scripts/experiments/refit_final_fit.sh does).
 set -uo pipefail
-cd "$(dirname "$0")/.."
+cd "$(dirname "$0")/../.."
 bin=${BIN:-./build/apps/saresgs}
 outdir=${1:?usage: residual_refit.sh OUTDIR RUN...}
 shift
@@ -30,7 +30,7 @@ for run in "$@"; do
   job=$(basename "$run")
   [ -f "$outdir/$job/refit.json" ] && { echo "skip $job: done"; continue; }
   [ -f "$run/results.json" ] || { echo "skip $job: no results.json"; continue; }
-  read -r ds views seed psnr residual iters preset cap < <(/usr/bin/python3 scripts/run_fit_options.py "$run/results.json") || { echo "FAIL $job: results.json has no final fit"; status=1; continue; }
+  read -r ds views seed psnr residual iters preset cap < <(/usr/bin/python3 scripts/experiments/run_fit_options.py "$run/results.json") || { echo "FAIL $job: results.json has no final fit"; status=1; continue; }
   [ "$residual" = False ] || { echo "skip $job: its final fit already trains residually"; continue; }
   [ "$preset" = quick ] || { echo "skip $job: preset $preset (only the quick preset's final fit)"; continue; }
   train=("$bin" train --dataset "$ds" --views "$views" --iterations "$iters" --max-gaussians "$cap" --sh-degree 0

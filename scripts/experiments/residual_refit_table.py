@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
-"""Pair the residual refits of scripts/residual_refit.sh against the baselines' final fits.
+"""Pair the residual refits of scripts/experiments/residual_refit.sh against the baselines' final fits.
 
-    python3 scripts/residual_refit_table.py OUTDIR RUNS_DIR
+    python3 scripts/experiments/residual_refit_table.py OUTDIR RUNS_DIR
 
 OUTDIR holds OUTDIR/SCENE__METHOD__VARIANT__sN/refit.json (a residual refit of that run's
 views); RUNS_DIR the grid's runs (results/verdict2/runs). For each scene and method it pairs,
@@ -38,7 +38,7 @@ def main():
     if not groups:
         sys.exit(f"residual_refit_table: no refits in {outdir}")
     lines = ["### Residual refits of a method's views against final fits, paired by seed (mean, 95 % "
-             "Student-t interval, seeds); from scripts/residual_refit_table.py", "",
+             "Student-t interval, seeds); from scripts/experiments/residual_refit_table.py", "",
              "| scene | method (residual refit) | against | mean_diff | ci_low | ci_high | n | per seed |",
              "|---|---|---|---:|---:|---:|---:|---|"]
     for (scene, method, variant), seeds in sorted(groups.items()):
