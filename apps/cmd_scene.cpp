@@ -49,8 +49,8 @@ int runScene(SceneArgs& a) {
 void addSceneCommand(CLI::App& app, Action& action) {
   auto args = std::make_shared<SceneArgs>();
   CLI::App* sub = app.add_subcommand("scene", "Write a ground-truth synthetic dataset");
-  sub->add_option("--layout", args->scene.layout, "object | room360 | unbalanced | tworooms (real meshes, two rooms and a door)")
-      ->check(CLI::IsMember({"object", "room360", "unbalanced", "tworooms"}))
+  sub->add_option("--layout", args->scene.layout, "object | room360 | unbalanced | tworooms (real meshes, two rooms and a door) | corridor (three rooms in a row, a walk of uneven density)")
+      ->check(CLI::IsMember({"object", "room360", "unbalanced", "tworooms", "corridor"}))
       ->capture_default_str();
   sub->add_option("--out", args->out, "Output folder")->required();
   sub->add_option("--width", args->scene.width, "Image width")->check(CLI::Range(16, 8192))->capture_default_str();

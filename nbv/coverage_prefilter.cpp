@@ -237,7 +237,8 @@ void applySceneType(PrefilterConfig& c, SceneType t) {
 }
 
 std::optional<SceneType> sceneTypeOfLayout(std::string_view layout) {
-  if (layout == "room360" || layout == "unbalanced" || layout == "tworooms") return SceneType::kIndoor;
+  if (layout == "room360" || layout == "unbalanced" || layout == "tworooms" || layout == "corridor")
+    return SceneType::kIndoor;
   if (layout == "object") return SceneType::kOutdoor;
   return std::nullopt;
 }

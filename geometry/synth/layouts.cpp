@@ -491,4 +491,107 @@ LayoutResult makeTwoRoomsLayout(const Assets& assets, int width, int height, std
   return out;
 }
 
+LayoutResult makeCorridorLayout(const Assets& assets, int width, int height, std::uint64_t seed,
+                                int num_views) {
+  LayoutResult out;
+  const std::uint64_t s = mix64(seed + 3333);
+  RoomTextures rt;
+  rt.floor = makeTiles(0.4f, 0.03f, rgb(180, 185, 190), rgb(95, 100, 110), rgb(50, 50, 55), s + 10);
+  rt.ceiling = makeSpeckle(1.3f, rgb(236, 234, 226), rgb(165, 160, 150), s + 11);
+  rt.xlo = makeMarble(0.8f, rgb(225, 210, 190), rgb(110, 70, 50), s + 12);
+  rt.xhi = makeBricks(0.26f, 0.1f, 0.016f, rgb(150, 90, 70), rgb(215, 210, 200), s + 13);
+  rt.ylo = makePlanks(0.2f, 1.5f, rgb(200, 160, 110), rgb(105, 70, 45), s + 14);
+  rt.yhi = makeStripes(Vector3f(0, 0, 1), 0.22f, rgb(90, 140, 190), rgb(240, 238, 225),
+                       rgb(60, 90, 130), s + 15);
+  const float half_w = 3.0f, top = 3.0f;
+  addRoom(out, Vector3f(-9, -half_w, 0), Vector3f(9, half_w, top), rt);
+
+  // Two dividing walls (16 cm thick) at x = -3 and x = 3, each with a doorway (1.1 m wide,
+  // 2.1 m high) on opposite sides, so that no straight line passes both doors.
+  const float t = 0.08f, door_top = 2.1f;
+  auto divider = [&](const std::string& name, float x, float door_lo, float door_hi, std::uint64_t k) {
+    auto tex = [&] { return makeChecker(0.25f, rgb(230, 228, 220), rgb(120, 70, 90), s + k); };
+    out.objects.push_back(fixedObject(name + "_south", "box",
+                                      makeBox(Vector3f(x - t, -half_w, 0), Vector3f(x + t, door_lo, top), 1), tex(), true));
+    out.objects.push_back(fixedObject(name + "_north", "box",
+                                      makeBox(Vector3f(x - t, door_hi, 0), Vector3f(x + t, half_w, top), 1), tex(), true));
+    out.objects.push_back(fixedObject(name + "_lintel", "box",
+                                      makeBox(Vector3f(x - t, door_lo, door_top), Vector3f(x + t, door_hi, top), 1), tex(), true));
+  };
+  divider("room_divider_ab", -3.0f, 0.9f, 2.0f, 20);
+  divider("room_divider_bc", 3.0f, -2.0f, -0.9f, 21);
+
+  Rng rng(seed ^ 0xC0441D02ull);
+  struct Slot {
+    const char* kind;
+    Vector2f xy;
+    float size;
+  };
+  // Two objects in each of the first two rooms, three in the last.
+  const Slot slots[7] = {{"blob", {-6.0f, 0.0f}, 0.55f},        {"crate", {-7.1f, -1.0f}, 0.4f},
+                         {"cone", {0.8f, 1.6f}, 0.45f},          {"donut", {-0.8f, -1.6f}, 0.45f},
+                         {"superquadric", {6.9f, -0.9f}, 0.5f},  {"ball", {5.4f, 0.8f}, 0.4f},
+                         {"column", {6.7f, 0.9f}, 0.4f}};
+  std::vector<Vector3d> centres;
+  for (int k = 0; k < 7; ++k) {
+    out.objects.push_back(placeOnFloor(assets, k, contentSpec(slots[k].kind, s + 100 * (k + 1)),
+                                       slots[k].xy, 0.0f, slots[k].size,
+                                       static_cast<float>(rng.uniform(0, 2 * kPi))));
+    centres.push_back(boundingBox(out.objects.back().mesh).center().cast<double>());
+  }
+
+  // The walk, in order, with uneven density: a slow look around the first room, through its
+  // door, a quick diagonal pass through the second room glancing at its two objects, through
+  // the second door, a dense cluster of close views of one object in the last room, then a
+  // sparse arc around that room.
+  const int n = num_views > 0 ? num_views : 150;
+  const std::vector<int> counts = apportion({55.0, 10.0, 10.0, 10.0, 47.0, 18.0}, n);
+  const Intrinsics K = layoutIntrinsics(width, height, 60.0);
+  auto centreOf = [&](double cx, double cy) {
+    return Vector3d(cx + rng.uniform(-0.4, 0.4), cy + rng.uniform(-0.4, 0.4), 0.4 + rng.uniform(-0.2, 0.2));
+  };
+  auto arc = [&](double cx, double r0, double from, double sweep, int m) {
+    for (int i = 0; i < m; ++i) {
+      const double a = from + sweep * (i + 0.5 + rng.uniform(-0.25, 0.25)) / m;
+      const double r = r0 + rng.uniform(-0.1, 0.1);
+      const Vector3d eye(cx + r * std::cos(a), r * std::sin(a), 1.5 + 0.2 * std::sin(2 * a) + rng.uniform(-0.05, 0.05));
+      out.cameras.push_back(lookAtf(K, eye, centreOf(cx, 0.0)));
+    }
+  };
+  // Evenly spaced by arc length along a polyline, looking ahead (yaw within +-0.35 rad) and down.
+  auto walk = [&](const std::vector<Vector3d>& poly, int m) {
+    std::vector<double> cum{0};
+    for (std::size_t j = 1; j < poly.size(); ++j) cum.push_back(cum.back() + (poly[j] - poly[j - 1]).norm());
+    for (int i = 0; i < m; ++i) {
+      const double len = cum.back() * (i + 0.5) / m;
+      std::size_t j = 1;
+      while (j + 1 < poly.size() && cum[j] < len) ++j;
+      const double f = (len - cum[j - 1]) / (cum[j] - cum[j - 1]);
+      Vector3d eye = poly[j - 1] + f * (poly[j] - poly[j - 1]);
+      eye.z() += rng.uniform(-0.05, 0.05);
+      const Vector3d ahead = Eigen::AngleAxisd(rng.uniform(-0.35, 0.35), Vector3d::UnitZ()) *
+                             (poly[j] - poly[j - 1]).normalized();
+      out.cameras.push_back(lookAtf(K, eye, eye + 2.5 * ahead + Vector3d(0, 0, -0.8)));
+    }
+  };
+  arc(-6.0, 1.8, 0.45 * kPi, 1.4 * kPi, counts[0]);  // the first room, 81 .. 333 degrees
+  walk({{-4.3, 0.6, 1.5}, {-3.6, 1.45, 1.5}, {-2.2, 1.45, 1.5}}, counts[1]);
+  for (int i = 0; i < counts[2]; ++i) {  // the second room: a diagonal, glancing either side
+    const double f = (i + 0.5) / counts[2];
+    const Vector3d eye(-1.8 + 3.6 * f, 1.45 - 2.9 * f + rng.uniform(-0.1, 0.1), 1.5 + rng.uniform(-0.05, 0.05));
+    const Eigen::Vector2d e = rng.disc() * 0.2;
+    out.cameras.push_back(lookAtf(K, eye, centres[2 + i % 2] + Vector3d(e.x(), e.y(), rng.uniform(-0.1, 0.1))));
+  }
+  walk({{2.2, -1.45, 1.5}, {3.6, -1.45, 1.5}, {4.4, -0.8, 1.5}}, counts[3]);
+  for (int i = 0; i < counts[4]; ++i) {  // the last room: a cluster of close views of one object
+    const Eigen::Vector2d d = rng.disc() * 0.2;
+    const Vector3d eye = Vector3d(5.0, -1.9, 1.3) + Vector3d(d.x(), d.y(), rng.uniform(-0.12, 0.12));
+    const Eigen::Vector2d e = rng.disc() * 0.2;
+    out.cameras.push_back(lookAtf(K, eye, centres[4] + Vector3d(e.x(), e.y(), rng.uniform(-0.1, 0.1))));
+  }
+  arc(6.2, 2.2, -0.35 * kPi, 1.4 * kPi, counts[5]);  // and a sparse arc around it
+  out.test = everyEighthTest(static_cast<int>(out.cameras.size()), out.train);
+  return out;
+}
+
 }  // namespace saresgs::synth

@@ -1,5 +1,5 @@
 #pragma once
-// The three camera layouts of the synthetic scenes and the objects placed in each
+// The camera layouts of the synthetic scenes and the objects placed in each
 // (internal to geometry/synth; the public entry point is makeSyntheticScene).
 //   object     one object (procedural: three parts, a bumpy marble blob, a striped ring around
 //              it and a dotted ball on top;
@@ -20,6 +20,12 @@
 //              in the first room, through the door, a three-quarter arc in the second, and
 //              looks back towards the first room, most of which the wall hides; every 8th
 //              a test view.
+//   corridor   three rooms in a row, [-9,9] x [-3,3] x [0,3], divided at x = -3 and x = 3 by
+//              walls whose doorways (1.1 m wide) sit on opposite sides; seven content
+//              objects; 150 cameras on one walk of uneven density: a slow arc around the
+//              first room, through a door, a quick diagonal through the second room, through
+//              the other door, a dense cluster of close views of one object in the third
+//              and a sparse arc around it; every 8th a test view.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <memory>
@@ -63,6 +69,8 @@ LayoutResult makeRoom360Layout(const Assets& assets, int width, int height, std:
 LayoutResult makeUnbalancedLayout(const Assets& assets, int width, int height,
                                   std::uint64_t seed, int num_views);
 LayoutResult makeTwoRoomsLayout(const Assets& assets, int width, int height, std::uint64_t seed,
+                                int num_views);
+LayoutResult makeCorridorLayout(const Assets& assets, int width, int height, std::uint64_t seed,
                                 int num_views);
 
 // The real meshes the tworooms layout uses when no mesh file is given (cgal:NAME specs

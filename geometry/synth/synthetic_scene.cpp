@@ -279,9 +279,9 @@ SyntheticScene makeSyntheticScene(const SyntheticOptions& opts) {
                      "expected 0 (the layout's default) .. " + std::to_string(kMaxSyntheticViews) + ", got " +
                          std::to_string(opts.num_views));
   if (opts.layout != "object" && opts.layout != "room360" && opts.layout != "unbalanced" &&
-      opts.layout != "tworooms")
+      opts.layout != "tworooms" && opts.layout != "corridor")
     throw InputError("options", "layout",
-                     "expected object, room360, unbalanced or tworooms, got '" + opts.layout + "'");
+                     "expected object, room360, unbalanced, tworooms or corridor, got '" + opts.layout + "'");
   synth::Assets assets;
   assets.projection = synth::parseProjection(opts.projection);
   const Eigen::Matrix3f up = synth::upAxisRotation(opts.up_axis);
@@ -314,8 +314,10 @@ SyntheticScene makeSyntheticScene(const SyntheticOptions& opts) {
     layout = synth::makeRoom360Layout(assets, opts.width, opts.height, opts.seed, opts.num_views);
   else if (opts.layout == "unbalanced")
     layout = synth::makeUnbalancedLayout(assets, opts.width, opts.height, opts.seed, opts.num_views);
-  else
+  else if (opts.layout == "tworooms")
     layout = synth::makeTwoRoomsLayout(assets, opts.width, opts.height, opts.seed, opts.num_views);
+  else
+    layout = synth::makeCorridorLayout(assets, opts.width, opts.height, opts.seed, opts.num_views);
 
   SyntheticScene scene;
   scene.cameras = std::move(layout.cameras);

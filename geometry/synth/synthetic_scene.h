@@ -9,12 +9,15 @@
 //              stretches, several objects and occluders, ~150 images, every 8th a test view;
 //   tworooms   two rooms joined by a doorway, real meshes (CGAL's animals and figures when
 //              no mesh file is given), one walk through both rooms that also looks back
-//              through the door, ~150 images, every 8th a test view.
+//              through the door, ~150 images, every 8th a test view;
+//   corridor   three rooms in a row joined by doorways on opposite sides, procedural
+//              objects, one walk of uneven density (a slow arc, a quick pass, a dense
+//              cluster, a sparse arc), ~150 images, every 8th a test view.
 // With no mesh or texture files given, the first three layouts use procedural objects and
 // procedural textures (the built-in scene needs no files).
 // Splits: object: train = the first 100 views, test = the last 50 (drawn independently,
 // so test positions differ from train; with num_views = n: the first round(2n/3) train);
-// room360, unbalanced and tworooms: index % 8 == 0 is a test view, the rest train.
+// room360, unbalanced, tworooms and corridor: index % 8 == 0 is a test view, the rest train.
 // Files: mesh files replace the content objects (object layout: the first file only;
 // rooms: cycled over the objects), normalised to unit radius with opts.up_axis turned to
 // +z; photographs replace the content objects' textures (cycled). The room's faces,
@@ -36,7 +39,7 @@
 namespace saresgs {
 
 struct SyntheticOptions {
-  std::string layout = "room360";    // object | room360 | unbalanced | tworooms
+  std::string layout = "room360";    // object | room360 | unbalanced | tworooms | corridor
   int width = 256, height = 192;
   std::uint64_t seed = 0;
   int num_views = 0;                 // 0: the layout's default count (train + test)

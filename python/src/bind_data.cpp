@@ -198,7 +198,7 @@ void bindData(py::module_& m) {
       },
       py::arg("layout"), py::arg("out"), py::arg("width") = 256, py::arg("height") = 192, py::arg("seed") = 0,
       py::arg("views") = 0,
-      "Writes a built-in synthetic scene (`saresgs scene`: object, room360, unbalanced or tworooms) as a COLMAP "
+      "Writes a built-in synthetic scene (`saresgs scene`: object, room360, unbalanced, tworooms or corridor) as a COLMAP "
       "folder at `out` and loads it.");
 }
 

@@ -96,7 +96,7 @@ TEST(SceneFrame, MoveToOwnFrameMovesCamerasPointsAndDepth) {
 // identity and its numbers are those of the versions before the frame, bit for bit (the
 // verdict grids pair runs across versions).
 TEST(SceneFrame, TheBuiltInCapturesKeepTheirWorldFrame) {
-  for (const char* layout : {"object", "room360", "unbalanced", "tworooms"})
+  for (const char* layout : {"object", "room360", "unbalanced", "tworooms", "corridor"})
     for (std::uint64_t seed : {0u, 1u, 100u}) {
       SyntheticOptions o;
       o.layout = layout;

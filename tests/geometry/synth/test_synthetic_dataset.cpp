@@ -184,7 +184,7 @@ TEST_P(SyntheticDataset, ReadsBackIdenticallyAndColmapAgrees) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Layouts, SyntheticDataset,
-                         ::testing::Values("object", "room360", "unbalanced", "tworooms"));
+                         ::testing::Values("object", "room360", "unbalanced", "tworooms", "corridor"));
 
 // The real COLMAP triangulates with our known poses: its points must lie on the true
 // surfaces. A wrong image-id mapping (by order instead of by name) would pair features

@@ -364,7 +364,7 @@ TEST(SyntheticLayouts, ObjectLayoutCountsAndHemisphere) {
 }
 
 TEST(SyntheticLayouts, RoomLayoutsKeepCamerasInsideTheRoomAndOutsideObjects) {
-  for (const char* layout : {"room360", "unbalanced", "tworooms"}) {
+  for (const char* layout : {"room360", "unbalanced", "tworooms", "corridor"}) {
     const SyntheticScene& s = scene(layout);
     const auto n = s.cameras.size();
     EXPECT_GE(n, 140u) << layout;
@@ -394,7 +394,7 @@ TEST(SyntheticLayouts, RoomLayoutsKeepCamerasInsideTheRoomAndOutsideObjects) {
 }
 
 TEST(SyntheticLayouts, ContentObjectsDoNotIntersect) {
-  for (const char* layout : {"room360", "unbalanced", "tworooms"}) {
+  for (const char* layout : {"room360", "unbalanced", "tworooms", "corridor"}) {
     const SyntheticScene& s = scene(layout);
     std::vector<Eigen::AlignedBox3f> boxes;
     for (const auto& o : s.manifest["objects"])
@@ -504,8 +504,63 @@ TEST(SyntheticLayouts, TwoRoomsIsRealMeshesBehindAWallWithADoor) {
   EXPECT_GT(through_door, 5);
 }
 
+TEST(SyntheticLayouts, CorridorIsThreeRoomsWithDoorsOnOppositeSidesAndAnUnevenWalk) {
+  const SyntheticScene& s = scene("corridor");
+  const auto names = s.objectNames();
+  std::vector<Eigen::AlignedBox3f> dividers;
+  std::vector<Eigen::Vector3f> first_room;  // centres of the content objects at x < -3
+  int content = 0;
+  for (const auto& o : s.manifest["objects"]) {
+    const std::string name = o["name"];
+    const Eigen::AlignedBox3f box(vec3(o["bbox_min"]), vec3(o["bbox_max"]));
+    if (name.rfind("room_divider", 0) == 0) {
+      dividers.push_back(box);
+    } else if (name.rfind("room_", 0) != 0) {
+      ++content;
+      if (box.center().x() < -3) first_room.push_back(box.center());
+    }
+  }
+  EXPECT_EQ(content, 7);
+  EXPECT_EQ(first_room.size(), 2u);
+  ASSERT_EQ(dividers.size(), 6u);
+  // The walk visits the three rooms in order and never stands inside a wall.
+  int per_room[3] = {0, 0, 0};
+  int last_room = 0;
+  for (const Camera& c : s.cameras) {
+    const Eigen::Vector3f p = c.center().cast<float>();
+    for (const auto& b : dividers) EXPECT_FALSE(b.contains(p));
+    const int room = p.x() < -3 ? 0 : (p.x() < 3 ? 1 : 2);
+    EXPECT_GE(room, last_room) << "the walk goes back a room";
+    last_room = room;
+    ++per_room[room];
+  }
+  EXPECT_GT(per_room[0], 40);
+  EXPECT_GT(per_room[1], 10);
+  EXPECT_GT(per_room[2], 60);
+  // Uneven: the densest views are far closer together than the sparsest.
+  const auto nn = nearestNeighbourDistances(s.cameras);
+  EXPECT_GT(*std::max_element(nn.begin(), nn.end()) / median(nn), 3.0);
+  // The doors are on opposite sides: from the third room the first room's objects are
+  // hidden from every camera, by a wall or by what stands before it.
+  int third_room_segments = 0, by_wall = 0;
+  for (const Camera& c : s.cameras) {
+    const Eigen::Vector3f cc = c.center().cast<float>();
+    if (cc.x() < 3.2f) continue;
+    for (const Eigen::Vector3f& target : first_room) {
+      ++third_room_segments;
+      const SurfaceHit h = s.intersect(cc, target - cc, 0.0f, 1.0f);
+      ASSERT_TRUE(h.hit);
+      // The segment stops at the first room's wall or before it.
+      EXPECT_GT(h.point.x(), -3.1f) << "the third room sees " << names[h.object] << " in the first";
+      by_wall += names[h.object].rfind("room_divider", 0) == 0;
+    }
+  }
+  EXPECT_GT(third_room_segments, 100);
+  EXPECT_GT(by_wall, third_room_segments / 2);
+}
+
 TEST(SyntheticLayouts, NumViewsOverridesTheCountAndSeedsChangeLayouts) {
-  for (const char* layout : {"object", "room360", "unbalanced", "tworooms"}) {
+  for (const char* layout : {"object", "room360", "unbalanced", "tworooms", "corridor"}) {
     SyntheticOptions o;
     o.layout = layout;
     o.width = 64;
