@@ -39,7 +39,7 @@ inline vi finiteLanes(vf v) { return absLanes(v) <= vs(3.40282347e+38f); }
 // std::max(T(0), v): 0 < v ? v : 0 (NaN gives 0).
 inline vf maxZeroLanes(vf v) { return vs(0.0f) < v ? v : vs(0.0f); }
 
-constexpr float kProjShC0 = 0.28209479177387814f;  // splat/gaussians.h's kShC0 (rasterizer.cpp checks)
+constexpr float kProjShC0 = 0.28209479177387814f;  // splat/gaussians.h's kShC0 (raster_kernels_base.cpp checks)
 
 // The L Gaussians of a vector: their indices (a short last vector repeats its last
 // Gaussian; only the first n lanes are written back) and per-lane loads of their arrays.
@@ -498,7 +498,7 @@ void projectBackwardList(const ProjectIn& in, const std::uint32_t* idx, int coun
   }
 }
 
-// squaredGradientsFloat's per-Gaussian stage (rasterizer.cpp) for L Gaussians at a time:
+// squaredGradientsFloat's per-Gaussian stage (fisher_pass.cpp) for L Gaussians at a time:
 // backwardFrame and projectJacobian<float> (projection.h) lane by lane in their order,
 // then the quadratic forms of the tile moments in double, L double lanes (the scalar code's
 // operations, in its order), and the squared gradients added as the scalar stage adds them.

@@ -1,7 +1,7 @@
 #pragma once
 // The float tile kernels of the fast rasterizer (internal). They are compiled from
 // splat/raster/raster_kernels_impl.h with four lanes for the baseline target (in
-// rasterizer.cpp) and eight lanes with AVX2 (splat/raster/raster_kernels_avx2.cpp, its own
+// raster_kernels_base.cpp) and eight lanes with AVX2 (splat/raster/raster_kernels_avx2.cpp, its own
 // compile flags), chosen at run time; a third compilation, of the Fisher kernel alone, has
 // AVX2's eight lanes and arithmetic on AVX-512VL's 32 registers
 // (splat/raster/raster_kernels_avx512.cpp), bit-identical to the AVX2 one. Each
@@ -21,13 +21,13 @@ namespace saresgs {
 // One Gaussian's data gathered per tile, in the tile's order. The chord terms bound, per
 // pixel row at offset dy from the mean, the columns where o G >= 1/255 can hold: centred
 // on mx + chord_slope dy with half width sqrt(chord_k0 - chord_k1 dy^2), widened so the
-// float per-pixel test never passes outside it (tileData in rasterizer.cpp); the kernels
+// float per-pixel test never passes outside it (tileData in raster_stages.h); the kernels
 // use them for Gaussians wider than 32 pixels. They only shorten the kernels' loops; the
 // per-pixel test decides.
 // The pixel spans (image columns px0..px1, rows py0..py1, inclusive; empty when
 // px0 > px1) hold every pixel whose centre can pass the float test |i + 0.5 - mean| <=
 // half: the exact bound widened by 1e-6 relative and 1e-3 px, computed once per Gaussian
-// (pixelSpan in rasterizer.cpp) so that a tile's loops start from integer clipping.
+// (pixelSpan in raster_stages.h) so that a tile's loops start from integer clipping.
 // The kernels bound a Gaussian's block rows by its chords when its pixel span
 // (px1 - px0 + 1) is wider than this (forEachBlock); tileData computes the chords only for
 // such Gaussians and for those whose tiles tileMeets tests.
@@ -81,7 +81,7 @@ using BackwardFn = void (*)(const TileGaussian<float>* q, int nq, int x0, int y0
 // whose pixel dependence is polynomial in the offsets (dx, dy) from the 2D mean (degree
 // <= 2 per input: the mean terms are linear, the conic terms quadratic). So a tile needs,
 // per Gaussian, only the sums below; the per-Gaussian Jacobian is applied once to them
-// (rasterizer.cpp) instead of at every pixel. E_ij = sum e^2 dx^i dy^j, F_ij = sum e wc
+// (fisher_pass.cpp) instead of at every pixel. E_ij = sum e^2 dx^i dy^j, F_ij = sum e wc
 // dx^i dy^j, W = sum wc^2.
 enum FisherMoment {
   kE00, kE20, kE11, kE02, kE30, kE21, kE12, kE03, kE40, kE31, kE22, kE13, kE04,
@@ -161,7 +161,7 @@ struct FisherGradOut {
   float* sh;
 };
 
-// The Fisher pass's per-Gaussian stage (rasterizer.cpp's squaredGradientsFloat): for the
+// The Fisher pass's per-Gaussian stage (fisher_pass.cpp's squaredGradientsFloat): for the
 // Gaussians idx[0, count) (distinct), given their projections (proj[idx[j]]) and their
 // tile moments summed in double (moments[j * kFisherSlot + m]), backwardFrame and
 // projectJacobian in float, the quadratic forms in double, and the squared gradients of

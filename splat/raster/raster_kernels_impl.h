@@ -38,7 +38,7 @@ namespace {
 
 constexpr int L = SARESGS_KERNEL_LANES;
 static_assert(L == 4 || L == 8);
-// The contract's constants (splat/rasterize.h; rasterizer.cpp checks they agree).
+// The contract's constants (splat/rasterize.h; raster_kernels_base.cpp checks they agree).
 constexpr int kTile = 16;
 constexpr float kMinA = 1.0f / 255.0f;
 constexpr float kMaxA = 0.99f;
@@ -732,7 +732,7 @@ struct GradSums {
   vf e, x, y, xx, xy, yy, c0, c1, c2;
 };
 
-// The scalar walkBack of rasterizer.cpp for one Gaussian (entry jv) at one block, per
+// The scalar walkBack of raster_stages.h for one Gaussian (entry jv) at one block, per
 // lane: updates the block's state and gives the contribution's e = G dL/dalpha (0 where
 // alpha is clamped or the entry does not touch the pixel) and colour weight alpha T.
 // kBg: the background term of dL/dalpha; without a background it is exactly 0 and its
@@ -817,7 +817,7 @@ inline GradSums zeroSums() {
   return GradSums{z, z, z, z, z, z, z, z, z};
 }
 
-// The back-to-front walk (the scalar walkBack of rasterizer.cpp, per lane), Gaussian by
+// The back-to-front walk (the scalar walkBack of raster_stages.h, per lane), Gaussian by
 // Gaussian. Entries beyond the longest walk get zero slots, so the caller needs no
 // cleared buffer.
 template <bool kBg>

@@ -31,7 +31,7 @@ struct Spec {
   double mx, my, a, b, c, o;
 };
 
-// The kernels' view of a Gaussian (what tileData in rasterizer.cpp builds): the
+// The kernels' view of a Gaussian (what tileData in raster_stages.h builds): the
 // opacity-aware rectangle, its pixel span widened as there, and the alpha-ellipse chords
 // when `chords` (else none: the rows cover the rectangle).
 TileGaussian<float> tileGaussian(const Spec& s, bool chords) {
