@@ -16,9 +16,8 @@
 #include "geometry/scene/cameras_json.h"
 #include "nbv/ause.h"
 #include "nbv/initial_views.h"
-#include "nbv/path_variance.h"
 #include "nbv/run_report.h"
-#include "splat/fisher.h"
+#include "nbv/selection_step.h"
 
 namespace saresgs {
 
@@ -120,18 +119,11 @@ int ActiveRun::selectNext(SelectionLog& log) {
     log.candidates = {next};
     return next;
   }
-  if (opt_.method == Method::kCustom) {
-    const int v = opt_.custom_selector(SelectionContext{scene_, *trainer_, selected_, candidates, rng_, opt_.fisher_lambda}, log);
-    if (std::find(candidates.begin(), candidates.end(), v) == candidates.end())
-      throw std::invalid_argument("custom selector: it chose view " + std::to_string(v) + ", which is not a candidate (a train view not held)");
-    if (!log.scores.empty() && log.scores.size() != candidates.size())
-      throw std::invalid_argument("custom selector: " + std::to_string(log.scores.size()) + " scores for " +
-                                  std::to_string(candidates.size()) + " candidates");
-    log.candidates = candidates;
-    return v;
-  }
+  // The SA-Point prefilter holds the run's state (what the held views observed), so its
+  // scores and cut are made here; everything else is the method's (nbv/selection_step.h).
   const MethodNeeds needs = needsOf(opt_.method);
   std::vector<int> pool = candidates;
+  std::vector<double> coverage;
   if (needs.coverage) {
     const std::vector<int> fresh(selected_.begin() + observed_upto_, selected_.end());
     for (std::size_t i = 0; i < fresh.size(); ++i) {
@@ -143,103 +135,18 @@ int ActiveRun::selectNext(SelectionLog& log) {
     }
     observed_upto_ = static_cast<int>(selected_.size());
     report(ActivePhase::kPrefilter, 0, static_cast<int>(candidates.size()));
-    const std::vector<double> cov = prefilter_->score(candidates, log.seconds);
-    if (!needs.fisher) {
-      log.candidates = candidates;
-      log.scores = cov;
-      return candidates[argmaxScore(cov, candidates)];
-    }
-    const auto t0 = Clock::now();
-    pool = topFraction(cov, candidates, opt_.prefilter.keep_fraction);
-    log.seconds.prefilter += since(t0);
-    log.prefiltered = pool;
-  }
-  switch (opt_.method) {
-    case Method::kRandom: {
-      log.candidates = candidates;
-      return selectRandom(candidates, rng_);
-    }
-    case Method::kFvs: {
-      log.candidates = candidates;
-      log.scores = fvsScores(scene_, selected_, candidates, opt_.fvs_metric);
-      return candidates[argmaxScore(log.scores, candidates)];
-    }
-    case Method::kKmedian: {
-      log.candidates = candidates;
-      log.scores = kmedianGains(scene_, selected_, candidates, scene_.train, poseAngleScale(scene_));
-      return candidates[argmaxScore(log.scores, candidates)];
-    }
-    case Method::kOracle: {
-      // Told the test poses: the k-median gain over them (over the train views where the
-      // dataset has no test split, as the evaluation does).
-      log.candidates = candidates;
-      log.scores = kmedianGains(scene_, selected_, candidates, scene_.test.empty() ? scene_.train : scene_.test,
-                                poseAngleScale(scene_));
-      return candidates[argmaxScore(log.scores, candidates)];
-    }
-    case Method::kPathVariance: {
+    coverage = prefilter_->score(candidates, log.seconds);
+    if (needs.fisher) {
       const auto t0 = Clock::now();
-      log.candidates = candidates;
-      log.scores = pathVarianceScores(trainer_->gaussians(), trainer_->rasterSettings(), scene_, selected_, candidates,
-                                      {opt_.fisher_lambda, opt_.path_variance_kappa},
-                                      [this](int done, int total) { report(ActivePhase::kFisher, done, total); });
-      log.seconds.fisher += since(t0);
-      return candidates[argmaxScore(log.scores, candidates)];
-    }
-    case Method::kKmedianFisher:
-    case Method::kFvsFisher:
-    case Method::kAdaptive: {
-      // The gate: a spread score over all candidates, whose top fraction Fisher ranks.
-      const auto t0 = Clock::now();
-      const std::vector<double> gate = usesKmedianGate(scene_, opt_) ? kmedianGains(scene_, selected_, candidates, scene_.train, poseAngleScale(scene_))
-                                               : fvsScores(scene_, selected_, candidates, opt_.fvs_metric);
-      pool = topFraction(gate, candidates, opt_.gate_keep);
-      log.prefiltered = pool;
+      pool = topFraction(coverage, candidates, opt_.prefilter.keep_fraction);
       log.seconds.prefilter += since(t0);
-      break;
+      log.prefiltered = pool;
     }
-    default: break;
   }
-  // Fisher on the pool (all candidates, or the prefiltered ones).
-  const RasterSettings s = trainer_->rasterSettings();
-  auto t0 = Clock::now();
-  log.candidates = pool;
-  const FisherCriterion criterion = opt_.method == Method::kFisherLogDet ? FisherCriterion::kLogDet
-                                    : opt_.method == Method::kHybrid     ? opt_.hybrid_criterion
-                                                                         : FisherCriterion::kTrace;
-  log.scores = fisherScores(trainer_->gaussians(), s, scene_, selected_, pool, opt_.fisher_lambda,
-                            [this](int done, int total) { report(ActivePhase::kFisher, done, total); }, criterion);
-  log.seconds.fisher += since(t0);
-  if (opt_.method == Method::kFisherKmedian) {
-    // Fisher scored every candidate; the k-median gain over them, each weighted by its score
-    // (held views are at distance 0 from a held view: they add nothing).
-    t0 = Clock::now();
-    log.fisher_scores = log.scores;
-    log.scores = kmedianGains(scene_, selected_, pool, pool, poseAngleScale(scene_), log.fisher_scores);
-    log.seconds.prefilter += since(t0);
-  }
-  if (needs.surface) {
-    // What the held views see is known from the poses: observing all of them again is a
-    // union (cached sets), so a resumed run needs no saved state.
-    t0 = Clock::now();
-    log.fisher_scores = log.scores;
-    if (surface_) {
-      surface_->observe(selected_);
-      log.new_surface = opt_.hybrid_coverage == HybridCoverage::kFacility ? surface_->facilityGain(pool, scene_.train)
-                                                                          : surface_->newSurface(pool);
-    } else {
-      log.view_distance = farthestViewScores(scene_, selected_, pool, ViewDistance::kEuclidean, Eigen::Vector3d::Zero());
-    }
-    log.scores = hybridScores(log.fisher_scores, surface_ ? log.new_surface : log.view_distance, opt_.hybrid_weight);
-    log.seconds.coverage += since(t0);
-  }
-  if (needs.coverage && opt_.time_exhaustive_fisher) {
-    t0 = Clock::now();
-    (void)fisherScores(trainer_->gaussians(), s, scene_, selected_, candidates, opt_.fisher_lambda,
-                       [this](int done, int total) { report(ActivePhase::kExhaustiveFisher, done, total); });
-    log.seconds.exhaustive_fisher += since(t0);
-  }
-  return pool[argmaxScore(log.scores, pool)];
+  SelectionStep step{scene_,   *trainer_, opt_,          selected_,
+                     candidates, std::move(pool), coverage, rng_,
+                     surface_.get(), [this](ActivePhase p, int done, int total) { report(p, done, total); }};
+  return selectorOf(opt_.method)(step, log);
 }
 
 void ActiveRun::begin() {
