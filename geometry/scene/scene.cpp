@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <exception>
 #include <mutex>
 #include <tbb/parallel_for.h>
@@ -13,7 +12,6 @@
 
 namespace saresgs {
 
-namespace fs = std::filesystem;
 
 // Images are read on first use and kept as 8-bit; the mutex guards the slots, and a
 // slot once filled is never replaced, so returned references stay valid.
@@ -225,14 +223,6 @@ void moveToOwnFrame(Scene& scene) {
   for (SparsePoint& p : scene.points) p.xyz = f.toInternal(p.xyz);
   scene.frame = f;
   scene.finalize();
-}
-
-Scene loadDataset(const std::string& path, const DatasetOptions& opts) {
-  const fs::path p(path);
-  if (!fs::exists(p)) throw InputError(path, "dataset", "folder does not exist");
-  if (fs::exists(p / "transforms_train.json")) return loadBlenderDataset(path, opts);
-  if (fs::exists(p / "transforms.json")) return loadNerfstudioDataset(path, opts);
-  return loadColmapDataset(path, opts);
 }
 
 }  // namespace saresgs
