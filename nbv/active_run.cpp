@@ -16,7 +16,7 @@
 #include "geometry/scene/cameras_json.h"
 #include "nbv/ause.h"
 #include "nbv/initial_views.h"
-#include "nbv/run_report.h"
+#include "nbv/step_report.h"
 #include "nbv/selection_step.h"
 
 namespace saresgs {

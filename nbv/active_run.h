@@ -18,14 +18,13 @@
 #include "geometry/scene/scene.h"
 #include "nbv/coverage_prefilter.h"
 #include "nbv/method.h"
+#include "nbv/selection_log.h"
 #include "nbv/selection_seconds.h"
 #include "nbv/selectors.h"
 #include "nbv/surface_coverage.h"
 #include "splat/train/trainer.h"
 
 namespace saresgs {
-
-struct SelectionLog;
 
 // What a caller's selector (ActiveOptions::custom_selector; the Python module's) sees when
 // the loop asks it for the next view: the model trained on the held views, the
@@ -110,19 +109,6 @@ struct ActiveOptions {
   CustomSelector custom_selector;
   TrainerOptions trainer;
   std::uint64_t seed = 0;
-};
-
-struct SelectionLog {
-  int views_before = 0;
-  int selected = -1;
-  std::vector<int> candidates;      // what the final scorer saw
-  std::vector<double> scores;       // their scores
-  std::vector<int> prefiltered;     // coverage methods: the kept top N %
-  SelectionSeconds seconds;
-  double progress_psnr = 0;         // on the progress test views, before selection
-  // hybrid: its two kinds of evidence (new_surface: the new surface or the facility gain;
-  // view_distance; by hybrid_coverage)
-  std::vector<double> fisher_scores, new_surface, view_distance;
 };
 
 // What an active run is doing; selection stages report per view or candidate handled.

@@ -12,21 +12,9 @@
 #include "geometry/scene/scene.h"
 #include "nbv/active_run.h"
 #include "nbv/selection_seconds.h"
+#include "nbv/step_report.h"
 
 namespace saresgs {
-
-// One training phase and the selection after it. The final phase has no selection:
-// `selected` is empty and so are the candidate lists.
-struct StepReport {
-  int views_before = 0;
-  double progress_psnr = 0;  // on the progress test views, before selection
-  SelectionSeconds seconds;
-  std::string selected;
-  std::vector<std::string> candidates;   // what the final scorer saw
-  std::vector<double> scores;            // their scores
-  std::vector<std::string> prefiltered;  // coverage methods: the kept top N %
-  std::vector<double> fisher_scores, new_surface, view_distance;  // hybrid: its evidence
-};
 
 // The options that shaped the run, as the tables name them.
 struct RunOptionsReport {
@@ -115,17 +103,9 @@ nlohmann::json toJson(const RunReport& r);
 // Throws InputError naming `source` and the field when a field is missing or mistyped.
 RunReport runReportFromJson(const nlohmann::json& j, const std::string& source);
 
-nlohmann::json toJson(const StepReport& s);
-StepReport stepReportFromJson(const nlohmann::json& j, const std::string& source, const std::string& field);
-
-// The loop's step record with views named, and back (names are looked up among the train
-// views; an unknown name throws InputError naming `source`).
-StepReport stepReport(const Scene& scene, const SelectionLog& log);
-
 // The views a run held, in order (initial first), as indices into `scene`: what a fixed-order
 // replay (ActiveOptions::replay) trains on. InputError names `source` and the field when a
 // view is not a train view of `scene`.
 std::vector<int> replaySequence(const Scene& scene, const RunReport& r, const std::string& source);
-SelectionLog selectionLog(const Scene& scene, const StepReport& step, const std::string& source);
 
 }  // namespace saresgs
