@@ -48,34 +48,33 @@ ActiveOptions activeOptions(const ActiveArgs& a) {
     throw std::invalid_argument(
         "--iterations is now --min-iterations: the loop trains at least that many iterations in all, the last phase "
         "what is left and never less than views x --interval (results.json: iterations, phase_iterations)");
-  ActiveOptions o = presetOptions(parsePreset(a.preset));
-  o.method = parseMethod(a.method);
-  o.seed = a.seed;
-  o.trainer.raster.execution.threads = a.threads;
-  o.final_trainer.raster.execution.threads = a.threads;
-  o.fisher_lambda = a.fisher_lambda;
+  ActiveSettings settings;
+  settings.preset = a.preset;
+  settings.method = parseMethod(a.method);
+  settings.seed = a.seed;
+  settings.threads = a.threads;
+  settings.max_views = a.max_views;
+  settings.interval = a.interval;
+  settings.min_iterations = a.total;
+  settings.final_iterations = a.final_iterations;
+  if (a.max_gaussians) settings.max_gaussians = static_cast<std::size_t>(*a.max_gaussians);
+  settings.plain_refit = !a.no_plain_refit;
+  settings.final_residual = a.final_residual;
+  settings.fisher_lambda = a.fisher_lambda;
+  settings.gate_keep = a.gate_keep;
+  settings.path_variance_kappa = a.path_variance_kappa;
+  settings.adaptive_clustering = a.adaptive_clustering;
+  settings.hybrid_weight = a.hybrid_weight;
+  ActiveOptions o = activeOptionsFrom(settings);
+  // What only the command line sets.
   o.reset_after_add = !a.continue_training;
   o.time_exhaustive_fisher = a.time_exhaustive_fisher;
-  o.plain_refit = !a.no_plain_refit;
-  o.final_residual = a.final_residual;
   o.fvs_metric = a.fvs_metric == "great-circle" ? ViewDistance::kGreatCircle : ViewDistance::kEuclidean;
-  if (a.max_views) o.max_views = *a.max_views;
-  if (a.interval) o.interval = *a.interval;
-  if (a.total) o.total_iterations = *a.total;
-  if (a.final_iterations) o.final_iterations = *a.final_iterations;
-  if (a.max_gaussians) {
-    o.trainer.densify.max_gaussians = static_cast<std::size_t>(*a.max_gaussians);
-    o.final_trainer.densify.max_gaussians = o.trainer.densify.max_gaussians;
-  }
   if (a.beta) o.trainer.residual.beta = *a.beta;
   if (!a.ranking.empty()) o.trainer.residual.ranking = parseUncertaintyRanking(a.ranking);
   if (a.sub_only) o.trainer.residual.sub_only = true;
   o.prefilter = parsePrefilterFlags(a.prefilter, o.prefilter, "--prefilter-", a.dataset);
   if (a.prefilter_keep) o.prefilter.keep_fraction = *a.prefilter_keep;
-  if (a.hybrid_weight) o.hybrid_weight = *a.hybrid_weight;
-  if (a.gate_keep) o.gate_keep = *a.gate_keep;
-  if (a.path_variance_kappa) o.path_variance_kappa = *a.path_variance_kappa;
-  if (a.adaptive_clustering) o.adaptive_clustering = *a.adaptive_clustering;
   o.hybrid_criterion = a.hybrid_fisher == "trace" ? FisherCriterion::kTrace : FisherCriterion::kLogDet;
   o.hybrid_coverage = a.hybrid_coverage == "views"      ? HybridCoverage::kViewDistance
                       : a.hybrid_coverage == "facility" ? HybridCoverage::kFacility

@@ -273,19 +273,21 @@ void bindNbv(py::module_& m) {
              auto r = std::make_unique<PyActiveRun>();
              r->dataset = withBackground(dataset, background);
              r->preset = preset;
+             // The same settings as `saresgs active`'s, turned into options by the same function.
+             ActiveSettings settings;
+             settings.preset = preset;
+             settings.method = selector.is_none() ? parseMethod(method) : Method::kCustom;
+             settings.seed = seed;
+             settings.threads = threads;
+             settings.max_views = max_views;
+             settings.interval = interval;
+             settings.min_iterations = min_iterations;
+             settings.final_iterations = final_iterations;
+             settings.max_gaussians = max_gaussians;
+             settings.plain_refit = plain_refit;
+             settings.final_residual = final_residual;
              ActiveOptions& o = r->opt;
-             o = presetOptions(parsePreset(preset));
-             o.method = selector.is_none() ? parseMethod(method) : Method::kCustom;
-             o.seed = seed;
-             o.trainer.raster.execution.threads = threads;
-             o.final_trainer.raster.execution.threads = threads;
-             if (max_views) o.max_views = *max_views;
-             if (interval) o.interval = *interval;
-             if (min_iterations) o.total_iterations = *min_iterations;
-             if (final_iterations) o.final_iterations = *final_iterations;
-             o.plain_refit = plain_refit;
-             o.final_residual = final_residual;
-             if (max_gaussians) o.trainer.densify.max_gaussians = o.final_trainer.densify.max_gaussians = *max_gaussians;
+             o = activeOptionsFrom(settings);
              // As `saresgs active --prefilter-scene`: auto reads a `saresgs scene` manifest's layout.
              applySceneType(o.prefilter, prefilter_scene == "auto" ? sceneTypeOfDataset(dataset->source).value_or(SceneType::kOutdoor)
                                                                    : parseSceneType(prefilter_scene));
