@@ -2,7 +2,7 @@
 # this build's libraries, and run for a bounded number of inputs each by CTest (label
 # `fuzz`). Needs clang and libFuzzer (Debian: clang, libclang-rt-14-dev; both installed
 # by scripts/install_deps.sh); without them the targets are left out with a warning.
-option(SARESGS_FUZZ "Build the libFuzzer targets (fuzz/) with clang and run them in CTest" ON)
+option(SARESGS_FUZZ "Build the libFuzzer targets (fuzz/) with clang and run them in CTest (scripts/test.sh turns it on)" OFF)
 if(NOT SARESGS_FUZZ)
   return()
 endif()

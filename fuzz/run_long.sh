@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# A long fuzz run of one target (docs/FUZZING.md), after `bash scripts/build.sh`:
+# A long fuzz run of one target (docs/FUZZING.md), after `bash scripts/build.sh -DSARESGS_FUZZ=ON`:
 #   bash fuzz/run_long.sh TARGET [RUNS] [WORK_DIR]
 # RUNS inputs (default 1000000) mutated from the seeds (fuzz/corpus/TARGET) and the
 # committed regression inputs (tests/**/fuzz_regressions/TARGET), with the limits of the

@@ -5,6 +5,6 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh
-bash scripts/build.sh
+bash scripts/build.sh -DSARESGS_FUZZ=ON  # everything: tests, Python module, fuzz targets
 ctest --test-dir build --output-on-failure --parallel "$(nproc)" --timeout 900
 bash scripts/test_slurm.sh
