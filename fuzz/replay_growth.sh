@@ -10,7 +10,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 target=$1 few=${2:-100} many=${3:-2000} seeds=${4:-5} limit_kb=${LIMIT_KB:-2}
 bin=build/fuzz/fuzz_$target
-[ -x "$bin" ] || { echo "replay_growth: $bin is missing; build first (scripts/build.sh)" >&2; exit 2; }
+[ -x "$bin" ] || { echo "replay_growth: $bin is missing; build first (bash scripts/build.sh -DSARESGS_FUZZ=ON)" >&2; exit 2; }
 peak() {  # peak RSS in KB of N replays of file F
   local n=$1 f=$2 list=()
   for _ in $(seq "$n"); do list+=("$f"); done

@@ -11,7 +11,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 target=$1 runs=${2:-1000000} work=${3:-build/fuzz/long/$1}
 bin=build/fuzz/fuzz_$target
-[ -x "$bin" ] || { echo "run_long: $bin is missing; build first (scripts/build.sh)" >&2; exit 2; }
+[ -x "$bin" ] || { echo "run_long: $bin is missing; build first (bash scripts/build.sh -DSARESGS_FUZZ=ON)" >&2; exit 2; }
 mkdir -p "$work/corpus" "$work/artifacts"
 extra=()
 while IFS= read -r -d '' d; do extra+=("$d"); done \
