@@ -443,6 +443,23 @@ TEST(SyntheticLayouts, SomeObjectsAreHiddenFromSomeUnbalancedViews) {
   EXPECT_GT(blocked_by_occluder, 10);
 }
 
+// A room layout's manifest split into its dividing walls (room_divider_*) and its content
+// objects (everything not named room_*), by bounding box.
+struct RoomParts {
+  std::vector<Eigen::AlignedBox3f> dividers;
+  std::vector<std::pair<std::string, Eigen::AlignedBox3f>> content;  // name, box
+};
+RoomParts roomParts(const SyntheticScene& s) {
+  RoomParts p;
+  for (const auto& o : s.manifest["objects"]) {
+    const std::string name = o["name"];
+    const Eigen::AlignedBox3f box(vec3(o["bbox_min"]), vec3(o["bbox_max"]));
+    if (name.rfind("room_divider", 0) == 0) p.dividers.push_back(box);
+    else if (name.rfind("room_", 0) != 0) p.content.emplace_back(name, box);
+  }
+  return p;
+}
+
 TEST(SyntheticLayouts, TwoRoomsIsRealMeshesBehindAWallWithADoor) {
   const SyntheticScene& s = scene("tworooms");
   const auto names = s.objectNames();
@@ -507,20 +524,12 @@ TEST(SyntheticLayouts, TwoRoomsIsRealMeshesBehindAWallWithADoor) {
 TEST(SyntheticLayouts, CorridorIsThreeRoomsWithDoorsOnOppositeSidesAndAnUnevenWalk) {
   const SyntheticScene& s = scene("corridor");
   const auto names = s.objectNames();
-  std::vector<Eigen::AlignedBox3f> dividers;
+  const RoomParts parts = roomParts(s);
+  const std::vector<Eigen::AlignedBox3f>& dividers = parts.dividers;
   std::vector<Eigen::Vector3f> first_room;  // centres of the content objects at x < -3
-  int content = 0;
-  for (const auto& o : s.manifest["objects"]) {
-    const std::string name = o["name"];
-    const Eigen::AlignedBox3f box(vec3(o["bbox_min"]), vec3(o["bbox_max"]));
-    if (name.rfind("room_divider", 0) == 0) {
-      dividers.push_back(box);
-    } else if (name.rfind("room_", 0) != 0) {
-      ++content;
-      if (box.center().x() < -3) first_room.push_back(box.center());
-    }
-  }
-  EXPECT_EQ(content, 7);
+  for (const auto& [name, box] : parts.content)
+    if (box.center().x() < -3) first_room.push_back(box.center());
+  EXPECT_EQ(parts.content.size(), 7u);
   EXPECT_EQ(first_room.size(), 2u);
   ASSERT_EQ(dividers.size(), 6u);
   // The walk visits the three rooms in order and never stands inside a wall.
