@@ -14,11 +14,9 @@
 #include "geometry/scene/dataset_checks.h"
 #include "geometry/error.h"
 #include "geometry/io/atomic_file.h"
-#include "geometry/synth/from_manifest.h"
 #include "nbv/eval/coverage_report.h"
 #include "splat/model_frame.h"
 #include "splat/ply.h"
-#include "splat/rasterize.h"
 
 namespace saresgs::apps {
 
@@ -38,29 +36,13 @@ int runCoverage(const CoverageArgs& a) {
   const Scene scene = loadDataset(a.dataset, dopt);
   std::cerr << formatWarnings(checkDataset(scene));
   const std::vector<int> views = parseTrainViews(a.views, scene, "--views");
-  ViewRenderer render;
-  DepthRenderer depth;
-  std::string source;
-  std::optional<SyntheticScene> truth;
   Gaussians model;
-  if (!a.model.empty()) {
-    model = gaussiansFromWorld(readGaussiansPly(a.model), scene.frame);
-    RasterSettings rs;
-    rs.sh_degree = model.max_sh_degree;
-    if (scene.background) rs.background = *scene.background;
-    render = [&, rs](const Camera& c) { return rasterize(model, c, rs).rgb; };
-    depth = [&, rs](const Camera& c) { return rasterize(model, c, rs).depth; };
-    source = "model " + a.model;
-  } else if ((truth = rebuildSyntheticScene(a.dataset, scene))) {
-    render = [&](const Camera& c) { return truth->render(c); };
-    depth = [&](const Camera& c) { return truth->renderDepth(c); };
-    source = "ground-truth renders of the synthetic scene";
-  } else {
-    throw InputError(a.dataset, "manifest.json",
-                     "not a rebuildable synthetic scene: give a trained model with --model to render extrapolated views");
-  }
+  if (!a.model.empty()) model = gaussiansFromWorld(readGaussiansPly(a.model), scene.frame);
+  const CoverageRenderers renderers =
+      coverageRenderers(scene, a.dataset, a.model.empty() ? nullptr : &model, a.model, "--model");
+  const std::string& source = renderers.source;
   std::cerr << "coverage of " << views.size() << " views from " << source << "\n";
-  const CoverageAnalysis c = analyzeCoverage(scene, views, config, render, depth);
+  const CoverageAnalysis c = analyzeCoverage(scene, views, config, renderers.render, renderers.depth);
 
   std::filesystem::create_directories(a.out);
   nlohmann::json j;

@@ -1,5 +1,9 @@
 #include "nbv/eval/coverage_report.h"
 
+#include "geometry/error.h"
+#include "geometry/synth/from_manifest.h"
+#include "splat/rasterize.h"
+
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -111,6 +115,30 @@ Image8 plotCoverage(const Scene& scene, const CoverageAnalysis& a, int size) {
   cv::cvtColor(img, rgb, cv::COLOR_BGR2RGB);
   std::memcpy(out.data.data(), rgb.data, out.data.size());
   return out;
+}
+
+CoverageRenderers coverageRenderers(const Scene& scene, const std::string& dataset_path, const Gaussians* model,
+                                    const std::string& model_name, const std::string& how_to_give_a_model) {
+  CoverageRenderers r;
+  if (model) {
+    RasterSettings rs;
+    rs.sh_degree = model->max_sh_degree;
+    if (scene.background) rs.background = *scene.background;
+    r.render = [model, rs](const Camera& c) { return rasterize(*model, c, rs).rgb; };
+    r.depth = [model, rs](const Camera& c) { return rasterize(*model, c, rs).depth; };
+    r.source = "model " + model_name;
+    return r;
+  }
+  std::optional<SyntheticScene> rebuilt = rebuildSyntheticScene(dataset_path, scene);
+  if (!rebuilt)
+    throw InputError(dataset_path, "manifest.json",
+                     "not a rebuildable synthetic scene: give a trained model (" + how_to_give_a_model +
+                         ") to render extrapolated views");
+  auto truth = std::make_shared<const SyntheticScene>(std::move(*rebuilt));
+  r.render = [truth](const Camera& c) { return truth->render(c); };
+  r.depth = [truth](const Camera& c) { return truth->renderDepth(c); };
+  r.source = "ground-truth renders of the synthetic scene";
+  return r;
 }
 
 }  // namespace saresgs

@@ -4,7 +4,6 @@
 #include <optional>
 
 #include "geometry/error.h"
-#include "geometry/synth/from_manifest.h"
 #include "nbv/active_run.h"
 #include "nbv/coverage_prefilter.h"
 #include "nbv/eval/run_files.h"
@@ -158,23 +157,9 @@ void bindNbv(py::module_& m) {
         c.lifting = parseLiftingSource(lifting);
         c.keep_fraction = keep;
         py::gil_scoped_release nogil;
-        ViewRenderer render;
-        DepthRenderer depth;
-        std::optional<SyntheticScene> truth;
-        if (model) {
-          RasterSettings rs;
-          rs.sh_degree = model->max_sh_degree;
-          if (scene->background) rs.background = *scene->background;
-          render = [&, rs](const Camera& cam) { return rasterize(*model, cam, rs).rgb; };
-          depth = [&, rs](const Camera& cam) { return rasterize(*model, cam, rs).depth; };
-        } else if ((truth = rebuildSyntheticScene(scene->source, *scene))) {
-          render = [&](const Camera& cam) { return truth->render(cam); };
-          depth = [&](const Camera& cam) { return truth->renderDepth(cam); };
-        } else {
-          throw InputError(scene->source, "manifest.json",
-                           "not a rebuildable synthetic scene: give a trained model (model=) to render extrapolated views");
-        }
-        const CoverageAnalysis a = analyzeCoverage(*scene, views, c, render, depth);
+        const CoverageRenderers renderers =
+            coverageRenderers(*scene, scene->source, model ? &*model : nullptr, "given as model=", "model=");
+        const CoverageAnalysis a = analyzeCoverage(*scene, views, c, renderers.render, renderers.depth);
         py::gil_scoped_acquire gil;
         py::dict d;
         d["encoding"] = encodingName(c.scoring);
