@@ -6,7 +6,7 @@
 #include <optional>
 
 #include "apps/cli_checks.h"
-#include "apps/thread_limit.h"
+#include "splat/thread_limit.h"
 #include "apps/commands.h"
 #include "apps/memory_budget.h"
 #include "apps/prefilter_flags.h"

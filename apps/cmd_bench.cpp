@@ -29,7 +29,7 @@
 
 #include "apps/cli_checks.h"
 #include "apps/commands.h"
-#include "apps/thread_limit.h"
+#include "splat/thread_limit.h"
 #include "apps/heap_count.h"
 #include "apps/memory_budget.h"
 #include "geometry/error.h"

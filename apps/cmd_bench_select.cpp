@@ -9,7 +9,7 @@
 
 #include "apps/cli_checks.h"
 #include "apps/commands.h"
-#include "apps/thread_limit.h"
+#include "splat/thread_limit.h"
 #include "geometry/synth/synthetic_scene.h"
 #include "geometry/synth/write_dataset.h"
 #include "nbv/eval/selection_bench.h"

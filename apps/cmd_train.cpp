@@ -10,7 +10,7 @@
 #include <iostream>
 
 #include "apps/cli_checks.h"
-#include "apps/thread_limit.h"
+#include "splat/thread_limit.h"
 #include "apps/commands.h"
 #include "apps/memory_budget.h"
 #include "apps/progress.h"

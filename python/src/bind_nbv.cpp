@@ -10,6 +10,7 @@
 #include "nbv/eval/coverage_report.h"
 #include "nbv/method.h"
 #include "nbv/preset.h"
+#include "splat/thread_limit.h"
 #include "nbv/run_report.h"
 #include "nbv/selectors.h"
 #include "geometry/io/atomic_file.h"
@@ -54,6 +55,11 @@ struct PyActiveRun {
   py::object selector = py::none(), progress = py::none();
   std::unique_ptr<ActiveRun> run;
   std::optional<ActiveResult> result;
+
+  // threads=N holds all of a call's TBB work at N, as --threads does for the CLI.
+  std::unique_ptr<tbb::global_control> threadLimit() const {
+    return limitThreads(opt.trainer.raster.execution.threads);
+  }
 
   void onProgress(const ActiveProgress& p) {
     py::gil_scoped_acquire gil;
@@ -303,6 +309,7 @@ void bindNbv(py::module_& m) {
           [](PyActiveRun& r, py::object progress) {
             r.progress = progress;
             py::gil_scoped_release nogil;
+            const auto limit = r.threadLimit();
             r.result = r.run->run([&r](const ActiveProgress& p) { r.onProgress(p); });
             py::gil_scoped_acquire gil;
             return r.report(r.dataset->source);
@@ -316,6 +323,7 @@ void bindNbv(py::module_& m) {
             r.progress = progress;
             r.wire();
             py::gil_scoped_release nogil;
+            const auto limit = r.threadLimit();
             r.run->trainPhase();
           },
           py::arg("progress") = py::none(), "Trains the phase of the views held now (nothing if trained already).")
@@ -328,6 +336,7 @@ void bindNbv(py::module_& m) {
             int v;
             {
               py::gil_scoped_release nogil;
+              const auto limit = r.threadLimit();
               v = r.run->nextView(&log);
             }
             py::dict d;
@@ -343,6 +352,7 @@ void bindNbv(py::module_& m) {
           [](PyActiveRun& r, int v) {
             r.wire();
             py::gil_scoped_release nogil;
+            const auto limit = r.threadLimit();
             r.run->addView(v);
           },
           py::arg("view"), "Holds `view` next (the method's choice or any train view not held).")
@@ -353,6 +363,7 @@ void bindNbv(py::module_& m) {
             r.wire();
             {
               py::gil_scoped_release nogil;
+              const auto limit = r.threadLimit();
               r.result = r.run->finish();
             }
             return r.report(r.dataset->source);

@@ -5,6 +5,7 @@
 #include "splat/model_frame.h"
 #include "splat/ply.h"
 #include "splat/train/schedule.h"
+#include "splat/thread_limit.h"
 #include "splat/train/trainer.h"
 
 namespace saresgs::python {
@@ -76,6 +77,7 @@ void bindTrain(py::module_& m) {
             if (iterations < 0) throw py::value_error("iterations: expected >= 0");
             if (every < 1) throw py::value_error("every: expected >= 1");
             py::gil_scoped_release nogil;
+            const auto limit = limitThreads(t.rasterSettings().execution.threads);  // threads=N: all TBB work
             // Each iteration takes the GIL back briefly: Ctrl-C stops the call (KeyboardInterrupt)
             // after a whole iteration, the model left as trained so far.
             t.train(views, iterations, [&](const TrainProgress& p) {
@@ -87,7 +89,13 @@ void bindTrain(py::module_& m) {
           py::arg("views"), py::arg("iterations"), py::arg("callback") = py::none(), py::arg("every") = 1,
           "Trains `iterations` iterations on `views` (indices into the dataset); callback(progress) is called every "
           "`every` iterations with a dict (iteration, done, total, loss, loss_ema, gaussians).")
-      .def("step", [](Trainer& t, int view) { checkViews(t.scene(), {view}); py::gil_scoped_release nogil; return t.step(view); },
+      .def("step",
+           [](Trainer& t, int view) {
+             checkViews(t.scene(), {view});
+             py::gil_scoped_release nogil;
+             const auto limit = limitThreads(t.rasterSettings().execution.threads);
+             return t.step(view);
+           },
            py::arg("view"), "One iteration on one view; returns its loss.")
       .def(
           "evaluate",

@@ -8,9 +8,9 @@
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
-#include "apps/thread_limit.h"
+#include "splat/thread_limit.h"
 
-using namespace saresgs::apps;
+using namespace saresgs;
 
 namespace {
 // The threads that ran a parallel loop of short sleeps (long enough for every worker TBB

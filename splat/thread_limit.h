@@ -1,5 +1,5 @@
 #pragma once
-// --threads N for a whole command. The rasterizer's arena takes N from its options; this
+// --threads N for a whole command (the CLI) or call (Python). The rasterizer's arena takes N from its options; this
 // caps everything else TBB runs in the process (SSIM, Adam, the residual subset, image
 // decoding, the Fisher chain) at the same N while the returned object lives, so a run or
 // an ablation job given one thread uses one core (before, only the tile kernels obeyed
@@ -9,7 +9,7 @@
 
 #include <tbb/global_control.h>
 
-namespace saresgs::apps {
+namespace saresgs {
 
 inline std::unique_ptr<tbb::global_control> limitThreads(int threads) {
   if (threads <= 0) return nullptr;
@@ -17,4 +17,4 @@ inline std::unique_ptr<tbb::global_control> limitThreads(int threads) {
                                                static_cast<std::size_t>(threads));
 }
 
-}  // namespace saresgs::apps
+}  // namespace saresgs
