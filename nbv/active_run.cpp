@@ -16,6 +16,7 @@
 #include "geometry/scene/cameras_json.h"
 #include "nbv/ause.h"
 #include "nbv/initial_views.h"
+#include "nbv/selection_seconds.h"
 #include "nbv/step_report.h"
 #include "nbv/selection_step.h"
 
@@ -27,7 +28,6 @@ namespace {
 constexpr const char* kCheckpointFormat = "saresgs-active-checkpoint-2";
 
 using Clock = std::chrono::steady_clock;
-double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 }  // namespace
 
@@ -139,7 +139,7 @@ int ActiveRun::selectNext(SelectionLog& log) {
     if (needs.fisher) {
       const auto t0 = Clock::now();
       pool = topFraction(coverage, candidates, opt_.prefilter.keep_fraction);
-      log.seconds.prefilter += since(t0);
+      log.seconds.prefilter += secondsSince(t0);
       log.prefiltered = pool;
     }
   }
@@ -192,7 +192,7 @@ void ActiveRun::trainPhase() {
     last_.loss = p.loss_ema;
     report(ActivePhase::kTraining, p.done, phase);
   });
-  phase_seconds_ = since(t0);
+  phase_seconds_ = secondsSince(t0);
   iterations_done_ += phase;
   phase_trained_ = true;
   if (!progress_views_.empty()) last_psnr_ = trainer_->evaluate(progress_views_).psnr;
@@ -311,7 +311,7 @@ ActiveResult ActiveRun::finish() {
       r.final_fit_views = f;
     }
   }
-  r.seconds = since(start_);
+  r.seconds = secondsSince(start_);
   return r;
 }
 

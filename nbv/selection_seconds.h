@@ -2,6 +2,7 @@
 // Stage times of one view selection (and, summed, of a run), seconds.
 #include <nlohmann/json.hpp>
 
+#include <chrono>
 #include <string>
 
 namespace saresgs {
@@ -20,5 +21,10 @@ struct SelectionSeconds {
 // missing: files written before it was recorded).
 nlohmann::json toJson(const SelectionSeconds& s);
 SelectionSeconds secondsFrom(const nlohmann::json& j, const std::string& file, const std::string& field);
+
+// Seconds of the steady clock since t0: how the stages above are timed.
+inline double secondsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
 
 }  // namespace saresgs

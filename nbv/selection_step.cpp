@@ -6,13 +6,13 @@
 #include <string>
 
 #include "nbv/path_variance.h"
+#include "nbv/selection_seconds.h"
 
 namespace saresgs {
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // The candidates' scores in the log and the best of them.
 int best(const std::vector<int>& candidates, std::vector<double> scores, SelectionLog& log) {
@@ -51,7 +51,7 @@ int selectPathVarianceView(SelectionStep& step, SelectionLog& log) {
       step.trainer.gaussians(), step.trainer.rasterSettings(), step.scene, step.held, step.candidates,
       {step.options.fisher_lambda, step.options.path_variance_kappa},
       [&step](int done, int total) { step.report(ActivePhase::kFisher, done, total); });
-  log.seconds.fisher += since(t0);
+  log.seconds.fisher += secondsSince(t0);
   return best(step.candidates, std::move(scores), log);
 }
 
@@ -70,14 +70,14 @@ int selectFisherView(SelectionStep& step, SelectionLog& log) {
                                                                       : FisherCriterion::kTrace;
   log.scores = fisherScores(step.trainer.gaussians(), s, step.scene, step.held, pool, o.fisher_lambda,
                             [&step](int done, int total) { step.report(ActivePhase::kFisher, done, total); }, criterion);
-  log.seconds.fisher += since(t0);
+  log.seconds.fisher += secondsSince(t0);
   if (o.method == Method::kFisherKmedian) {
     // Fisher scored every candidate; the k-median gain over them, each weighted by its score
     // (held views are at distance 0 from a held view: they add nothing).
     t0 = Clock::now();
     log.fisher_scores = log.scores;
     log.scores = kmedianGains(step.scene, step.held, pool, pool, poseAngleScale(step.scene), log.fisher_scores);
-    log.seconds.prefilter += since(t0);
+    log.seconds.prefilter += secondsSince(t0);
   }
   const MethodNeeds needs = needsOf(o.method);
   if (needs.surface) {
@@ -93,13 +93,13 @@ int selectFisherView(SelectionStep& step, SelectionLog& log) {
       log.view_distance = farthestViewScores(step.scene, step.held, pool, ViewDistance::kEuclidean, Eigen::Vector3d::Zero());
     }
     log.scores = hybridScores(log.fisher_scores, step.surface ? log.new_surface : log.view_distance, o.hybrid_weight);
-    log.seconds.coverage += since(t0);
+    log.seconds.coverage += secondsSince(t0);
   }
   if (needs.coverage && o.time_exhaustive_fisher) {
     t0 = Clock::now();
     (void)fisherScores(step.trainer.gaussians(), s, step.scene, step.held, step.candidates, o.fisher_lambda,
                        [&step](int done, int total) { step.report(ActivePhase::kExhaustiveFisher, done, total); });
-    log.seconds.exhaustive_fisher += since(t0);
+    log.seconds.exhaustive_fisher += secondsSince(t0);
   }
   return pool[argmaxScore(log.scores, pool)];
 }
@@ -113,7 +113,7 @@ int selectGatedFisherView(SelectionStep& step, SelectionLog& log) {
                                        : fvsScores(s, step.held, step.candidates, step.options.fvs_metric);
   step.pool = topFraction(gate, step.candidates, step.options.gate_keep);
   log.prefiltered = step.pool;
-  log.seconds.prefilter += since(t0);
+  log.seconds.prefilter += secondsSince(t0);
   return selectFisherView(step, log);
 }
 

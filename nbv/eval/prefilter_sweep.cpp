@@ -12,13 +12,13 @@
 #include "geometry/error.h"
 #include "geometry/io/json_file.h"
 #include "nbv/initial_views.h"
+#include "nbv/selection_seconds.h"
 
 namespace saresgs {
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // The protocol's initial views, then random train views (seeded), `count` in all.
 std::vector<int> observedOrder(const Scene& scene, int count, std::uint64_t seed) {
@@ -157,7 +157,7 @@ std::vector<SweepRow> prefilterSweep(const Scene& scene, const SweepSpec& spec, 
       const Camera& cam = scene.views[static_cast<std::size_t>(v)].camera;
       const auto t0 = Clock::now();
       sets[kind].push_back(builder.build(cam, kind, config.visible_stride));
-      set_seconds[kind].push_back(since(t0));
+      set_seconds[kind].push_back(secondsSince(t0));
     }
   }
 
@@ -195,7 +195,7 @@ std::vector<SweepRow> prefilterSweep(const Scene& scene, const SweepSpec& spec, 
           for (int r = 0; r < std::max(1, spec.timing_repeats); ++r) {
             const auto t0 = Clock::now();
             v = values(s, o);
-            times.push_back(since(t0));
+            times.push_back(secondsSince(t0));
           }
           std::nth_element(times.begin(), times.begin() + static_cast<long>(times.size() / 2), times.end());
           SweepRow row;

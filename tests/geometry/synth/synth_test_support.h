@@ -39,6 +39,7 @@ inline std::vector<double> nearestNeighbourDistances(const std::vector<Camera>& 
       if (i != j) d[i] = std::min(d[i], (cams[i].center() - cams[j].center()).norm());
   return d;
 }
+
 inline double median(std::vector<double> v) {
   std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
   return v[v.size() / 2];
