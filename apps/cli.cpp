@@ -22,6 +22,7 @@ int runCli(const std::vector<std::string>& args) {
   addActiveCommand(app, action);
   addCoverageCommand(app, action);
   addAblateCommand(app, action);
+  addReportCommand(app, action);
   // An unknown first word would otherwise read "A subcommand is required".
   std::string names;
   bool known = false;

@@ -19,6 +19,7 @@
 #include "nbv/preset.h"
 #include "nbv/run_report.h"
 #include "splat/raster_execution.h"
+#include "report/run_page.h"
 #include "splat/train/test_renders.h"
 
 namespace saresgs::apps {
@@ -108,6 +109,20 @@ void printSummary(const RunReport& r, const std::string& out) {
               r.final_fit ? ", final_fit.ply" : "", plain_file ? ", final_fit_views.ply" : "");
 }
 
+// The run's HTML page (report/run_page.h). The run's files are written by now: a page
+// that cannot be made is said, not a failed run.
+void writeReportPage(const std::string& out, const Scene& scene, int threads) {
+  try {
+    RunPageOptions page;
+    page.threads = threads;
+    const RunPageResult r = writeRunPage(out, &scene, page);
+    for (const std::string& m : r.missing) std::cerr << "report: " << m << "\n";
+    std::printf("wrote %s (%.1f MB): open it in a browser\n", r.path.c_str(), static_cast<double>(r.bytes) / (1024.0 * 1024.0));
+  } catch (const std::exception& e) {
+    std::cerr << "report: no report.html: " << e.what() << "\n";
+  }
+}
+
 int runActive(const ActiveArgs& a) {
   const auto thread_limit = limitThreads(a.threads);
   ActiveOptions opt = activeOptions(a);
@@ -183,6 +198,7 @@ int runActive(const ActiveArgs& a) {
   results["memory"] = {{"peak_rss_bytes", peakRssBytes()}, {"rss_at_phase_start_this_process", phase_memory}};
   writeFileAtomic(a.out + "/results.json", results.dump(2) + "\n");
   printSummary(report, a.out);
+  writeReportPage(a.out, scene, a.threads);
   std::printf("peak resident memory %.0f MB (this process)\n", peakRssBytes() / (1024.0 * 1024.0));
   return 0;
 }

@@ -17,6 +17,7 @@ void addSelectBenchCommand(CLI::App& bench, Action& action);  // apps/cmd_bench_
 void addActiveCommand(CLI::App& app, Action& action);  // apps/cmd_active.cpp
 void addCoverageCommand(CLI::App& app, Action& action);  // apps/cmd_coverage.cpp
 void addAblateCommand(CLI::App& app, Action& action);  // apps/cmd_ablate.cpp
+void addReportCommand(CLI::App& app, Action& action);  // apps/cmd_report.cpp
 
 // Parses `saresgs active` arguments (without the subcommand; --out may be left out) and
 // builds the run's options without running anything; throws std::invalid_argument with

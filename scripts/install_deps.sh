@@ -20,6 +20,8 @@ packages=(
   # the fuzz targets (fuzz/): clang 14 and its runtimes (libFuzzer, ASan, UBSan), which
   # clang only recommends (third_party_notes/libfuzzer.md)
   clang-14 libclang-rt-14-dev
+  # the HTML report's browser tests: headless Chromium with software WebGL, and a font
+  chromium fonts-liberation
   # CC0 meshes (/usr/share/doc/libcgal-dev/data.tar.gz) and photographs for textures
   libcgal-demo opencv-doc
 )

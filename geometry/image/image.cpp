@@ -132,22 +132,33 @@ bool imageHasTransparency(const std::string& path) {
   return false;
 }
 
-void writeImage(const std::string& path, const Image8& img) {
+std::vector<std::uint8_t> encodeImage(const Image8& img, const std::string& ext, int jpeg_quality) {
   const int type = CV_8UC(img.channels);
   cv::Mat m(img.height, img.width, type, const_cast<std::uint8_t*>(img.data.data()));
   cv::Mat bgr;
   if (img.channels == 3) cv::cvtColor(m, bgr, cv::COLOR_RGB2BGR);
   else if (img.channels == 4) cv::cvtColor(m, bgr, cv::COLOR_RGBA2BGRA);
   else bgr = m;
-  const std::string ext = std::filesystem::path(path).extension().string();
   std::vector<std::uint8_t> bytes;
   bool encoded = false;
+  const std::vector<int> params = {cv::IMWRITE_JPEG_QUALITY, std::clamp(jpeg_quality, 0, 100)};
   try {
-    encoded = cv::imencode(ext, bgr, bytes);
+    encoded = cv::imencode(ext, bgr, bytes, params);
   } catch (const cv::Exception&) {
     encoded = false;  // OpenCV throws for an extension it has no encoder for
   }
-  if (!encoded) throw InputError(path, "extension", "expected .png or .jpg to encode the image");
+  if (!encoded) throw InputError(ext, "extension", "expected .png or .jpg to encode the image");
+  return bytes;
+}
+
+void writeImage(const std::string& path, const Image8& img) {
+  const std::string ext = std::filesystem::path(path).extension().string();
+  std::vector<std::uint8_t> bytes;
+  try {
+    bytes = encodeImage(img, ext);
+  } catch (const InputError&) {
+    throw InputError(path, "extension", "expected .png or .jpg to encode the image");
+  }
   writeFileAtomic(path, std::string(bytes.begin(), bytes.end()));
 }
 

@@ -47,6 +47,9 @@ bool imageHasAlpha(const std::string& path);
 bool imageHasTransparency(const std::string& path);
 // Writes PNG/JPEG by extension, to a temporary name first, then renames.
 void writeImage(const std::string& path, const Image8& img);
+// The image encoded as `ext` (".png" or ".jpg"; JPEG at `jpeg_quality`, 0..100), in memory.
+// Throws InputError naming `ext` for any other extension.
+std::vector<std::uint8_t> encodeImage(const Image8& img, const std::string& ext, int jpeg_quality = 90);
 // Area-averaging resize to an exact size (used for downscaled loading).
 Image8 resizeImage(const Image8& img, int width, int height);
 // Composites RGBA on a background colour (components in [0,1]) and returns RGB.

@@ -7,6 +7,7 @@
 #include "nbv/active_run.h"
 #include "nbv/coverage_prefilter.h"
 #include "nbv/eval/run_files.h"
+#include "report/run_page.h"
 #include "nbv/eval/coverage_report.h"
 #include "nbv/method.h"
 #include "nbv/preset.h"
@@ -377,16 +378,30 @@ void bindNbv(py::module_& m) {
       })
       .def(
           "write",
-          [](const PyActiveRun& r, const std::string& out) {
+          [](const PyActiveRun& r, const std::string& out, bool html) -> py::object {
             py::object report = r.report(r.dataset->source);
             const std::string text = py::module_::import("json").attr("dumps")(report, py::arg("indent") = 2).cast<std::string>();
             py::gil_scoped_release nogil;
             std::filesystem::create_directories(out);
             writeRunFiles(*r.run, *r.result, *r.dataset, out);
             writeFileAtomic(out + "/results.json", text + "\n");
+            if (!html) {
+              py::gil_scoped_acquire gil;
+              return py::none();
+            }
+            const RunPageResult page = writeRunPage(out, r.dataset.get(), RunPageOptions{});
+            py::gil_scoped_acquire gil;
+            py::dict d;
+            d["path"] = page.path;
+            d["bytes"] = page.bytes;
+            d["viewer"] = page.viewer;
+            d["missing"] = page.missing;
+            return d;
           },
-          py::arg("out"),
-          "Writes results.json, the .ply files, cameras.json and cameras.png into `out`, as `saresgs active` does.");
+          py::arg("out"), py::arg("report") = true,
+          "Writes results.json, the .ply files, cameras.json and cameras.png into `out`, as `saresgs active` does, and "
+          "with `report` the run's page, report.html (saresgs report); returns {path, bytes, viewer, missing} of the "
+          "page (missing: what it could not show, and why), or None without it.");
 }
 
 }  // namespace saresgs::python

@@ -13,6 +13,7 @@
 
 #include "common/test_support.h"
 #include "splat/ply.h"
+#include "splat/splat_file.h"
 
 using namespace saresgs;
 using saresgs::test::TempDir;
@@ -181,4 +182,57 @@ TEST(SplatTransform, FilterHarmonicsKeepsOurBandOneCoefficients) {
     for (int a = 0; a < 3; ++a) ASSERT_EQ(b.means[3 * i + a], g.means[3 * i + a]);
     ASSERT_EQ(b.opacities[i], g.opacities[i]);
   }
+}
+
+// The HTML report's compressed form (splat/splat_file.h) read by splat-transform: every
+// Gaussian comes back, positions exactly, the rest within the format's 8-bit steps.
+TEST(SplatTransform, ReadsOurSplatFileAsWritten) {
+  ASSERT_TRUE(toolPresent());
+  TempDir dir;
+  Gaussians g = randomModel(1200, 3, 31);
+  g.rotations[0] = g.rotations[1] = g.rotations[2] = g.rotations[3] = 0;  // a zero quaternion: identity
+  const std::string bytes = splatFileBytes(g);
+  ASSERT_EQ(bytes.size(), g.size() * kSplatRecordBytes);
+  const std::string in = dir.file("model.splat"), back = dir.file("back.ply");
+  {
+    std::FILE* f = std::fopen(in.c_str(), "wb");
+    ASSERT_NE(f, nullptr);
+    ASSERT_EQ(std::fwrite(bytes.data(), 1, bytes.size(), f), bytes.size());
+    std::fclose(f);
+  }
+  const ToolRun r = runTool("-w " + quote(in) + " " + quote(back));
+  ASSERT_EQ(r.rc, 0) << r.out;
+  const Gaussians b = readGaussiansPly(back);
+  ASSERT_EQ(b.size(), g.size());
+  const int K = g.shCoeffs(), Kb = b.shCoeffs();
+  double max_pos = 0, max_scale = 0, max_alpha = 0, max_colour = 0, min_dot = 1;
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    for (int a = 0; a < 3; ++a) {
+      max_pos = std::max(max_pos, std::abs(double(b.means[3 * i + a]) - g.means[3 * i + a]));
+      max_scale = std::max(max_scale, std::abs(double(b.log_scales[3 * i + a]) - g.log_scales[3 * i + a]));
+    }
+    max_alpha = std::max(max_alpha, std::abs(sigmoid(b.opacities[i]) - sigmoid(g.opacities[i])));
+    for (int c = 0; c < 3; ++c) {
+      const double want = std::clamp(0.5 + kShC0 * g.sh[i * K * 3 + c], 0.0, 1.0);
+      max_colour = std::max(max_colour, std::abs(0.5 + kShC0 * b.sh[i * Kb * 3 + c] - want));
+    }
+    double na = 0, nb = 0, dot = 0;
+    const bool zero = i == 0;
+    for (int a = 0; a < 4; ++a) {
+      const double ga = zero ? (a == 0 ? 1.0 : 0.0) : g.rotations[4 * i + a];
+      na += ga * ga;
+      nb += double(b.rotations[4 * i + a]) * b.rotations[4 * i + a];
+      dot += ga * b.rotations[4 * i + a];
+    }
+    min_dot = std::min(min_dot, std::abs(dot) / std::sqrt(na * nb));
+  }
+  EXPECT_EQ(max_pos, 0.0);
+  EXPECT_LE(max_scale, 1e-5);
+  // 8 bits: half a step of 1/255 plus splat-transform's own float rounding
+  EXPECT_LE(max_alpha, 0.6 / 255.0);
+  EXPECT_LE(max_colour, 0.6 / 255.0);
+  // rotation components in steps of 1/128
+  EXPECT_GE(min_dot, 0.995);
+  std::printf("  .splat: log-scale %.3g, opacity %.3g, colour %.3g, min |cos| quaternion %.6f\n", max_scale, max_alpha,
+              max_colour, min_dot);
 }
