@@ -157,6 +157,9 @@ GridPageResult writeGridPage(const std::string& grid_dir, const GridPageOptions&
   for (const auto& e : fs::directory_iterator(runs))
     if (e.is_directory()) job_dirs.push_back(e.path());
   std::sort(job_dirs.begin(), job_dirs.end());
+  // links relative to where the page is written, so that they work from any --out
+  const fs::path page_dir = fs::absolute(fs::path(res.path)).parent_path();
+  const auto link = [&](const fs::path& file) { return fs::absolute(file).lexically_normal().lexically_relative(page_dir).generic_string(); };
   nlohmann::json jobs = nlohmann::json::array();
   // scene -> method label -> views -> progress PSNRs over seeds
   std::map<std::string, std::map<std::string, std::map<int, std::vector<double>>>> curves;
@@ -165,7 +168,8 @@ GridPageResult writeGridPage(const std::string& grid_dir, const GridPageOptions&
     const JobName jn = splitJob(name);
     nlohmann::json j = {{"name", name}, {"scene", jn.scene}, {"method", jn.method}, {"variant", jn.variant},
                         {"seed", jn.seed}};
-    const fs::path rp = jd / "results.json";
+    // an active job's results.json, a prefilter sweep's sweep.json
+    const fs::path rp = fs::exists(jd / "sweep.json") && !fs::exists(jd / "results.json") ? jd / "sweep.json" : jd / "results.json";
     if (!fs::exists(rp)) {
       j["status"] = fs::exists(jd / "checkpoint.json") ? "running or interrupted" : "not started";
       jobs.push_back(std::move(j));
@@ -181,8 +185,8 @@ GridPageResult writeGridPage(const std::string& grid_dir, const GridPageOptions&
       continue;
     }
     if (!r.is_object() || !r.contains("steps")) {  // a sweep or another kind of job
-      j["status"] = "finished (no run report)";
-      j["link"] = "runs/" + name + "/" + rp.filename().string();
+      j["status"] = "finished (a sweep: no run page)";
+      j["link"] = link(rp);
       jobs.push_back(std::move(j));
       continue;
     }
@@ -209,7 +213,7 @@ GridPageResult writeGridPage(const std::string& grid_dir, const GridPageOptions&
         res.problems.push_back(name + ": its run page: " + e.what());
       }
     }
-    j["link"] = fs::exists(jd / "report.html") ? "runs/" + name + "/report.html" : "runs/" + name + "/results.json";
+    j["link"] = link(fs::exists(jd / "report.html") ? jd / "report.html" : rp);
     const std::string label = jn.variant.empty() || jn.variant == "default" ? jn.method : jn.method + " " + jn.variant;
     if (r["steps"].is_array())
       for (const auto& s : r["steps"])

@@ -117,6 +117,48 @@ std::optional<Model> loadModel(const fs::path& dir, const RunReport& rep, std::v
 
 // The dataset as the run loaded it: its path from results.json (or the caller's), the
 // background the run used, and the resolution of its cameras.json (a run with --downscale).
+// A run inside a grid (GRID/runs/SCENE__METHOD__VARIANT__sSEED): the other finished jobs of
+// the same scene and seed, as curve series {name, points: [[views, progress PSNR], ...],
+// final: final-fit PSNR or null}.
+nlohmann::json gridSiblingCurves(const fs::path& dir) {
+  nlohmann::json out = nlohmann::json::array();
+  const fs::path runs = fs::absolute(dir).lexically_normal().parent_path();
+  if (runs.filename() != "runs") return out;
+  const std::string me = fs::absolute(dir).lexically_normal().filename().string();
+  const auto split = [](const std::string& n) {
+    std::vector<std::string> parts;
+    for (std::size_t p = 0;;) {
+      const std::size_t q = n.find("__", p);
+      parts.push_back(n.substr(p, q == std::string::npos ? std::string::npos : q - p));
+      if (q == std::string::npos) break;
+      p = q + 2;
+    }
+    return parts;
+  };
+  const std::vector<std::string> mine = split(me);
+  if (mine.size() < 4) return out;
+  std::vector<fs::path> sibs;
+  for (const auto& e : fs::directory_iterator(runs))
+    if (e.is_directory() && e.path().filename().string() != me) sibs.push_back(e.path());
+  std::sort(sibs.begin(), sibs.end());
+  for (const fs::path& p : sibs) {
+    const std::vector<std::string> theirs = split(p.filename().string());
+    if (theirs.size() < 4 || theirs[0] != mine[0] || theirs[3] != mine[3] || !fs::exists(p / "results.json")) continue;
+    try {
+      const nlohmann::json r = readJsonFile((p / "results.json").string());
+      nlohmann::json pts = nlohmann::json::array();
+      for (const auto& st : r.at("steps")) pts.push_back({st.at("views_before"), st.at("progress_psnr")});
+      const std::string label = theirs[2] == "default" ? theirs[1] : theirs[1] + " " + theirs[2];
+      nlohmann::json final_psnr;
+      if (r.contains("final_fit") && r["final_fit"].is_object()) final_psnr = r["final_fit"].value("psnr", nlohmann::json());
+      out.push_back({{"name", label}, {"job", p.filename().string()}, {"points", pts}, {"final", final_psnr}});
+    } catch (const std::exception&) {
+      // a sibling that cannot be read is left out of the curve; the grid page lists it
+    }
+  }
+  return out;
+}
+
 std::optional<Scene> loadRunDataset(const fs::path& dir, const nlohmann::json& results, const std::string& path,
                                     std::vector<std::string>& missing) {
   DatasetOptions dopt;
@@ -347,6 +389,7 @@ RunPageResult writeRunPage(const std::string& run_dir, const Scene* given, const
                          {"cameras", cameras},
                          {"views", views},
                          {"error_scale", kErrorScale},
+                         {"baselines", gridSiblingCurves(dir)},
                          {"viewer", {{"present", !viewer.script.empty()}, {"path", viewer.path}}}};
   PageParts parts;
   parts.title = "saresgs report: " + data["title"].get<std::string>();

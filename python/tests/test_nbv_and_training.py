@@ -141,3 +141,25 @@ def test_prefilter_scores_equal_the_cli(room, tmp_path):
     assert cli["prefilter_regime"] == py["prefilter_regime"]
     exact = saresgs.coverage(room, views, encoding="exact", score="new")
     assert exact["prefilter_regime"]["encoding"] == "exact" and max(exact["scores"]) > 0
+
+
+def test_write_leaves_the_clis_files_and_the_run_page(room, tmp_path):
+    run = saresgs.ActiveRun(room, method="fvs", **SHORT)
+    run.run()
+    out = tmp_path / "w"
+    page = run.write(str(out))
+    for name in ("results.json", "point_cloud.ply", "final_fit.ply", "cameras.json", "report.html"):
+        assert (out / name).exists(), name
+    assert page["path"] == str(out / "report.html")
+    assert page["bytes"] == (out / "report.html").stat().st_size
+    # the page carries the run's results.json as written
+    html = (out / "report.html").read_text()
+    start = html.index('id="saresgs-data">') + len('id="saresgs-data">')
+    data = json.loads(html[start:html.index("</script>", start)])
+    assert data["kind"] == "run"
+    assert data["results"] == json.loads((out / "results.json").read_text())
+    assert [v["name"] for v in data["views"]] == [v["name"] for v in data["results"]["final_fit"]["views"]]
+    assert all(v["render"].startswith("data:image/jpeg;base64,") for v in data["views"])
+    # without it: the files only
+    assert run.write(str(tmp_path / "plain"), report=False) is None
+    assert not (tmp_path / "plain" / "report.html").exists()

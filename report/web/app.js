@@ -184,6 +184,8 @@
     const n = r.selected_view_indices.length;
     series.push({ name: "in-loop model, all test views", points: [[n, r.psnr]], markersOnly: true, cls: "series1" });
     if (r.final_fit) series.push({ name: "final fit, all test views", points: [[n, r.final_fit.psnr]], markersOnly: true, cls: "series2" });
+    // the grid's other methods on the same scene and seed
+    (data.baselines || []).forEach((b, i) => series.push({ name: `${b.name} (same scene and seed)`, points: b.points, cls: `series${3 + (i % 3)}` }));
     const sec = section("curve", "How the model improved, view by view", lineChart(series, { xLabel: "views held", yLabel: "PSNR (dB)", label: "PSNR against views held" }));
     const ssim = [`in-loop SSIM ${fmt(r.ssim, 4)}`];
     if (r.final_fit) ssim.push(`final fit SSIM ${fmt(r.final_fit.ssim, 4)}`);

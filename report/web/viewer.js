@@ -239,15 +239,17 @@ export async function createViewer(canvas, opts) {
   };
   controls.addEventListener("change", requestDraw);
   const animationFrame = () => new Promise((r) => requestAnimationFrame(r));
-  // Draws until Spark reports no change for `quiet` frames (its sort runs in a worker and
-  // lands a frame or more later), at most `limit` frames.
-  async function settle(quiet = 2, limit = 30) {
+  // Draws until Spark has sorted for this viewpoint and nothing changed for `quiet` frames
+  // (its sort runs in a worker and lands a frame or more later), at most `limitMs`.
+  async function settle(quiet = 3, limitMs = 30000) {
+    const t0 = performance.now();
     let calm = 0;
-    for (let n = 0; n < limit && calm < quiet; ++n) {
+    while (calm < quiet && performance.now() - t0 < limitMs) {
+      dirtySince = 0;
       draw();
       await animationFrame();
-      await animationFrame();
-      calm = dirtySince === 0 ? calm + 1 : 0;
+      const sorted = !spark.sorting && !spark.sortDirty && spark.activeSplats > 0;
+      calm = sorted && dirtySince === 0 ? calm + 1 : 0;
     }
   }
   requestDraw();
@@ -275,7 +277,7 @@ export async function createViewer(canvas, opts) {
     // Draws dataset camera i exactly (its pixel size, intrinsics and pose, cameras hidden)
     // and returns the picture: a PNG data URL, or with `raw` {width, height, rgba: base64
     // RGBA rows top-down}, what the browser test compares with saresgs's render of the view.
-    async capture(i, { settleFrames = 30, raw = false } = {}) {
+    async capture(i, { raw = false } = {}) {
       const cam = cams[i];
       const prevSize = size;
       const shown = cameraLayer.visible;
@@ -288,7 +290,7 @@ export async function createViewer(canvas, opts) {
       camera.projectionMatrix.copy(projectionFor(cam, near, far));
       camera.projectionMatrixInverse.copy(camera.projectionMatrix).invert();
       exact = i;
-      await settle(2, settleFrames);
+      await settle();
       renderer.render(scene, camera);
       let result;
       if (raw) {

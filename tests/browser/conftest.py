@@ -68,6 +68,6 @@ def small_run(tmp_path_factory):
     scene = base / "scene"
     run_cli("scene", "--layout", "object", "--out", scene, "--views", 24, "--width", 256, "--height", 192, "--seed", 1)
     run = base / "run"
-    run_cli("active", "--dataset", scene, "--out", run, "--method", "fvs", "--max-views", 6, "--interval", 80,
+    run_cli("active", "--dataset", scene, "--out", run, "--method", "fvs", "--max-views", 6, "--interval", 80, "--min-iterations", 480,
             "--final-iterations", 400, "--threads", 2, "--seed", 0)
     return {"scene": scene, "run": run}

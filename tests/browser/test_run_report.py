@@ -144,7 +144,7 @@ def test_names_from_the_data_stay_text(tmp_path):
         tf.write_text(json.dumps(meta))
     run = tmp_path / "run </script><script>alert(3)</script>"
     run.mkdir(parents=True)  # "run <" / "script><script>alert(3)<" / "script>"
-    run_cli("active", "--dataset", scene, "--out", run, "--method", "fvs", "--max-views", 4, "--interval", 20,
+    run_cli("active", "--dataset", scene, "--out", run, "--method", "fvs", "--max-views", 4, "--interval", 20, "--min-iterations", 80,
             "--final-iterations", 40, "--threads", 2)
     page = run / "report.html"
     seen = probe(page, "saresgsReport.ready.then(() => ({text: document.body.innerText, "
@@ -162,3 +162,51 @@ def test_names_from_the_data_stay_text(tmp_path):
     # the page's own scripts only: data, model, viewer, app
     assert seen["result"]["scripts"] == 4
     assert all(src == "data:" for src in seen["result"]["imgs"])
+
+
+def test_a_500k_gaussian_model_keeps_the_page_under_40_mb(small_run, tmp_path):
+    """A large model travels as a .splat (degree 0, 8-bit): the page says so and its size."""
+    run = tmp_path / "run"
+    shutil.copytree(small_run["run"], run)
+    n = 500_000
+    rng = np.random.default_rng(0)
+    big = saresgs.Gaussians(rng.uniform(-1, 1, (n, 3)).astype(np.float32),
+                            rng.uniform(-5, -3, (n, 3)).astype(np.float32),
+                            rng.normal(size=(n, 4)).astype(np.float32),
+                            rng.uniform(-3, 3, n).astype(np.float32),
+                            rng.uniform(-1, 1, (n, 4, 3)).astype(np.float32))
+    big.write_ply(str(run / "final_fit.ply"))  # degree 1: 58 MB
+    assert (run / "final_fit.ply").stat().st_size > 50e6
+    r = run_cli("report", run)
+    page = run / "report.html"
+    assert page.stat().st_size < 40 * 2**20, page.stat().st_size
+    data = page.read_text()
+    start = data.index('id="saresgs-data">') + len('id="saresgs-data">')
+    meta = json.loads(data[start:data.index("</script>", start)])
+    assert meta["model"]["format"] == "splat" and meta["model"]["gaussians"] == n
+    assert meta["model"]["bytes"] == 32 * meta["model"].get("shown_gaussians", n)
+    assert "MB" in r.stdout
+
+
+def test_the_splat_form_draws_the_same_picture(small_run, tmp_path):
+    """The small model forced into the .splat form (a tiny budget) still matches the
+    rasterizer in the browser: the compressed path is a real consumer too."""
+    run = tmp_path / "run"
+    shutil.copytree(small_run["run"], run)
+    ply = (run / "final_fit.ply").stat().st_size
+    run_cli("report", run, "--model-budget-bytes", ply - 1)  # below the .ply's size, above the .splat's (about half)
+    results = json.loads((run / "results.json").read_text())
+    name = results["final_fit"]["views"][0]["name"]
+    seen = probe(run / "report.html", "saresgsReport.ready.then(async (v) => { const d = saresgsReport.data; "
+                 f"return {{format: d.model.format, shot: await v.capture(d.cameras.findIndex((c) => c.name === {json.dumps(name)}), {{raw: true}})}}; }})",
+                 tmp_path)
+    errors, outside = problems(seen, run / "report.html")
+    assert errors == [] and outside == []
+    assert seen["result"]["format"] == "splat"
+    got = decode(seen["result"]["shot"])
+    dataset = saresgs.load_dataset(str(small_run["scene"]))
+    model = saresgs.Gaussians.read_ply(str(run / "final_fit.ply")).from_world(dataset)
+    bg = dataset.background or [0.0, 0.0, 0.0]
+    rgb, _, _ = saresgs.render(model, dataset.camera(dataset.names.index(name)), background=list(bg))
+    psnr = 10 * np.log10(1.0 / np.mean((got - np.clip(np.asarray(rgb, np.float64), 0, 1)) ** 2))
+    assert psnr >= 25.0, f"viewer (.splat) vs rasterizer: {psnr:.2f} dB"
