@@ -19,6 +19,7 @@
 #include "geometry/io/atomic_file.h"
 #include "geometry/synth/from_manifest.h"
 #include "nbv/eval/ablation.h"
+#include "report/grid_page.h"
 #include "nbv/eval/prefilter_sweep.h"
 
 namespace saresgs::apps {
@@ -154,6 +155,14 @@ int writeSummary(const AblationGrid& g, const std::vector<AblationJob>& jobs, co
   writeFileAtomic(out + "/README.md", page.str());
   std::cerr << "[ablate] wrote " << out << "/README.md, tables/ and plots/ from " << results.size() << " of " << jobs.size()
             << " jobs\n";
+  // The same as one page to look at (report/grid_page.h); a page that cannot be made is
+  // said, the tables stand.
+  try {
+    const GridPageResult r = writeGridPage(out);
+    std::cerr << "[ablate] wrote " << r.path << ": open it in a browser\n";
+  } catch (const std::exception& e) {
+    std::cerr << "[ablate] no report.html: " << e.what() << "\n";
+  }
   if (!missing.empty()) {
     std::cerr << "[ablate] " << missing.size() << " jobs not finished";
     if (!allow_partial) std::cerr << " (pass --allow-partial to accept)";

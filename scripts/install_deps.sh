@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs every Debian 12 package saresgs needs. Idempotent: installs only what is
-# missing, runs as root or through sudo. Usage: bash scripts/install_deps.sh
+# missing, runs as root or through sudo. With --tests also what only the tests need (the
+# browser the report's tests drive). Usage: bash scripts/install_deps.sh [--tests]
 set -euo pipefail
 
 packages=(
@@ -20,11 +21,14 @@ packages=(
   # the fuzz targets (fuzz/): clang 14 and its runtimes (libFuzzer, ASan, UBSan), which
   # clang only recommends (third_party_notes/libfuzzer.md)
   clang-14 libclang-rt-14-dev
-  # the HTML report's browser tests: headless Chromium with software WebGL, and a font
-  chromium fonts-liberation
   # CC0 meshes (/usr/share/doc/libcgal-dev/data.tar.gz) and photographs for textures
   libcgal-demo opencv-doc
 )
+
+if [ "${1:-}" = "--tests" ]; then
+  # the HTML report's browser tests: headless Chromium with software WebGL, and a font
+  packages+=(chromium fonts-liberation)
+fi
 
 missing=()
 for p in "${packages[@]}"; do

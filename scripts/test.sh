@@ -4,7 +4,7 @@
 # one-node cluster of this machine (scripts/test_slurm.sh, about 40 s with its install).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/install_deps.sh
+bash scripts/install_deps.sh --tests  # with the browser the report's tests drive
 bash scripts/build.sh -DSARESGS_FUZZ=ON  # everything: tests, Python module, fuzz targets
 ctest --test-dir build --output-on-failure --parallel "$(nproc)" --timeout 900
 bash scripts/test_slurm.sh

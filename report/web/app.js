@@ -225,7 +225,7 @@
     }
     const info = el("div", { id: "step-info" });
     const slider = el("input", { type: "range", min: 0, max: steps.length - 1, value: 0, id: "step-slider" });
-    const show = (k) => {
+    const show = (k, recolor) => {
       const s = steps[k];
       const kept = new Set(s.prefiltered && s.prefiltered.length ? s.prefiltered : s.candidates);
       const heldBefore = new Set(data.cameras.filter((c) => c.role === "initial" || (c.role === "chosen" && c.order <= k)).map((c) => c.name));
@@ -236,7 +236,7 @@
         sortableTable([{ title: "rank" }, { title: "candidate" }, { title: "score" }, { title: "kept by the prefilter" }],
           order.slice(0, 12).map(([n, sc], i) => el("tr", { class: n === s.selected ? "chosen-row" : null }, cell(i + 1, 0), el("td", { "data-value": n }, n), el("td", { class: "num", "data-value": sc }, Number.isFinite(sc) ? sc.toPrecision(4) : "n/a"), el("td", {}, kept.has(n) ? "yes" : "no"))), { class: "sortable compact" }),
       );
-      if (report.viewer) {
+      if (report.viewer && recolor) {
         const byName = new Map(order.map(([n, sc], i) => [n, i]));
         const colors = data.cameras.map((c) => {
           if (c.name === s.selected) return 0xff2bd6;
@@ -249,10 +249,11 @@
         report.viewer.setCameraColors(colors);
       }
     };
-    slider.addEventListener("input", () => show(Number(slider.value)));
-    sec.append(el("p", { class: "muted" }, "Move the slider through the steps: in the 3D view the candidates are coloured by their rank (yellow best, blue worst), the chosen view magenta, views not scored dark grey."), slider, info);
-    show(0);
-    if (report.ready) report.ready.then(() => show(Number(slider.value)), () => {});
+    slider.addEventListener("input", () => show(Number(slider.value), true));
+    const roles = el("button", { type: "button", id: "show-roles" }, "colour the cameras by role again");
+    roles.addEventListener("click", () => report.viewer && report.viewer.setCameraColors(null));
+    sec.append(el("p", { class: "muted" }, "Move the slider through the steps: in the 3D view the candidates are coloured by their rank (yellow best, blue worst), the chosen view magenta, views not scored dark grey."), slider, " ", roles, info);
+    show(0, false);
     return sec;
   }
   function scoreColor(u) {

@@ -8,7 +8,8 @@
 //           when it is a promise, returned by value: JSON-serialisable).
 // Usage: node --experimental-websocket page_probe.mjs --chromium BIN --url URL
 //          [--eval EXPR] [--width W --height H] [--timeout-ms N] [--wait-ms N]
-//          [--screenshot PNG (the whole page, after --eval)] --out FILE
+//          [--screenshot PNG (after --eval)] [--full-page 0|1 (the whole page; default
+//          the window)] --out FILE
 import { spawn } from "node:child_process";
 import { mkdtempSync, rmSync, writeFileSync } from "node:fs";
 import { Buffer } from "node:buffer";
@@ -30,6 +31,7 @@ function parseArgs(argv) {
     else if (k === "--timeout-ms") a.timeoutMs = Number(v);
     else if (k === "--wait-ms") a.waitMs = Number(v);
     else if (k === "--screenshot") a.screenshot = v;
+    else if (k === "--full-page") a.fullPage = v === "1";
     else throw new Error(`page_probe: unknown option ${k}`);
   }
   for (const k of ["chromium", "url", "out"]) if (!a[k]) throw new Error(`page_probe: --${k} is required`);
@@ -176,7 +178,7 @@ try {
   }
   if (args.screenshot) {
     stage = "taking the screenshot";
-    const shot = await send("Page.captureScreenshot", { format: "png", captureBeyondViewport: true }, sessionId);
+    const shot = await send("Page.captureScreenshot", { format: "png", captureBeyondViewport: !!args.fullPage }, sessionId);
     writeFileSync(args.screenshot, Buffer.from(shot.data, "base64"));
   }
   finish(null, out);
