@@ -144,7 +144,9 @@
     const legend = el("div", { class: "legend" }, ["initial", "chosen", "test", "candidate"].map((k) => el("span", { class: `key role-${k}` }, k === "chosen" ? "chosen (numbered in order)" : k === "initial" ? "held at the start" : k)));
     sec.append(legend);
     const picked = el("p", { id: "picked", class: "muted" }, "");
-    sec.append(picked);
+    const overviewButton = el("button", { type: "button", id: "overview" }, "see every camera from outside");
+    overviewButton.addEventListener("click", () => report.viewer && report.viewer.overview());
+    sec.append(overviewButton, picked);
     const modelEl = document.getElementById("saresgs-model");
     if (!window.SaresgsViewer || !modelEl || !data.cameras.length) {
       box.append(el("p", { class: "missing" }, !window.SaresgsViewer ? "The 3D viewer is not in this page (see above)." : !modelEl ? "No model to show." : "No cameras: the dataset could not be read."));

@@ -179,6 +179,26 @@ export async function createViewer(canvas, opts) {
     camera.updateProjectionMatrix();
     controls.update();
   }
+  // From outside the capture: above and behind the cameras' centroid, all of them in view.
+  function overview() {
+    const c = new THREE.Vector3();
+    for (const p of centres) c.add(p);
+    c.multiplyScalar(1 / Math.max(1, centres.length));
+    let radius = 0;
+    for (const p of centres) radius = Math.max(radius, p.distanceTo(c));
+    radius = Math.max(radius, 1e-6);
+    const forward = new THREE.Vector3();
+    for (const cam of cams) forward.add(cameraPose(cam).z);
+    forward.addScaledVector(camera.up, -forward.dot(camera.up));
+    if (forward.lengthSq() < 1e-12) forward.set(1, 0, 0).addScaledVector(camera.up, -camera.up.x);
+    forward.normalize();
+    camera.position.copy(c).addScaledVector(camera.up, 1.2 * radius).addScaledVector(forward, -2.2 * radius);
+    controls.target.copy(c);
+    camera.fov = 50;
+    camera.updateProjectionMatrix();
+    controls.update();
+  }
+
   // Start where a person would look first: through one of the dataset's cameras.
   if (cams.length) lookFrom(opts.startCamera ?? 0);
 
@@ -265,6 +285,18 @@ export async function createViewer(canvas, opts) {
       });
       requestDraw();
     },
+    // Where dataset camera i's marker is on the canvas, in CSS pixels from its top-left
+    // corner (null when behind the viewer): what a click must hit to look through it.
+    markerOnScreen(i) {
+      const p = centres[i].clone().project(camera);
+      if (p.z < -1 || p.z > 1) return null;
+      const r = canvas.getBoundingClientRect();
+      return { x: ((p.x + 1) / 2) * r.width, y: ((1 - p.y) / 2) * r.height };
+    },
+    // The camera the viewer looks from, in world coordinates.
+    position() {
+      return camera.position.toArray();
+    },
     showCameras(on) {
       cameraLayer.visible = on;
       requestDraw();
@@ -274,6 +306,10 @@ export async function createViewer(canvas, opts) {
       requestDraw();
     },
     requestDraw,
+    overview() {
+      overview();
+      requestDraw();
+    },
     // Draws dataset camera i exactly (its pixel size, intrinsics and pose, cameras hidden)
     // and returns the picture: a PNG data URL, or with `raw` {width, height, rgba: base64
     // RGBA rows top-down}, what the browser test compares with saresgs's render of the view.

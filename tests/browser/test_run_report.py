@@ -210,3 +210,46 @@ def test_the_splat_form_draws_the_same_picture(small_run, tmp_path):
     rgb, _, _ = saresgs.render(model, dataset.camera(dataset.names.index(name)), background=list(bg))
     psnr = 10 * np.log10(1.0 / np.mean((got - np.clip(np.asarray(rgb, np.float64), 0, 1)) ** 2))
     assert psnr >= 25.0, f"viewer (.splat) vs rasterizer: {psnr:.2f} dB"
+
+
+def test_a_click_on_a_camera_looks_through_it(small_run, tmp_path):
+    """A click (pointer down and up, as a mouse gives them) on a camera's marker moves the
+    viewer to that camera and names it on the page."""
+    page = small_run["run"] / "report.html"
+    expr = """saresgsReport.ready.then(async (v) => {
+      const d = saresgsReport.data, canvas = document.getElementById('viewer');
+      const r = canvas.getBoundingClientRect();
+      // from outside the capture (the page's button), every marker in view
+      document.getElementById('overview').click();
+      await new Promise((res) => requestAnimationFrame(() => requestAnimationFrame(res)));
+      const start = v.position();
+      // the on-screen marker nearest the viewer: no other marker can hide it
+      let pick = -1, at = null, best = Infinity;
+      for (let i = 0; i < d.cameras.length; ++i) {
+        const p = v.markerOnScreen(i);
+        if (!p || p.x < 5 || p.y < 5 || p.x > r.width - 5 || p.y > r.height - 5) continue;
+        const c = d.cameras[i], R = c.R, t = c.t;
+        const centre = [0, 1, 2].map((k) => -(R[0][k] * t[0] + R[1][k] * t[1] + R[2][k] * t[2]));
+        const dist = Math.hypot(centre[0] - start[0], centre[1] - start[1], centre[2] - start[2]);
+        if (dist < best) { best = dist; pick = i; at = p; }
+      }
+      if (pick < 0) return {pick};
+      const opts = {clientX: r.left + at.x, clientY: r.top + at.y, bubbles: true, pointerId: 1, isPrimary: true, button: 0, buttons: 1};
+      canvas.dispatchEvent(new PointerEvent('pointerdown', opts));
+      canvas.dispatchEvent(new PointerEvent('pointerup', Object.assign({}, opts, {buttons: 0})));
+      return {pick, name: d.cameras[pick].name, start, now: v.position(), text: document.getElementById('picked').textContent};
+    })"""
+    seen = probe(page, expr, tmp_path)
+    res = seen["result"]
+    assert res["pick"] >= 0, "no camera marker on screen"
+    assert res["name"] in res["text"]
+    # the viewer now stands at that camera's centre, -R^T t
+    cam = next(c for c in json.loads(_page_data(page))["cameras"] if c["name"] == res["name"])
+    R, t = np.array(cam["R"]), np.array(cam["t"])
+    assert np.allclose(res["now"], -R.T @ t, atol=1e-6)
+
+
+def _page_data(page):
+    html = page.read_text()
+    start = html.index('id="saresgs-data">') + len('id="saresgs-data">')
+    return html[start:html.index("</script>", start)]
