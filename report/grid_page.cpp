@@ -60,18 +60,11 @@ bool alignmentRow(const std::vector<std::string>& cells) {
   return true;
 }
 
-// A job folder's name: SCENE__METHOD__VARIANT__sSEED (nbv/eval/ablation.cpp's job id).
 struct JobName {
   std::string scene, method, variant, seed;
 };
 JobName splitJob(const std::string& name) {
-  std::vector<std::string> parts;
-  for (std::size_t p = 0;;) {
-    const std::size_t q = name.find("__", p);
-    parts.push_back(name.substr(p, q == std::string::npos ? std::string::npos : q - p));
-    if (q == std::string::npos) break;
-    p = q + 2;
-  }
+  const std::vector<std::string> parts = jobNameParts(name);
   JobName j;
   if (parts.size() >= 4) {
     j.scene = parts[0], j.method = parts[1], j.variant = parts[2], j.seed = parts[3];
@@ -82,6 +75,17 @@ JobName splitJob(const std::string& name) {
 }
 
 }  // namespace
+
+std::vector<std::string> jobNameParts(const std::string& name) {
+  std::vector<std::string> parts;
+  for (std::size_t p = 0;;) {
+    const std::size_t q = name.find("__", p);
+    parts.push_back(name.substr(p, q == std::string::npos ? std::string::npos : q - p));
+    if (q == std::string::npos) break;
+    p = q + 2;
+  }
+  return parts;
+}
 
 std::vector<MarkdownBlock> parseMarkdown(const std::string& text) {
   std::vector<MarkdownBlock> blocks;

@@ -16,6 +16,7 @@
 #include "geometry/io/json_file.h"
 #include "geometry/scene/dataset_checks.h"
 #include "nbv/run_report.h"
+#include "report/grid_page.h"
 #include "report/html_page.h"
 #include "splat/model_frame.h"
 #include "splat/ply.h"
@@ -125,24 +126,14 @@ nlohmann::json gridSiblingCurves(const fs::path& dir) {
   const fs::path runs = fs::absolute(dir).lexically_normal().parent_path();
   if (runs.filename() != "runs") return out;
   const std::string me = fs::absolute(dir).lexically_normal().filename().string();
-  const auto split = [](const std::string& n) {
-    std::vector<std::string> parts;
-    for (std::size_t p = 0;;) {
-      const std::size_t q = n.find("__", p);
-      parts.push_back(n.substr(p, q == std::string::npos ? std::string::npos : q - p));
-      if (q == std::string::npos) break;
-      p = q + 2;
-    }
-    return parts;
-  };
-  const std::vector<std::string> mine = split(me);
+  const std::vector<std::string> mine = jobNameParts(me);
   if (mine.size() < 4) return out;
   std::vector<fs::path> sibs;
   for (const auto& e : fs::directory_iterator(runs))
     if (e.is_directory() && e.path().filename().string() != me) sibs.push_back(e.path());
   std::sort(sibs.begin(), sibs.end());
   for (const fs::path& p : sibs) {
-    const std::vector<std::string> theirs = split(p.filename().string());
+    const std::vector<std::string> theirs = jobNameParts(p.filename().string());
     if (theirs.size() < 4 || theirs[0] != mine[0] || theirs[3] != mine[3] || !fs::exists(p / "results.json")) continue;
     try {
       const nlohmann::json r = readJsonFile((p / "results.json").string());
