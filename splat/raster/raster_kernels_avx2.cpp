@@ -9,6 +9,7 @@
 #define SARESGS_KERNEL_LANES 8
 #define SARESGS_KERNEL_FMA 1
 #include "splat/raster/raster_kernels_impl.h"
+#include "splat/raster/raster_kernels_backward_impl.h"
 #include "splat/raster/raster_kernels_pair_impl.h"
 #include "splat/raster/project_kernels_impl.h"
 

@@ -34,6 +34,7 @@
 #define SARESGS_KERNEL_FISHER_ONE_PASS 1
 #define SARESGS_KERNEL_NO_COMPOSITE 1
 #include "splat/raster/raster_kernels_impl.h"
+#include "splat/raster/raster_kernels_backward_impl.h"
 #include "splat/raster/raster_kernels_pair_impl.h"
 
 namespace saresgs::raster_kernels::avx512 {

@@ -8,6 +8,7 @@
 #define SARESGS_KERNEL_NS base4
 #define SARESGS_KERNEL_LANES 4
 #include "splat/raster/raster_kernels_impl.h"
+#include "splat/raster/raster_kernels_backward_impl.h"
 #include "splat/raster/raster_kernels_pair_impl.h"
 #include "splat/raster/project_kernels_impl.h"
 #undef SARESGS_KERNEL_NS

@@ -1,8 +1,8 @@
 // The float tile kernels that composite, and back-propagate, a full render and the render
 // of a subset of its Gaussians in one walk (see splat/raster/raster_kernels.h). Included
-// right after splat/raster/raster_kernels_impl.h in the same translation unit, with the
-// same SARESGS_KERNEL_NS / SARESGS_KERNEL_LANES, and reuses its states and steps (ForwardState,
-// BackwardState, backStep, forEachBlock, ...).
+// right after splat/raster/raster_kernels_impl.h and splat/raster/raster_kernels_backward_impl.h
+// in the same translation unit, with the same SARESGS_KERNEL_NS / SARESGS_KERNEL_LANES, and
+// reuses their states and steps (ForwardState, BackwardState, backStep, forEachBlock, ...).
 //
 // Why one walk: a subset Gaussian's alpha at a pixel is the full render's alpha at that
 // pixel (rule 8 only removes Gaussians), and the kernels are bound by the exponential, so
