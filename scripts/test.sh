@@ -5,6 +5,6 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh --tests  # with the browser the report's tests drive
-bash scripts/build.sh -DSARESGS_FUZZ=ON  # everything: tests, Python module, fuzz targets
+bash scripts/build.sh -DSARESGS_FUZZ=ON -DSARESGS_WERROR=ON  # everything (tests, Python module, fuzz targets), no warning
 ctest --test-dir build --output-on-failure --parallel "$(nproc)" --timeout 900
 bash scripts/test_slurm.sh
