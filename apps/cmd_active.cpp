@@ -130,7 +130,10 @@ int runActive(const ActiveArgs& a) {
   dopt.load.downscale = a.downscale;
   if (!a.background.empty()) dopt.background = parseBackground(a.background, "--background");
   const Scene scene = loadDataset(a.dataset, dopt);
-  std::cerr << formatWarnings(checkDataset(scene, opt.trainer.raster.near_plane)) << backgroundWarning(scene);
+  // What the run says before it starts, kept for results.json's "warnings" (the report
+  // shows them): the dataset's checks, the background, the memory budget.
+  std::string said = formatWarnings(checkDataset(scene, opt.trainer.raster.near_plane)) + backgroundWarning(scene);
+  std::cerr << said;
   if (!a.replay.empty()) {
     const RunReport replayed = runReportFromJson(readJsonFile(a.replay), a.replay);
     opt.replay = replaySequence(scene, replayed, a.replay);
@@ -153,9 +156,11 @@ int runActive(const ActiveArgs& a) {
     const int models =
         1 + (opt.final_iterations > 0 ? (finalFitIsResidual(opt) && opt.plain_refit ? 2 : 1) : 0);
     std::size_t cap = opt.trainer.densify.max_gaussians;
-    std::cerr << applyMemoryBudget(estimateTrainingMemory(scene, trained, scene.test.empty() ? scene.train : scene.test,
+    const std::string budget = applyMemoryBudget(estimateTrainingMemory(scene, trained, scene.test.empty() ? scene.train : scene.test,
                                                           initial, opt.trainer.max_sh_degree, models),
                                    memoryBudgetBytes(a.memory_budget_gb), a.memory_budget_gb.has_value(), cap);
+    std::cerr << budget;
+    said += budget;
     opt.trainer.densify.max_gaussians = opt.final_trainer.densify.max_gaussians = cap;
   }
   const bool resuming = a.resume && fs::exists(ckpt);
@@ -196,6 +201,12 @@ int runActive(const ActiveArgs& a) {
   nlohmann::json results = toJson(report);
   // Machine state, like the timings: not part of what a resumed run must reproduce.
   results["memory"] = {{"peak_rss_bytes", peakRssBytes()}, {"rss_at_phase_start_this_process", phase_memory}};
+  results["warnings"] = nlohmann::json::array();
+  for (std::size_t p = 0, q; p < said.size(); p = q + 1) {
+    q = said.find('\n', p);
+    if (q == std::string::npos) q = said.size();
+    if (q > p) results["warnings"].push_back(said.substr(p, q - p));
+  }
   writeFileAtomic(a.out + "/results.json", results.dump(2) + "\n");
   printSummary(report, a.out);
   writeReportPage(a.out, scene, a.threads);

@@ -239,9 +239,20 @@ RunPageResult writeRunPage(const std::string& run_dir, const Scene* given, const
       else if (test.count(v.name)) role = "test";
       cameras.push_back(cameraJson(w, v.name, role, order, is_train[i]));
     }
+  }
+  // What the run printed before it started (results.json's "warnings", written by
+  // `saresgs active`), else the dataset's checks made again here.
+  std::string warnings_from = "the run";
+  if (results.contains("warnings") && results["warnings"].is_array()) {
+    for (const auto& w : results["warnings"])
+      if (w.is_string()) warnings.push_back(w);
+  } else if (scene) {
+    warnings_from = "the dataset's checks, made again for this page";
     for (const DatasetWarning& w : checkDataset(*scene))
       warnings.push_back((w.view.empty() ? std::string() : w.view + ": ") + w.field + ": " + w.message);
     if (const std::string b = backgroundWarning(*scene); !b.empty()) warnings.push_back(b);
+  } else {
+    warnings_from = "nothing (no dataset read)";
   }
 
   // The test views with the model shown: its own numbers from results.json, its render,
@@ -375,6 +386,7 @@ RunPageResult writeRunPage(const std::string& run_dir, const Scene* given, const
                          {"missing", missing},
                          {"notes", notes},
                          {"warnings", warnings},
+                         {"warnings_from", warnings_from},
                          {"dataset", dataset},
                          {"model", model_info},
                          {"cameras", cameras},

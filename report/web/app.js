@@ -279,7 +279,8 @@
     if (d.loaded) Object.assign(ds, { views: d.views, "train views": d.train, "test views": d.test, "frame centre": JSON.stringify(d.frame.center), "frame scale": d.frame.scale, background: d.background ? JSON.stringify(d.background) : "none", "background from": d.background_from });
     wrap.append(el("div", {}, el("h3", {}, "Dataset"), kvTable(ds, "dataset")));
     const sec = section("details", "Timings, options, dataset", wrap);
-    sec.append(el("h3", {}, "Warnings"), data.warnings.length ? el("ul", { id: "warnings" }, data.warnings.map((w) => el("li", {}, w))) : el("p", { class: "muted" }, "The dataset raised no warning."));
+    sec.append(el("h3", {}, "Warnings"), el("p", { class: "muted" }, `From ${data.warnings_from}.`),
+      data.warnings.length ? el("ul", { id: "warnings" }, data.warnings.map((w) => el("li", {}, w))) : el("p", { class: "muted" }, "None."));
     return sec;
   }
 

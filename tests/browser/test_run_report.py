@@ -68,7 +68,8 @@ def test_curve_and_table_equal_results_json(small_run, tmp_path):
             "[c.getAttribute('data-series'), Number(c.getAttribute('data-x')), Number(c.getAttribute('data-y'))]), "
             "rows: Array.from(document.querySelectorAll('#views-table tbody tr')).map((tr) => "
             "[tr.getAttribute('data-view'), Number(tr.children[1].getAttribute('data-value')), "
-            "Number(tr.children[2].getAttribute('data-value')), tr.children[1].textContent])})")
+            "Number(tr.children[2].getAttribute('data-value')), tr.children[1].textContent]), "
+            "warnings: Array.from(document.querySelectorAll('#warnings li')).map((li) => li.textContent)})")
     seen = probe(page, expr, tmp_path)
     r = json.loads((small_run["run"] / "results.json").read_text())
     loop = [(x, y) for s, x, y in seen["result"]["curve"] if s.startswith("in the loop")]
@@ -79,6 +80,8 @@ def test_curve_and_table_equal_results_json(small_run, tmp_path):
     want = sorted(((v["name"], v["psnr"], v["ssim"]) for v in r["final_fit"]["views"]), key=lambda t: t[1])
     assert [(n, p, s) for n, p, s, _ in rows] == want  # worst first
     assert all(text == f"{p:.2f}" for _, p, _, text in rows)
+    # what the run printed before it started, as results.json keeps it
+    assert seen["result"]["warnings"] == r["warnings"]
 
 
 def test_incomplete_runs_say_what_is_missing(small_run, tmp_path):
