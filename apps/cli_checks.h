@@ -22,7 +22,8 @@ inline CLI::Validator wholeNumberAtLeast(long long min) {
         } catch (const std::exception&) {
           used = 0;
         }
-        if (used != s.size() || s.empty() || v < min) return "'" + s + "': expected a whole number >= " + std::to_string(min);
+        if (used != s.size() || s.empty() || v < min)
+          return "'" + s + "': expected a whole number >= " + std::to_string(min);
         return {};
       },
       "INT>=" + std::to_string(min));

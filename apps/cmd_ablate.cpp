@@ -51,7 +51,8 @@ std::vector<std::string> activeArgs(const AblationJob& j, const std::string& out
 // an exclusive lock on DATASET.lock, then a second look.
 void ensureDataset(const AblationScene& sc) {
   if (fs::exists(sc.dataset)) return;
-  if (sc.layout.empty()) throw InputError(sc.dataset, "dataset", "missing, and the grid gives no layout to generate it");
+  if (sc.layout.empty())
+    throw InputError(sc.dataset, "dataset", "missing, and the grid gives no layout to generate it");
   if (fs::path(sc.dataset).has_parent_path()) fs::create_directories(fs::path(sc.dataset).parent_path());
   const std::string lock = sc.dataset + ".lock";
   const int fd = ::open(lock.c_str(), O_CREAT | O_RDWR, 0644);
@@ -102,7 +103,9 @@ void runSweep(const AblationGrid& g, const AblationJob& j, const std::string& ou
   const AblationScene& sc = sceneOf(g, j.scene);
   const Scene scene = loadDataset(sc.dataset, {});
   const std::optional<SyntheticScene> truth = rebuildSyntheticScene(sc.dataset, scene);
-  if (!truth) throw InputError(sc.dataset, "manifest.json", "the prefilter sweep lifts SA-Points from ground-truth renders: needs a `saresgs scene` dataset");
+  if (!truth)
+    throw InputError(sc.dataset, "manifest.json",
+                     "the prefilter sweep lifts SA-Points from ground-truth renders: needs a `saresgs scene` dataset");
   const ViewRenderer render = [&](const Camera& c) { return truth->render(c); };
   const DepthRenderer depth = [&](const Camera& c) { return truth->renderDepth(c); };
   // The occupancy grid of the scene's type (the paper's m = 5 indoors, 2 outdoors), as the
@@ -127,7 +130,8 @@ void runSweep(const AblationGrid& g, const AblationJob& j, const std::string& ou
 }
 
 // Tables, plots and an index page for every finished job of the grid.
-int writeSummary(const AblationGrid& g, const std::vector<AblationJob>& jobs, const std::string& out, bool allow_partial) {
+int writeSummary(const AblationGrid& g, const std::vector<AblationJob>& jobs, const std::string& out,
+                 bool allow_partial) {
   const std::vector<JobResult> results = loadFinishedJobs(out, jobs);
   std::vector<std::string> missing;
   for (const auto& j : jobs)
@@ -153,8 +157,8 @@ int writeSummary(const AblationGrid& g, const std::vector<AblationJob>& jobs, co
     page << "![" << p.name << "](plots/" << p.name << ".png)\n\n";
   }
   writeFileAtomic(out + "/README.md", page.str());
-  std::cerr << "[ablate] wrote " << out << "/README.md, tables/ and plots/ from " << results.size() << " of " << jobs.size()
-            << " jobs\n";
+  std::cerr << "[ablate] wrote " << out << "/README.md, tables/ and plots/ from " << results.size() << " of "
+            << jobs.size() << " jobs\n";
   // The same as one page to look at (report/grid_page.h); a page that cannot be made is
   // said, the tables stand.
   try {
@@ -201,8 +205,10 @@ int runAblate(const AblateArgs& a) {
   if (a.list) {
     for (const auto& j : jobs) {
       std::printf("%s %s\n", jobFinished(a.out, j) ? "[done]" : "[todo]", j.id.c_str());
-      if (j.kind == AblationJob::Kind::kActive) std::printf("    %s\n", commandLine(activeArgs(j, a.out)).c_str());
-      else std::printf("    prefilter sweep of %s (in-process)\n", j.scene.c_str());
+      if (j.kind == AblationJob::Kind::kActive)
+        std::printf("    %s\n", commandLine(activeArgs(j, a.out)).c_str());
+      else
+        std::printf("    prefilter sweep of %s (in-process)\n", j.scene.c_str());
     }
     return 0;
   }
@@ -226,8 +232,8 @@ int runAblate(const AblateArgs& a) {
       }
       queue.push_back(k);
       if (++deferred_in_a_row >= queue.size()) {
-        std::cerr << "[ablate] " << queue.size() << " replay jobs wait for their source runs (" << replaySource(a.out, j)
-                  << ", ...): checking again in 30 s\n";
+        std::cerr << "[ablate] " << queue.size() << " replay jobs wait for their source runs ("
+                  << replaySource(a.out, j) << ", ...): checking again in 30 s\n";
         std::this_thread::sleep_for(std::chrono::seconds(30));
         deferred_in_a_row = 0;
       }
@@ -277,11 +283,12 @@ int runAblate(const AblateArgs& a) {
       ++failed;
     }
   }
-  std::cerr << "[ablate] " << done << " of " << jobs.size() << " jobs finished" << (failed ? ", " + std::to_string(failed) + " failed" : "")
-            << "\n";
+  std::cerr << "[ablate] " << done << " of " << jobs.size() << " jobs finished"
+            << (failed ? ", " + std::to_string(failed) + " failed" : "") << "\n";
   if (sn > 1) {
-    std::cerr << "[ablate] shard " << si << "/" << sn << " done; when every shard is, run: saresgs ablate merge --config "
-              << a.config << " --out " << a.out << " [--inputs OTHER_OUT,...]\n";
+    std::cerr << "[ablate] shard " << si << "/" << sn
+              << " done; when every shard is, run: saresgs ablate merge --config " << a.config << " --out " << a.out
+              << " [--inputs OTHER_OUT,...]\n";
     return failed ? 1 : 0;
   }
   const int rc = writeSummary(g, all, a.out, false);
@@ -316,12 +323,14 @@ int runMerge(const AblateArgs& a) {
 
 void addAblateCommand(CLI::App& app, Action& action) {
   auto a = std::make_shared<AblateArgs>();
-  CLI::App* sub = app.add_subcommand("ablate", "Run an ablation grid of active runs and prefilter sweeps; `ablate merge` makes its tables");
+  CLI::App* sub = app.add_subcommand(
+      "ablate", "Run an ablation grid of active runs and prefilter sweeps; `ablate merge` makes its tables");
   sub->add_option("--config", a->config, "Grid JSON (format: nbv/ablation.h)");
   sub->add_option("--out", a->out, "Output folder (runs/, tables/, plots/, README.md)");
   sub->add_option("--shard", a->shard, "Run only jobs i, i+n, ... (i/n)");
   sub->add_flag("--list", a->list, "Print the jobs (and their `saresgs active` command lines) and exit");
-  CLI::App* merge = sub->add_subcommand("merge", "Collect finished jobs (from --inputs) into OUT and write the tables and plots");
+  CLI::App* merge =
+      sub->add_subcommand("merge", "Collect finished jobs (from --inputs) into OUT and write the tables and plots");
   merge->add_option("--config", a->config, "Grid JSON")->required();
   merge->add_option("--out", a->out, "Output folder")->required();
   merge->add_option("--inputs", a->inputs, "Comma-separated shard output folders to copy finished jobs from");

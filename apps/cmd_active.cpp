@@ -30,15 +30,17 @@ namespace fs = std::filesystem;
 
 // Options as typed; the preset's values apply where an override is not given.
 struct ActiveArgs {
-  std::string dataset, out, method = "adaptive", preset = "quick", fvs_metric = "euclidean", ranking, replay, background;
+  std::string dataset, out, method = "adaptive", preset = "quick", fvs_metric = "euclidean", ranking, replay,
+                            background;
   int downscale = 1, threads = 0;
-  bool resume = false, continue_training = false, sub_only = false, time_exhaustive_fisher = false, no_plain_refit = false,
-       final_residual = false;
+  bool resume = false, continue_training = false, sub_only = false, time_exhaustive_fisher = false,
+       no_plain_refit = false, final_residual = false;
   std::uint64_t seed = 0;
   double fisher_lambda = 1e-6;
   std::optional<int> max_views, interval, total, final_iterations, renamed_iterations;
   std::optional<long long> max_gaussians;
-  std::optional<double> beta, prefilter_keep, hybrid_weight, gate_keep, adaptive_clustering, memory_budget_gb, path_variance_kappa;
+  std::optional<double> beta, prefilter_keep, hybrid_weight, gate_keep, adaptive_clustering, memory_budget_gb,
+      path_variance_kappa;
   std::string hybrid_fisher = "logdet", hybrid_coverage = "facility";
   PrefilterFlags prefilter;
 };
@@ -87,9 +89,9 @@ void printSummary(const RunReport& r, const std::string& out) {
   std::string phases;
   if (r.phase_iterations)
     for (int p : *r.phase_iterations) phases += (phases.empty() ? "" : " + ") + std::to_string(p);
-  std::printf("\n%s run, preset %s, seed %llu, %d iterations in the loop (%s; at least %d asked), %zu views\n", r.method.c_str(),
-              r.preset.c_str(), static_cast<unsigned long long>(r.seed), r.iterations, phases.c_str(), r.options.total_iterations,
-              r.selected_view_indices.size());
+  std::printf("\n%s run, preset %s, seed %llu, %d iterations in the loop (%s; at least %d asked), %zu views\n",
+              r.method.c_str(), r.preset.c_str(), static_cast<unsigned long long>(r.seed), r.iterations, phases.c_str(),
+              r.options.total_iterations, r.selected_view_indices.size());
   std::printf("%-44s %8s %8s %8s %10s %10s %10s\n", "model", "PSNR", "SSIM", "AUSE", "select s", "train s", "total s");
   std::printf("%-44s %8.2f %8.4f %8s %10.1f %10.1f %10.1f\n", "in the loop (paper's protocol)", r.psnr, r.ssim,
               r.ause ? std::to_string(*r.ause).substr(0, 6).c_str() : "n/a", r.seconds.selection(), r.seconds.training,
@@ -117,7 +119,8 @@ void writeReportPage(const std::string& out, const Scene& scene, int threads) {
     page.threads = threads;
     const RunPageResult r = writeRunPage(out, &scene, page);
     for (const std::string& m : r.missing) std::cerr << "report: " << m << "\n";
-    std::printf("wrote %s (%.1f MB): open it in a browser\n", r.path.c_str(), static_cast<double>(r.bytes) / (1024.0 * 1024.0));
+    std::printf("wrote %s (%.1f MB): open it in a browser\n", r.path.c_str(),
+                static_cast<double>(r.bytes) / (1024.0 * 1024.0));
   } catch (const std::exception& e) {
     std::cerr << "report: no report.html: " << e.what() << "\n";
   }
@@ -137,11 +140,12 @@ int runActive(const ActiveArgs& a) {
   if (!a.replay.empty()) {
     const RunReport replayed = runReportFromJson(readJsonFile(a.replay), a.replay);
     opt.replay = replaySequence(scene, replayed, a.replay);
-    std::cerr << "replaying the " << opt.replay.size() << " views of " << a.replay << " (" << replayed.method << ", seed "
-              << replayed.seed << ") in their order\n";
+    std::cerr << "replaying the " << opt.replay.size() << " views of " << a.replay << " (" << replayed.method
+              << ", seed " << replayed.seed << ") in their order\n";
   }
   fs::create_directories(a.out);
-  if (const int n = removeStaleTemporaries(a.out)) std::cerr << "removed " << n << " temporaries left by a killed run\n";
+  if (const int n = removeStaleTemporaries(a.out))
+    std::cerr << "removed " << n << " temporaries left by a killed run\n";
   const std::string ckpt = a.out + "/checkpoint.json";
   if (!a.resume && fs::exists(ckpt))
     throw std::runtime_error(ckpt + " exists: pass --resume to continue that run, or choose another --out");
@@ -149,16 +153,17 @@ int runActive(const ActiveArgs& a) {
     // The views it will train on: max_views of the candidates (their sizes, as the largest
     // ones are not known before selection: the first ones); the models it holds: the
     // loop's, the final fit's and, for residual methods, the plain refit's.
-    std::vector<int> trained(scene.train.begin(),
-                             scene.train.begin() + std::min<std::ptrdiff_t>(static_cast<std::ptrdiff_t>(scene.train.size()),
-                                                                            std::max(opt.max_views, 1)));
+    std::vector<int> trained(
+        scene.train.begin(),
+        scene.train.begin() +
+            std::min<std::ptrdiff_t>(static_cast<std::ptrdiff_t>(scene.train.size()), std::max(opt.max_views, 1)));
     const std::size_t initial = initialModelSize(scene, opt.trainer);
-    const int models =
-        1 + (opt.final_iterations > 0 ? (finalFitIsResidual(opt) && opt.plain_refit ? 2 : 1) : 0);
+    const int models = 1 + (opt.final_iterations > 0 ? (finalFitIsResidual(opt) && opt.plain_refit ? 2 : 1) : 0);
     std::size_t cap = opt.trainer.densify.max_gaussians;
-    const std::string budget = applyMemoryBudget(estimateTrainingMemory(scene, trained, scene.test.empty() ? scene.train : scene.test,
-                                                          initial, opt.trainer.max_sh_degree, models),
-                                   memoryBudgetBytes(a.memory_budget_gb), a.memory_budget_gb.has_value(), cap);
+    const std::string budget =
+        applyMemoryBudget(estimateTrainingMemory(scene, trained, scene.test.empty() ? scene.train : scene.test, initial,
+                                                 opt.trainer.max_sh_degree, models),
+                          memoryBudgetBytes(a.memory_budget_gb), a.memory_budget_gb.has_value(), cap);
     std::cerr << budget;
     said += budget;
     opt.trainer.densify.max_gaussians = opt.final_trainer.densify.max_gaussians = cap;
@@ -172,7 +177,8 @@ int runActive(const ActiveArgs& a) {
     const bool kmedian = usesKmedianGate(scene, opt);
     std::cerr << "adaptive: capture clustering " << captureClustering(scene) << (kmedian ? " > " : " <= ")
               << opt.adaptive_clustering << ", so Fisher ranks the top " << opt.gate_keep * 100 << " % by "
-              << (kmedian ? "k-median gain (kmedian-fisher)" : "distance to the nearest held view (fvs-fisher)") << "\n";
+              << (kmedian ? "k-median gain (kmedian-fisher)" : "distance to the nearest held view (fvs-fisher)")
+              << "\n";
   }
   Progress progress;
   // Resident memory at the start of every phase (per number of views held): an active run
@@ -182,21 +188,24 @@ int runActive(const ActiveArgs& a) {
   const auto note_memory = [&](const std::string& phase, int views, std::size_t gaussians) {
     if (phase == last_phase) return;
     last_phase = phase;
-    phase_memory.push_back({{"phase", phase}, {"views", views}, {"gaussians", gaussians}, {"rss_bytes", currentRssBytes()}});
+    phase_memory.push_back(
+        {{"phase", phase}, {"views", views}, {"gaussians", gaussians}, {"rss_bytes", currentRssBytes()}});
   };
   const ActiveResult r = run.run([&](const ActiveProgress& p) {
     note_memory(std::string(toString(p.phase)) + " " + std::to_string(p.views), p.views, p.gaussians);
     char detail[200];
-    std::snprintf(detail, sizeof detail, "%s %d/%d  views %d/%d  loss %.4f  PSNR %.2f  Gaussians %zu", toString(p.phase),
-                  p.phase_done, p.phase_total, p.views, p.max_views, p.loss, p.psnr, p.gaussians);
+    std::snprintf(detail, sizeof detail, "%s %d/%d  views %d/%d  loss %.4f  PSNR %.2f  Gaussians %zu",
+                  toString(p.phase), p.phase_done, p.phase_total, p.views, p.max_views, p.loss, p.psnr, p.gaussians);
     // A phase is a phase of its own per number of views held (a log line each).
-    progress.update("active", p.iteration, p.total_iterations, detail, std::string(toString(p.phase)) + " " + std::to_string(p.views));
+    progress.update("active", p.iteration, p.total_iterations, detail,
+                    std::string(toString(p.phase)) + " " + std::to_string(p.views));
   });
   const Trainer& t = run.trainer();
   writeTestRenders(t, r.test, a.out + "/test_renders");
   writeRunFiles(run, r, scene, a.out);
-  const RunReport report =
-      makeRunReport(scene, opt, r, {a.dataset, a.preset, a.replay, t.gaussians().size(), rasterThreadCount(opt.trainer.raster.execution)});
+  const RunReport report = makeRunReport(
+      scene, opt, r,
+      {a.dataset, a.preset, a.replay, t.gaussians().size(), rasterThreadCount(opt.trainer.raster.execution)});
   note_memory("end", static_cast<int>(r.selected_views.size()), t.gaussians().size());
   nlohmann::json results = toJson(report);
   // Machine state, like the timings: not part of what a resumed run must reproduce.
@@ -227,14 +236,16 @@ CLI::App* addActiveOptions(CLI::App& app, const std::shared_ptr<ActiveArgs>& a) 
   sub->add_option("--seed", a->seed, "Random seed")->check(wholeNumberAtLeast(0))->capture_default_str();
   sub->add_option("--preset", a->preset, "quick | paper")->capture_default_str();
   sub->add_option("--max-views", a->max_views, "Views at the end (default 20)")->check(wholeNumberAtLeast(1));
-  sub->add_option("--interval", a->interval, "Iterations per view held (preset's by default)")->check(wholeNumberAtLeast(1));
+  sub->add_option("--interval", a->interval, "Iterations per view held (preset's by default)")
+      ->check(wholeNumberAtLeast(1));
   sub->add_option("--min-iterations", a->total,
                   "Least total iterations of the loop: the last phase trains what is left and never less than views x "
                   "interval, so more may run (preset's by default; results.json: iterations, phase_iterations)")
       ->check(wholeNumberAtLeast(1));
   sub->add_option("--iterations", a->renamed_iterations, "Renamed --min-iterations")->group("");
-  sub->add_option("--final-iterations", a->final_iterations,
-                  "Final fit: a fresh model trained on the chosen views for N iterations (0: none; preset's by default)")
+  sub->add_option(
+         "--final-iterations", a->final_iterations,
+         "Final fit: a fresh model trained on the chosen views for N iterations (0: none; preset's by default)")
       ->check(wholeNumberAtLeast(0));
   sub->add_flag("--no-plain-refit", a->no_plain_refit,
                 "Methods with their own training (sa-resgs, resgs): leave out the plain 3DGS refit of the chosen "
@@ -248,15 +259,20 @@ CLI::App* addActiveOptions(CLI::App& app, const std::shared_ptr<ActiveArgs>& a) 
       ->check(CLI::Range(0.001, 1e6));
   sub->add_option("--max-gaussians", a->max_gaussians, "Cap on the model size (0: none; preset's by default)")
       ->check(CLI::Range(0.0, 1e9));
-  sub->add_option("--residual-beta", a->beta, "Uncertain fraction of the residual subset (default 0.1)")->check(CLI::Range(0.0, 1.0));
-  sub->add_option("--residual-ranking", a->ranking, "Uncertainty ranking: both | opacity | scale | random (default both)")
+  sub->add_option("--residual-beta", a->beta, "Uncertain fraction of the residual subset (default 0.1)")
+      ->check(CLI::Range(0.0, 1.0));
+  sub->add_option("--residual-ranking", a->ranking,
+                  "Uncertainty ranking: both | opacity | scale | random (default both)")
       ->check(CLI::IsMember({"both", "opacity", "scale", "random"}));
   sub->add_flag("--residual-sub-only", a->sub_only, "Ablation: subset loss only, no full-render loss");
   sub->add_flag("--continue-training", a->continue_training,
                 "Keep training the same model after each addition instead of resetting it");
   sub->add_option("--fvs-metric", a->fvs_metric, "euclidean | great-circle")
-      ->check(CLI::IsMember({"euclidean", "great-circle"}))->capture_default_str();
-  sub->add_option("--fisher-lambda", a->fisher_lambda, "Fisher damping lambda (> 0)")->check(positiveNumber())->capture_default_str();
+      ->check(CLI::IsMember({"euclidean", "great-circle"}))
+      ->capture_default_str();
+  sub->add_option("--fisher-lambda", a->fisher_lambda, "Fisher damping lambda (> 0)")
+      ->check(positiveNumber())
+      ->capture_default_str();
   sub->add_option("--prefilter-set", a->prefilter.set, "frustum | visible")->capture_default_str();
   sub->add_option("--prefilter-encoding", a->prefilter.encoding,
                   "hash:auto (the smallest 2^K, K in 11..19, with load <= 0.5) | hash:K (11..19) | exact")
@@ -267,37 +283,48 @@ CLI::App* addActiveOptions(CLI::App& app, const std::shared_ptr<ActiveArgs>& a) 
       ->check(CLI::IsMember({"auto", "indoor", "outdoor"}))
       ->capture_default_str();
   sub->add_option("--prefilter-score", a->prefilter.score, "xor | new")->capture_default_str();
-  sub->add_option("--prefilter-lifting", a->prefilter.lifting, "SA-Point lifting: flow (DIS + epipolar refinement) | depth (the trainer's rendered depth) | oracle (the dataset's ground-truth depth maps)")
+  sub->add_option("--prefilter-lifting", a->prefilter.lifting,
+                  "SA-Point lifting: flow (DIS + epipolar refinement) | depth (the trainer's rendered depth) | oracle "
+                  "(the dataset's ground-truth depth maps)")
       ->capture_default_str();
-  sub->add_option("--prefilter-keep", a->prefilter_keep, "Fraction kept for Fisher (default 0.2)")->check(CLI::Range(0.0, 1.0));
+  sub->add_option("--prefilter-keep", a->prefilter_keep, "Fraction kept for Fisher (default 0.2)")
+      ->check(CLI::Range(0.0, 1.0));
   sub->add_option("--hybrid-weight", a->hybrid_weight,
                   "hybrid: share of the coverage evidence against Fisher's, in [0, 1] (default 0.5)")
       ->check(CLI::Range(0.0, 1.0));
   sub->add_option("--hybrid-fisher", a->hybrid_fisher, "hybrid: Fisher criterion combined, trace | logdet")
-      ->check(CLI::IsMember({"trace", "logdet"}))->capture_default_str();
-  sub->add_option("--hybrid-coverage", a->hybrid_coverage,
-                  "hybrid: second evidence, surface (Embree-visible SfM surface no held view saw) | views (distance to the "
-                  "nearest held camera) | facility (the facility-location gain over the train views, by the overlap of their visible "
-                  "surface)")
-      ->check(CLI::IsMember({"surface", "views", "facility"}))->capture_default_str();
+      ->check(CLI::IsMember({"trace", "logdet"}))
+      ->capture_default_str();
+  sub->add_option(
+         "--hybrid-coverage", a->hybrid_coverage,
+         "hybrid: second evidence, surface (Embree-visible SfM surface no held view saw) | views (distance to the "
+         "nearest held camera) | facility (the facility-location gain over the train views, by the overlap of their "
+         "visible "
+         "surface)")
+      ->check(CLI::IsMember({"surface", "views", "facility"}))
+      ->capture_default_str();
   sub->add_option("--path-variance-kappa", a->path_variance_kappa,
                   "path-variance: each parameter group's damping, as a multiple of the median of its nonzero held "
                   "information (0: --fisher-lambda alone; default 0.01)")
       ->check(CLI::Range(0.0, 1e6));
-  sub->add_option("--gate-keep", a->gate_keep,
-                  "kmedian-fisher, fvs-fisher, adaptive: fraction of the candidates, best by the gate's spread score (k-median "
-                  "gain or distance to the nearest held view), that Fisher ranks (default 0.2)")
+  sub->add_option(
+         "--gate-keep", a->gate_keep,
+         "kmedian-fisher, fvs-fisher, adaptive: fraction of the candidates, best by the gate's spread score (k-median "
+         "gain or distance to the nearest held view), that Fisher ranks (default 0.2)")
       ->check(CLI::Range(0.0, 1.0));
-  sub->add_option("--adaptive-clustering", a->adaptive_clustering,
-                  "adaptive: a capture whose clustering (the coefficient of variation of each train camera's distance to its "
-                  "5th nearest; `saresgs info` prints it) exceeds this gets the k-median gate, any other the farthest-view gate "
-                  "(default 0.7)")
+  sub->add_option(
+         "--adaptive-clustering", a->adaptive_clustering,
+         "adaptive: a capture whose clustering (the coefficient of variation of each train camera's distance to its "
+         "5th nearest; `saresgs info` prints it) exceeds this gets the k-median gate, any other the farthest-view gate "
+         "(default 0.7)")
       ->check(CLI::Range(0.0, 1e6));
   sub->add_flag("--time-exhaustive-fisher", a->time_exhaustive_fisher, "Also time Fisher over all candidates");
   sub->add_option("--replay", a->replay,
                   "Fixed order: train with this method's training on the views of another run's results.json, in their "
                   "order, instead of selecting (the paper's ablation)");
-  sub->add_option("--downscale", a->downscale, "Image downscale factor")->check(CLI::Range(1, 64))->capture_default_str();
+  sub->add_option("--downscale", a->downscale, "Image downscale factor")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
   sub->add_option("--background", a->background, kBackgroundHelp)->check(backgroundValue());
   sub->add_option("--threads", a->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
   sub->add_flag("--resume", a->resume, "Continue the run in OUT from its checkpoint");

@@ -113,8 +113,8 @@ struct StepTimes {
   double median_ms = 0;
   StageSeconds stages;  // summed over the timed steps
   double mean_contributors = 0;
-  double allocations_per_step = 0;   // C++ heap allocations (apps/heap_count.h), timed steps
-  double page_faults_per_step = 0;   // minor + major, whole process, timed steps
+  double allocations_per_step = 0;  // C++ heap allocations (apps/heap_count.h), timed steps
+  double page_faults_per_step = 0;  // minor + major, whole process, timed steps
 };
 
 // Page faults (minor + major) of the whole process so far.
@@ -185,7 +185,8 @@ void checkBenchSize(const BenchArgs& a) {
   const double have = static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGE_SIZE));
   if (have > 0 && need > 0.5 * have) {
     char msg[256];
-    std::snprintf(msg, sizeof msg, "needs about %.1f GB for %lld Gaussians at %dx%d; the limit is half this machine's memory, %.1f GB",
+    std::snprintf(msg, sizeof msg,
+                  "needs about %.1f GB for %lld Gaussians at %dx%d; the limit is half this machine's memory, %.1f GB",
                   need / 1e9, static_cast<long long>(a.gaussians), a.width, a.height, 0.5 * have / 1e9);
     throw InputError("--gaussians/--width/--height", "size", msg);
   }
@@ -265,7 +266,9 @@ int runFisherBench(const BenchArgs& a) {
   const ImageF dL = photometricLoss(fwd.rgb, target, 0.2, true).grad;
   Gaussians H = g.zerosLike(), grad = g.zerosLike();
   std::vector<double> fisher_ms, view_ms, backward_ms, forward_ms;
-  auto ms = [](auto t0) { return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count(); };
+  auto ms = [](auto t0) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  };
   for (int it = 0; it < a.warmup + a.steps; ++it) {
     const bool timed = it >= a.warmup;
     auto t0 = std::chrono::steady_clock::now();
@@ -409,7 +412,7 @@ int runTrainBench(const TrainBenchArgs& a) {
                         (end.densify - start.densify) * k};
   };
   auto stages = [](const StageSeconds& ms, double per) {
-    return nlohmann::json{{"render", ms.render},   {"loss", ms.loss},       {"backward", ms.backward},
+    return nlohmann::json{{"render", ms.render},  {"loss", ms.loss},       {"backward", ms.backward},
                           {"adam", ms.optimizer}, {"densify", ms.densify}, {"other", per - ms.total()}};
   };
   const StageSeconds ms = msPerIteration(trainer.seconds(), s0);
@@ -510,8 +513,9 @@ double medianMs(int reps, const std::function<void()>& f) {
 
 int runOccupancyBench(const OccupancyBenchArgs& a) {
   const auto thread_limit = limitThreads(a.threads);
-  const int threads = std::min<int>(tbb::info::default_concurrency(),
-      static_cast<int>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)));
+  const int threads =
+      std::min<int>(tbb::info::default_concurrency(),
+                    static_cast<int>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)));
 
   // A room360 scene and what COLMAP would give for it.
   SyntheticOptions so;
@@ -558,15 +562,22 @@ int runOccupancyBench(const OccupancyBenchArgs& a) {
   // Per candidate: every camera of the scene is a candidate.
   const double n = static_cast<double>(cams.size());
   std::vector<VoxelSet> fr(cams.size()), vis(cams.size());
-  const double t_fr = medianMs(3, [&] {
-    for (std::size_t j = 0; j < cams.size(); ++j) fr[j] = frustumSet(*g, cams[j]);
-  }) / n;
-  const double t_vis4 = medianMs(3, [&] {
-    for (std::size_t j = 0; j < cams.size(); ++j) vis[j] = tracer->visibleSet(cams[j], 4);
-  }) / n;
-  const double t_vis1 = medianMs(1, [&] {
-    for (std::size_t j = 0; j < cams.size(); ++j) tracer->visibleSet(cams[j], 1);
-  }) / n;
+  const double t_fr = medianMs(3,
+                               [&] {
+                                 for (std::size_t j = 0; j < cams.size(); ++j) fr[j] = frustumSet(*g, cams[j]);
+                               }) /
+                      n;
+  const double t_vis4 = medianMs(3,
+                                 [&] {
+                                   for (std::size_t j = 0; j < cams.size(); ++j)
+                                     vis[j] = tracer->visibleSet(cams[j], 4);
+                                 }) /
+                        n;
+  const double t_vis1 = medianMs(1,
+                                 [&] {
+                                   for (std::size_t j = 0; j < cams.size(); ++j) tracer->visibleSet(cams[j], 1);
+                                 }) /
+                        n;
   double mean_fr = 0, mean_vis = 0;
   for (std::size_t j = 0; j < cams.size(); ++j) {
     mean_fr += static_cast<double>(fr[j].size());
@@ -583,9 +594,12 @@ int runOccupancyBench(const OccupancyBenchArgs& a) {
   const double t_h11 = medianMs(5, [&] { scoreCandidates(obs, fr, g->sceneCount(), p); }) / n;
   // The dense path, on one thread: encode each candidate into T bits, XOR/popcount all T.
   const HashedBits ho = HashedBits::encode(obs, std::size_t{1} << 19);
-  const double t_dense19 = medianMs(5, [&] {
-    for (const VoxelSet& c : fr) scoreHashed(ho, HashedBits::encode(c, std::size_t{1} << 19));
-  }) / n;
+  const double t_dense19 = medianMs(5,
+                                    [&] {
+                                      for (const VoxelSet& c : fr)
+                                        scoreHashed(ho, HashedBits::encode(c, std::size_t{1} << 19));
+                                    }) /
+                           n;
   const GridMemory m = g->memory();
 
   nlohmann::json j;
@@ -609,9 +623,12 @@ int runOccupancyBench(const OccupancyBenchArgs& a) {
   j["mean_frustum_voxels"] = mean_fr / n;
   j["mean_visible_voxels"] = mean_vis / n;
   j["stage_ms"] = {{"scene_grid", t_build}, {"add_observed", t_obs}, {"embree_bvh", t_tracer}};
-  j["per_candidate_ms"] = {{"frustum_set", t_fr},        {"visible_set_stride4", t_vis4},
-                           {"visible_set_stride1", t_vis1}, {"score_exact", t_exact},
-                           {"score_hashed_2pow19", t_h19},  {"score_hashed_2pow11", t_h11},
+  j["per_candidate_ms"] = {{"frustum_set", t_fr},
+                           {"visible_set_stride4", t_vis4},
+                           {"visible_set_stride1", t_vis1},
+                           {"score_exact", t_exact},
+                           {"score_hashed_2pow19", t_h19},
+                           {"score_hashed_2pow11", t_h11},
                            {"score_dense_2pow19_1thread", t_dense19}};
   j["memory_kb"] = {{"scene_vdb", m.scene_vdb / 1024.0},
                     {"observed_vdb", m.observed_vdb / 1024.0},
@@ -631,9 +648,13 @@ void addBenchCommand(CLI::App& app, Action& action) {
   CLI::App* step = bench->add_subcommand("step", "Time training steps on a reproducible random scene");
   step->add_option("--width", a->width, "Image width")->check(CLI::Range(1, 16384))->capture_default_str();
   step->add_option("--height", a->height, "Image height")->check(CLI::Range(1, 16384))->capture_default_str();
-  step->add_option("--gaussians", a->gaussians, "Number of Gaussians")->check(CLI::Range(1, 100000000))->capture_default_str();
+  step->add_option("--gaussians", a->gaussians, "Number of Gaussians")
+      ->check(CLI::Range(1, 100000000))
+      ->capture_default_str();
   step->add_option("--sh-degree", a->sh_degree, "SH degree (active)")->check(CLI::Range(0, 3))->capture_default_str();
-  step->add_option("--coverage", a->coverage, "Mean 3-sigma ellipses per pixel")->check(CLI::Range(0.01, 1000.0))->capture_default_str();
+  step->add_option("--coverage", a->coverage, "Mean 3-sigma ellipses per pixel")
+      ->check(CLI::Range(0.01, 1000.0))
+      ->capture_default_str();
   step->add_option("--steps", a->steps, "Timed steps")->check(CLI::Range(1, 100000))->capture_default_str();
   step->add_option("--warmup", a->warmup, "Untimed steps first")->check(CLI::Range(0, 100000))->capture_default_str();
   step->add_option("--threads", a->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
@@ -649,11 +670,17 @@ void addBenchCommand(CLI::App& app, Action& action) {
       "fisher", "Time the Fisher (squared-gradient) pass against the backward pass of the same view");
   fisher->add_option("--width", f->width, "Image width")->check(CLI::Range(1, 16384))->capture_default_str();
   fisher->add_option("--height", f->height, "Image height")->check(CLI::Range(1, 16384))->capture_default_str();
-  fisher->add_option("--gaussians", f->gaussians, "Number of Gaussians")->check(CLI::Range(1, 100000000))->capture_default_str();
+  fisher->add_option("--gaussians", f->gaussians, "Number of Gaussians")
+      ->check(CLI::Range(1, 100000000))
+      ->capture_default_str();
   fisher->add_option("--sh-degree", f->sh_degree, "SH degree (active)")->check(CLI::Range(0, 3))->capture_default_str();
-  fisher->add_option("--coverage", f->coverage, "Mean 3-sigma ellipses per pixel")->check(CLI::Range(0.01, 1000.0))->capture_default_str();
+  fisher->add_option("--coverage", f->coverage, "Mean 3-sigma ellipses per pixel")
+      ->check(CLI::Range(0.01, 1000.0))
+      ->capture_default_str();
   fisher->add_option("--steps", f->steps, "Timed iterations")->check(CLI::Range(1, 100000))->capture_default_str();
-  fisher->add_option("--warmup", f->warmup, "Untimed iterations first")->check(CLI::Range(0, 100000))->capture_default_str();
+  fisher->add_option("--warmup", f->warmup, "Untimed iterations first")
+      ->check(CLI::Range(0, 100000))
+      ->capture_default_str();
   fisher->add_option("--threads", f->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
   fisher->add_option("--seed", f->seed, "Scene seed")->check(wholeNumberAtLeast(0))->capture_default_str();
   fisher->callback([&action, f] { action = [f] { return runFisherBench(*f); }; });
@@ -661,29 +688,49 @@ void addBenchCommand(CLI::App& app, Action& action) {
   auto tr = std::make_shared<TrainBenchArgs>();
   CLI::App* train = bench->add_subcommand(
       "train", "Time whole training iterations of a real scene by stage, beside `bench step` at the same size");
-  train->add_option("--dataset", tr->dataset, "Dataset folder (default: the built-in room360 scene at --width x --height, written once to out/)");
-  train->add_option("--width", tr->width, "Image width of the built-in scene")->check(CLI::Range(16, 8192))->capture_default_str();
-  train->add_option("--height", tr->height, "Image height of the built-in scene")->check(CLI::Range(16, 8192))->capture_default_str();
-  train->add_option("--iterations", tr->iterations, "Timed iterations")->check(CLI::Range(1, 1000000))->capture_default_str();
-  train->add_option("--warmup", tr->warmup, "Untimed iterations first")->check(CLI::Range(0, 1000000))->capture_default_str();
-  train->add_option("--compare-steps", tr->compare_steps, "Timed steps of the same-size `bench step`")->check(CLI::Range(1, 100000))->capture_default_str();
+  train->add_option("--dataset", tr->dataset,
+                    "Dataset folder (default: the built-in room360 scene at --width x --height, written once to out/)");
+  train->add_option("--width", tr->width, "Image width of the built-in scene")
+      ->check(CLI::Range(16, 8192))
+      ->capture_default_str();
+  train->add_option("--height", tr->height, "Image height of the built-in scene")
+      ->check(CLI::Range(16, 8192))
+      ->capture_default_str();
+  train->add_option("--iterations", tr->iterations, "Timed iterations")
+      ->check(CLI::Range(1, 1000000))
+      ->capture_default_str();
+  train->add_option("--warmup", tr->warmup, "Untimed iterations first")
+      ->check(CLI::Range(0, 1000000))
+      ->capture_default_str();
+  train->add_option("--compare-steps", tr->compare_steps, "Timed steps of the same-size `bench step`")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
   train->add_option("--threads", tr->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
   train->add_option("--seed", tr->seed, "Trainer seed")->check(wholeNumberAtLeast(0))->capture_default_str();
   train->add_flag("--residual", tr->residual,
-                  "Train with residual supervision, alternated in chunks of 10 iterations with a plain trainer from the same start; reports both and their ratio");
+                  "Train with residual supervision, alternated in chunks of 10 iterations with a plain trainer from "
+                  "the same start; reports both and their ratio");
   train->callback([&action, tr] { action = [tr] { return runTrainBench(*tr); }; });
 
   auto o = std::make_shared<OccupancyBenchArgs>();
   CLI::App* occ = bench->add_subcommand(
       "occupancy", "Time the prefilter's parts (grids, candidate sets, scoring) on a room360 scene");
   occ->add_option("--width", o->width, "Image width of the views")->check(CLI::Range(8, 16384))->capture_default_str();
-  occ->add_option("--height", o->height, "Image height of the views")->check(CLI::Range(8, 16384))->capture_default_str();
-  occ->add_option("--points", o->points, "Simulated SfM points at most")->check(CLI::Range(1, 10000000))->capture_default_str();
+  occ->add_option("--height", o->height, "Image height of the views")
+      ->check(CLI::Range(8, 16384))
+      ->capture_default_str();
+  occ->add_option("--points", o->points, "Simulated SfM points at most")
+      ->check(CLI::Range(1, 10000000))
+      ->capture_default_str();
   occ->add_option("--resolution", o->resolution, "Coarse voxels along the longest box side")
-      ->check(CLI::Range(1, 4096))->capture_default_str();
-  occ->add_option("--upsample", o->upsample, "Fine voxels per coarse voxel per axis")->check(CLI::Range(1, 16))->capture_default_str();
+      ->check(CLI::Range(1, 4096))
+      ->capture_default_str();
+  occ->add_option("--upsample", o->upsample, "Fine voxels per coarse voxel per axis")
+      ->check(CLI::Range(1, 16))
+      ->capture_default_str();
   occ->add_option("--min-points", o->min_points, "SfM points for an occupied coarse voxel")
-      ->check(CLI::Range(1, 1000000))->capture_default_str();
+      ->check(CLI::Range(1, 1000000))
+      ->capture_default_str();
   occ->add_option("--threads", o->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
   occ->add_option("--seed", o->seed, "Scene and SfM seed")->check(wholeNumberAtLeast(0))->capture_default_str();
   occ->callback([&action, o] { action = [o] { return runOccupancyBench(*o); }; });

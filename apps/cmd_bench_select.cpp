@@ -27,8 +27,10 @@ struct SelectBenchArgs {
 std::string firstLine(const char* path, const char* prefix = nullptr) {
   std::ifstream in(path);
   for (std::string line; std::getline(in, line);)
-    if (!prefix) return line;
-    else if (line.rfind(prefix, 0) == 0) return line.substr(line.find(':') + 2);
+    if (!prefix)
+      return line;
+    else if (line.rfind(prefix, 0) == 0)
+      return line.substr(line.find(':') + 2);
   return "unknown";
 }
 
@@ -47,14 +49,16 @@ int runSelectBench(SelectBenchArgs& a) {
       so.layout = "room360";
       so.width = a.width;
       so.height = a.height;
-      std::cerr << "bench select: writing the room360 scene at " << a.width << "x" << a.height << " to " << path << " (once)\n";
+      std::cerr << "bench select: writing the room360 scene at " << a.width << "x" << a.height << " to " << path
+                << " (once)\n";
       writeSyntheticDataset(makeSyntheticScene(so), path);
     }
   }
   const std::string load_before = firstLine("/proc/loadavg");
   const SelectionBenchResult r = benchSelection(loadDataset(path), a.opt);
   std::vector<double> ratio;
-  for (std::size_t k = 0; k < r.fisher_seconds.size(); ++k) ratio.push_back(r.path_variance_seconds[k] / r.fisher_seconds[k]);
+  for (std::size_t k = 0; k < r.fisher_seconds.size(); ++k)
+    ratio.push_back(r.path_variance_seconds[k] / r.fisher_seconds[k]);
   nlohmann::json j;
   j["benchmark"] = "select";
   j["dataset"] = path;
@@ -84,17 +88,30 @@ int runSelectBench(SelectBenchArgs& a) {
 void addSelectBenchCommand(CLI::App& bench, Action& action) {
   auto a = std::make_shared<SelectBenchArgs>();
   CLI::App* sub = bench.add_subcommand(
-      "select", "Time a selection step of path-variance against FisherRF's on the same model, held views and candidates");
-  sub->add_option("--dataset", a->dataset, "Dataset folder (default: the built-in room360 scene at --width x --height, written once to out/)");
-  sub->add_option("--width", a->width, "Image width of the built-in scene")->check(CLI::Range(16, 8192))->capture_default_str();
-  sub->add_option("--height", a->height, "Image height of the built-in scene")->check(CLI::Range(16, 8192))->capture_default_str();
-  sub->add_option("--held", a->opt.held, "Views held when the step is taken")->check(CLI::Range(1, 100000))->capture_default_str();
+      "select",
+      "Time a selection step of path-variance against FisherRF's on the same model, held views and candidates");
+  sub->add_option("--dataset", a->dataset,
+                  "Dataset folder (default: the built-in room360 scene at --width x --height, written once to out/)");
+  sub->add_option("--width", a->width, "Image width of the built-in scene")
+      ->check(CLI::Range(16, 8192))
+      ->capture_default_str();
+  sub->add_option("--height", a->height, "Image height of the built-in scene")
+      ->check(CLI::Range(16, 8192))
+      ->capture_default_str();
+  sub->add_option("--held", a->opt.held, "Views held when the step is taken")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
   sub->add_option("--train-iterations", a->opt.train_iterations, "Training on the held views first")
-      ->check(CLI::Range(0, 1000000))->capture_default_str();
-  sub->add_option("--rounds", a->opt.rounds, "Rounds, each one step of each method")->check(CLI::Range(1, 1000))->capture_default_str();
+      ->check(CLI::Range(0, 1000000))
+      ->capture_default_str();
+  sub->add_option("--rounds", a->opt.rounds, "Rounds, each one step of each method")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
   sub->add_option("--threads", a->opt.threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
   sub->add_option("--seed", a->opt.seed, "Trainer seed")->check(wholeNumberAtLeast(0))->capture_default_str();
-  sub->add_option("--kappa", a->opt.kappa, "path-variance's relative damping")->check(CLI::Range(0.0, 1e6))->capture_default_str();
+  sub->add_option("--kappa", a->opt.kappa, "path-variance's relative damping")
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str();
   sub->callback([&action, a] { action = [a] { return runSelectBench(*a); }; });
 }
 

@@ -67,7 +67,8 @@ int runCoverage(const CoverageArgs& a) {
   std::string csv = "view,score,rank,kept\n";
   for (const auto& k : c.candidates) {
     j["candidates"].push_back({{"view", name(k.view)}, {"score", k.score}, {"rank", k.rank}, {"kept", k.kept}});
-    csv += name(k.view) + "," + std::to_string(k.score) + "," + std::to_string(k.rank) + "," + (k.kept ? "1" : "0") + "\n";
+    csv +=
+        name(k.view) + "," + std::to_string(k.score) + "," + std::to_string(k.rank) + "," + (k.kept ? "1" : "0") + "\n";
   }
   writeFileAtomic(a.out + "/coverage.json", j.dump(2) + "\n");
   writeFileAtomic(a.out + "/coverage.csv", csv);
@@ -76,7 +77,8 @@ int runCoverage(const CoverageArgs& a) {
   std::printf("observed %zu of %zu scene voxels (%.1f %%) from %zu SA-Points; kept %zu of %zu candidates\n",
               c.observed_voxels, c.scene_voxels, 100 * c.observed_fraction, c.lifting.kept, c.top.size(),
               c.candidates.size());
-  std::printf("%-16s %12s %6s\n", "candidate", config.scoring.criterion == CoverageCriterion::NewCount ? "new voxels" : "hamming", "rank");
+  std::printf("%-16s %12s %6s\n", "candidate",
+              config.scoring.criterion == CoverageCriterion::NewCount ? "new voxels" : "hamming", "rank");
   std::vector<CandidateCoverage> by_rank = c.candidates;
   std::sort(by_rank.begin(), by_rank.end(), [](const auto& x, const auto& y) { return x.rank < y.rank; });
   for (std::size_t i = 0; i < by_rank.size() && i < 10; ++i)
@@ -94,7 +96,9 @@ void addCoverageCommand(CLI::App& app, Action& action) {
   auto a = std::make_shared<CoverageArgs>();
   CLI::App* sub = app.add_subcommand("coverage", "Observed voxels of some views and the coverage score of the others");
   sub->add_option("--dataset", a->dataset, "COLMAP, Blender or `saresgs scene` folder")->required();
-  sub->add_option("--views", a->views, "Observed train views: indices into the train list or image names, comma-separated")->required();
+  sub->add_option("--views", a->views,
+                  "Observed train views: indices into the train list or image names, comma-separated")
+      ->required();
   sub->add_option("--out", a->out, "Output folder")->required();
   sub->add_option("--model", a->model, "Trained .ply to render extrapolated views (datasets without ground truth)");
   sub->add_option("--set", a->flags.set, "frustum | visible")->capture_default_str();
@@ -103,13 +107,26 @@ void addCoverageCommand(CLI::App& app, Action& action) {
                   "hash:auto (the smallest 2^K, K = 11..19, with load <= 0.5) | hash:K (K = 11..19) | exact")
       ->capture_default_str();
   sub->add_option("--score", a->flags.score, "xor | new")->capture_default_str();
-  sub->add_option("--lifting", a->flags.lifting, "flow | depth | oracle (the dataset's ground-truth depth maps)")->capture_default_str();
-  sub->add_option("--keep", a->config.keep_fraction, "Fraction of candidates kept (top N %)")->check(CLI::Range(0.0, 1.0))->capture_default_str();
-  sub->add_option("--resolution", a->config.resolution, "Grid resolution along the longest side")->check(CLI::Range(4, 4096))->capture_default_str();
-  sub->add_option("--min-points", a->config.min_points, "SfM points per occupied voxel (paper: 2 outdoor, 5 indoor)")->check(CLI::Range(1, 1000))->capture_default_str();
-  sub->add_option("--upsample", a->config.upsample, "Upsampling of the occupied voxels")->check(CLI::Range(1, 16))->capture_default_str();
-  sub->add_option("--stride", a->config.visible_stride, "Pixel stride of visibility rays")->check(CLI::Range(1, 64))->capture_default_str();
-  sub->add_option("--downscale", a->downscale, "Image downscale factor")->check(CLI::Range(1, 64))->capture_default_str();
+  sub->add_option("--lifting", a->flags.lifting, "flow | depth | oracle (the dataset's ground-truth depth maps)")
+      ->capture_default_str();
+  sub->add_option("--keep", a->config.keep_fraction, "Fraction of candidates kept (top N %)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  sub->add_option("--resolution", a->config.resolution, "Grid resolution along the longest side")
+      ->check(CLI::Range(4, 4096))
+      ->capture_default_str();
+  sub->add_option("--min-points", a->config.min_points, "SfM points per occupied voxel (paper: 2 outdoor, 5 indoor)")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  sub->add_option("--upsample", a->config.upsample, "Upsampling of the occupied voxels")
+      ->check(CLI::Range(1, 16))
+      ->capture_default_str();
+  sub->add_option("--stride", a->config.visible_stride, "Pixel stride of visibility rays")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
+  sub->add_option("--downscale", a->downscale, "Image downscale factor")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
   sub->callback([&action, a] { action = [a] { return runCoverage(*a); }; });
 }
 

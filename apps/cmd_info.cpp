@@ -30,9 +30,12 @@ std::string frameText(const SceneFrame& f) {
 // The background line: the colour (or none), random, and where it came from.
 std::string backgroundLine(const Scene& s) {
   std::ostringstream o;
-  if (!s.background) o << "none (opaque images; renders are on black)";
-  else if (s.random_background) o << "random per training step, evaluated on " << backgroundText(BackgroundChoice{false, *s.background});
-  else o << backgroundText(BackgroundChoice{false, *s.background});
+  if (!s.background)
+    o << "none (opaque images; renders are on black)";
+  else if (s.random_background)
+    o << "random per training step, evaluated on " << backgroundText(BackgroundChoice{false, *s.background});
+  else
+    o << backgroundText(BackgroundChoice{false, *s.background});
   o << " (" << s.background_from << ")";
   return o.str();
 }
@@ -50,21 +53,21 @@ int runInfo(const InfoArgs& a) {
   int with_depth = 0;
   for (size_t i = 0; i < s.views.size(); ++i) with_depth += s.hasDepth(static_cast<int>(i));
   std::cout << "dataset " << s.source << "\n"
-            << "  views:   " << s.views.size() << " (" << s.train.size() << " train, " << s.test.size()
-            << " test), " << with_depth << " with ground-truth depth\n"
-            << "  camera:  " << K.width << "x" << K.height << ", fx " << K.fx << ", fy " << K.fy
-            << ", fov " << K.fovX() * 180 / M_PI << " x " << K.fovY() * 180 / M_PI << " deg\n"
+            << "  views:   " << s.views.size() << " (" << s.train.size() << " train, " << s.test.size() << " test), "
+            << with_depth << " with ground-truth depth\n"
+            << "  camera:  " << K.width << "x" << K.height << ", fx " << K.fx << ", fy " << K.fy << ", fov "
+            << K.fovX() * 180 / M_PI << " x " << K.fovY() * 180 / M_PI << " deg\n"
             << "  points:  " << s.points.size() << "\n"
             << "  aabb:    [" << s.aabb.min.transpose() << "] .. [" << s.aabb.max.transpose() << "]" << internal << "\n"
             << "  extent:  " << s.extent << internal << "\n"
             << "  frame:   " << frameText(s.frame) << "\n"
             << "  background: " << backgroundLine(s) << "\n"
             << "  capture: clustering " << captureClustering(s) << " (" << (adaptiveKmedian ? "clustered" : "even")
-            << "; `active --method adaptive` gates Fisher by " << (adaptiveKmedian ? "k-median gain" : "farthest view") << ")\n";
+            << "; `active --method adaptive` gates Fisher by " << (adaptiveKmedian ? "k-median gain" : "farthest view")
+            << ")\n";
   // Reading one image proves the images are there and of the right size.
   const Image8& img = s.image(s.train.front());
-  std::cout << "  image " << s.views[s.train.front()].name << ": " << img.width << "x" << img.height
-            << " read\n";
+  std::cout << "  image " << s.views[s.train.front()].name << ": " << img.width << "x" << img.height << " read\n";
   return 0;
 }
 

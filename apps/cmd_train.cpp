@@ -48,8 +48,10 @@ struct TrainArgs {
 
 std::string shortCount(std::size_t n) {
   char buf[32];
-  if (n >= 10000) std::snprintf(buf, sizeof buf, "%.0fk", n / 1000.0);
-  else std::snprintf(buf, sizeof buf, "%zu", n);
+  if (n >= 10000)
+    std::snprintf(buf, sizeof buf, "%.0fk", n / 1000.0);
+  else
+    std::snprintf(buf, sizeof buf, "%zu", n);
   return buf;
 }
 
@@ -65,21 +67,22 @@ int runTrain(TrainArgs& a) {
   if (a.schedule_scale != 1.0) a.opt = scaledSchedule(a.opt, a.schedule_scale);
   const std::vector<int> views = a.views.empty() ? scene.train : parseTrainViews(a.views, scene, "--views");
   fs::create_directories(a.out);
-  if (const int n = removeStaleTemporaries(a.out)) std::cerr << "removed " << n << " temporaries left by a killed run\n";
+  if (const int n = removeStaleTemporaries(a.out))
+    std::cerr << "removed " << n << " temporaries left by a killed run\n";
   const std::string ckpt = a.out + "/checkpoint.bin";
   const std::size_t initial = initialModelSize(scene, a.opt);
   // The views evaluated at the end (the train views where the dataset has no test split).
   const std::vector<int>& eval_views = scene.test.empty() ? scene.train : scene.test;
-  const MemoryEstimate memory = estimateTrainingMemory(scene, views, eval_views,
-                                                       initial, a.opt.max_sh_degree);
+  const MemoryEstimate memory = estimateTrainingMemory(scene, views, eval_views, initial, a.opt.max_sh_degree);
   const double budget = memoryBudgetBytes(a.memory_budget_gb);
   std::cerr << applyMemoryBudget(memory, budget, a.memory_budget_gb.has_value(), a.opt.densify.max_gaussians);
   Trainer trainer(scene, a.opt);
   if (a.resume && fs::exists(ckpt)) {
     trainer.loadCheckpoint(ckpt);
     if (trainer.iteration() > a.iterations)
-      throw InputError(ckpt, "iteration", "the checkpoint is at iteration " + std::to_string(trainer.iteration()) +
-                                              ", past --iterations " + std::to_string(a.iterations));
+      throw InputError(ckpt, "iteration",
+                       "the checkpoint is at iteration " + std::to_string(trainer.iteration()) +
+                           ", past --iterations " + std::to_string(a.iterations));
     std::cerr << "resumed " << ckpt << " at iteration " << trainer.iteration() << "\n";
   }
   std::cerr << "training on " << views.size() << " views (" << scene.test.size() << " test), "
@@ -90,19 +93,21 @@ int runTrain(TrainArgs& a) {
   // on all cores at once rather than one by one inside the steps.
   {
     std::vector<int> read(eval_views);
-    if (a.iterations - trainer.iteration() >= static_cast<int>(views.size())) read.insert(read.end(), views.begin(), views.end());
+    if (a.iterations - trainer.iteration() >= static_cast<int>(views.size()))
+      read.insert(read.end(), views.begin(), views.end());
     const auto d0 = std::chrono::steady_clock::now();
     const std::size_t decoded = scene.preloadImages(read);
     std::cerr << "decoded " << decoded << " images in "
-              << std::lround(1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - d0).count()) << " ms\n";
+              << std::lround(1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - d0).count())
+              << " ms\n";
   }
   Progress progress;
   const int start = trainer.iteration();
   const auto t0 = std::chrono::steady_clock::now();
   while (trainer.iteration() < a.iterations) {
-    const int chunk = std::min(a.iterations - trainer.iteration(),
-                               a.checkpoint_every > 0 ? a.checkpoint_every - trainer.iteration() % a.checkpoint_every
-                                                      : a.iterations);
+    const int chunk =
+        std::min(a.iterations - trainer.iteration(),
+                 a.checkpoint_every > 0 ? a.checkpoint_every - trainer.iteration() % a.checkpoint_every : a.iterations);
     trainer.train(views, chunk, [&](const TrainProgress& p) {
       char detail[128];
       std::snprintf(detail, sizeof detail, "it %d  loss %.4f  Gaussians %s", p.iteration, p.loss_ema,
@@ -137,10 +142,14 @@ int runTrain(TrainArgs& a) {
   j["frame"] = toJson(scene.frame);
   j["background"] = backgroundJson(scene);
   const StageSeconds& s = trainer.seconds();
-  j["stage_seconds"] = {{"render", s.render}, {"loss", s.loss}, {"backward", s.backward},
-                        {"optimizer", s.optimizer}, {"densify", s.densify}};
+  j["stage_seconds"] = {{"render", s.render},
+                        {"loss", s.loss},
+                        {"backward", s.backward},
+                        {"optimizer", s.optimizer},
+                        {"densify", s.densify}};
   for (const ViewMetrics& m : ev.views)
-    j["views"].push_back({{"name", scene.views[static_cast<std::size_t>(m.view)].name}, {"psnr", m.psnr}, {"ssim", m.ssim}});
+    j["views"].push_back(
+        {{"name", scene.views[static_cast<std::size_t>(m.view)].name}, {"psnr", m.psnr}, {"ssim", m.ssim}});
   writeFileAtomic(a.out + "/results.json", j.dump(2) + "\n");
   std::printf("PSNR %.2f dB  SSIM %.4f  on %zu %s views; %zu Gaussians; %.1f s (%.1f it/s)\n", ev.psnr, ev.ssim,
               ev.views.size(), scene.test.empty() ? "train" : "test", trainer.gaussians().size(), train_seconds,
@@ -157,31 +166,51 @@ void addTrainCommand(CLI::App& app, Action& action) {
   CLI::App* sub = app.add_subcommand("train", "Train 3D Gaussians on all train views of a dataset");
   sub->add_option("--dataset", a->dataset, "COLMAP, Blender or `saresgs scene` folder")->required();
   sub->add_option("--out", a->out, "Output folder")->required();
-  sub->add_option("--iterations", a->iterations, "Training iterations")->check(CLI::Range(1, 10000000))->capture_default_str();
-  sub->add_option("--downscale", a->downscale, "Image downscale factor")->check(CLI::Range(1, 64))->capture_default_str();
+  sub->add_option("--iterations", a->iterations, "Training iterations")
+      ->check(CLI::Range(1, 10000000))
+      ->capture_default_str();
+  sub->add_option("--downscale", a->downscale, "Image downscale factor")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
   sub->add_option("--background", a->background, kBackgroundHelp)->check(backgroundValue());
-  sub->add_option("--sh-degree", a->opt.max_sh_degree, "Maximum SH degree")->check(CLI::Range(0, 3))->capture_default_str();
+  sub->add_option("--sh-degree", a->opt.max_sh_degree, "Maximum SH degree")
+      ->check(CLI::Range(0, 3))
+      ->capture_default_str();
   sub->add_option("--seed", a->opt.seed, "Random seed")->check(wholeNumberAtLeast(0))->capture_default_str();
   sub->add_option("--threads", a->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
-  sub->add_option("--densify-until", a->opt.densify.until_iter, "Last densification iteration")->check(wholeNumberAtLeast(0))->capture_default_str();
-  sub->add_option("--max-gaussians", a->opt.densify.max_gaussians, "Cap on the model size (0: none)")->check(CLI::Range(0.0, 1e9))->capture_default_str();
+  sub->add_option("--densify-until", a->opt.densify.until_iter, "Last densification iteration")
+      ->check(wholeNumberAtLeast(0))
+      ->capture_default_str();
+  sub->add_option("--max-gaussians", a->opt.densify.max_gaussians, "Cap on the model size (0: none)")
+      ->check(CLI::Range(0.0, 1e9))
+      ->capture_default_str();
   sub->add_option("--memory-budget", a->memory_budget_gb,
                   "GB this run may use: refused before it starts if its images and initial model do not fit, the model "
                   "capped to fit (default: refused only beyond what the machine has available)")
       ->check(CLI::Range(0.001, 1e6));
-  sub->add_option("--random-init", a->opt.random_init_points, "Random points when the dataset has none")->check(CLI::Range(1, 10000000))->capture_default_str();
+  sub->add_option("--random-init", a->opt.random_init_points, "Random points when the dataset has none")
+      ->check(CLI::Range(1, 10000000))
+      ->capture_default_str();
   sub->add_flag("--residual", a->opt.residual.enabled, "Add SA-ResGS residual supervision");
   sub->add_option("--views", a->views,
                   "Train on these train views only, in this order (indices or image names, comma-separated; e.g. an "
                   "active run's selected_views to refit them)");
   sub->add_option("--schedule-scale", a->schedule_scale,
                   "Scale the densification, opacity-reset and SH schedules (the quick preset's is 0.25)")
-      ->check(CLI::Range(1e-4, 1e4))->capture_default_str();
-  sub->add_option("--residual-alpha", a->opt.residual.alpha, "Random fraction of G_sub")->check(CLI::Range(0.0, 1.0))->capture_default_str();
-  sub->add_option("--residual-beta", a->opt.residual.beta, "Uncertain fraction of G_sub")->check(CLI::Range(0.0, 1.0))->capture_default_str();
+      ->check(CLI::Range(1e-4, 1e4))
+      ->capture_default_str();
+  sub->add_option("--residual-alpha", a->opt.residual.alpha, "Random fraction of G_sub")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  sub->add_option("--residual-beta", a->opt.residual.beta, "Uncertain fraction of G_sub")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
   sub->add_option("--residual-ranking", a->ranking, "both | opacity | scale | random")
-      ->check(CLI::IsMember({"both", "opacity", "scale", "random"}))->capture_default_str();
-  sub->add_option("--checkpoint-every", a->checkpoint_every, "Iterations between checkpoints (0: none)")->check(wholeNumberAtLeast(0))->capture_default_str();
+      ->check(CLI::IsMember({"both", "opacity", "scale", "random"}))
+      ->capture_default_str();
+  sub->add_option("--checkpoint-every", a->checkpoint_every, "Iterations between checkpoints (0: none)")
+      ->check(wholeNumberAtLeast(0))
+      ->capture_default_str();
   sub->add_flag("--resume", a->resume, "Continue from OUT/checkpoint.bin when it exists");
   sub->callback([&action, a] { action = [a] { return runTrain(*a); }; });
 }

@@ -4,6 +4,4 @@
 
 #include "apps/cli.h"
 
-int main(int argc, char** argv) {
-  return saresgs::apps::runCli(std::vector<std::string>(argv + 1, argv + argc));
-}
+int main(int argc, char** argv) { return saresgs::apps::runCli(std::vector<std::string>(argv + 1, argv + argc)); }

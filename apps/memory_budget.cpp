@@ -16,8 +16,10 @@ namespace {
 
 std::string gb(double bytes) {
   char buf[32];
-  if (bytes >= 1e9) std::snprintf(buf, sizeof buf, "%.2f GB", bytes / 1e9);
-  else std::snprintf(buf, sizeof buf, "%.1f MB", bytes / 1e6);
+  if (bytes >= 1e9)
+    std::snprintf(buf, sizeof buf, "%.2f GB", bytes / 1e9);
+  else
+    std::snprintf(buf, sizeof buf, "%.1f MB", bytes / 1e6);
   return buf;
 }
 
@@ -71,10 +73,10 @@ std::string applyMemoryBudget(const MemoryEstimate& e, double budget, bool budge
     throw InputError("--memory-budget", "memory",
                      "this run needs about " + gb(start) + " before training (images " + gb(e.image_bytes) + " for " +
                          std::to_string(e.views) + " views up to " + std::to_string(e.largest_width) + "x" +
-                         std::to_string(e.largest_height) + ", step buffers " + gb(e.buffer_bytes) + ", initial model " +
-                         gb(model) + " for " + std::to_string(e.initial_gaussians) + " Gaussians) but the budget is " +
-                         gb(budget) + " (" + source + "): use --downscale 2 (about " + gb(halved) +
-                         ") or fewer views, or raise --memory-budget");
+                         std::to_string(e.largest_height) + ", step buffers " + gb(e.buffer_bytes) +
+                         ", initial model " + gb(model) + " for " + std::to_string(e.initial_gaussians) +
+                         " Gaussians) but the budget is " + gb(budget) + " (" + source +
+                         "): use --downscale 2 (about " + gb(halved) + ") or fewer views, or raise --memory-budget");
   }
   std::string line = "memory: about " + gb(start) + " at the start (images " + gb(e.image_bytes) + ", model " +
                      gb(model) + "), budget " + gb(budget) + " (" + source + ")";

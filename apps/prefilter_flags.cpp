@@ -5,7 +5,6 @@
 
 #include <nlohmann/json.hpp>
 
-
 #include "geometry/error.h"
 #include "geometry/io/json_file.h"
 

@@ -12,7 +12,8 @@ std::vector<int> parseTrainViews(const std::string& text, const Scene& scene, co
   std::stringstream ss(text);
   for (std::string item; std::getline(ss, item, ',');) {
     int v = -1;
-    const bool digits = !item.empty() && std::all_of(item.begin(), item.end(), [](char c) { return c >= '0' && c <= '9'; });
+    const bool digits =
+        !item.empty() && std::all_of(item.begin(), item.end(), [](char c) { return c >= '0' && c <= '9'; });
     if (digits) {
       // A train index (at most 9 digits: anything longer is out of range anyway).
       const long long i = item.size() <= 9 ? std::stoll(item) : -1;

@@ -22,7 +22,8 @@ const Scene& tinyScene() {
       SceneView& v = s.views[i];
       v.image_path = (fs::path(dir).parent_path() / v.name).string();
       Image8 img(v.camera.K.width, v.camera.K.height, 3);
-      for (std::size_t p = 0; p < img.data.size(); ++p) img.data[p] = static_cast<std::uint8_t>((p * 37 + i * 11) % 251);
+      for (std::size_t p = 0; p < img.data.size(); ++p)
+        img.data[p] = static_cast<std::uint8_t>((p * 37 + i * 11) % 251);
       writeImage(v.image_path, img);
     }
     for (int p = 0; p < 8; ++p) {

@@ -122,7 +122,8 @@ void check(const std::function<void()>& read) {
   try {
     read();
   } catch (const InputError& e) {
-    if (e.file().empty() || e.field().empty()) finding(std::string("InputError without a file or a field: ") + e.what());
+    if (e.file().empty() || e.field().empty())
+      finding(std::string("InputError without a file or a field: ") + e.what());
     if (expectValid()) finding(std::string("a seed was refused: ") + e.what());
   } catch (const std::exception& e) {
     finding(std::string("an exception other than InputError (no file and field for the user): ") + e.what());

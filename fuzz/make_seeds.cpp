@@ -105,7 +105,8 @@ int main(int argc, char** argv) {
   seed(out, "colmap_text", "tiny_model", packedModel(model, ".txt", writeColmapText));
   seed(out, "colmap_binary", "tiny_model", packedModel(model, ".bin", writeColmapBinary));
 
-  seed(out, "blender", "nerf_train_test", fuzz::joinFiles({transforms({1, 2, 3}, false).dump(2), transforms({0}, false).dump(2)}));
+  seed(out, "blender", "nerf_train_test",
+       fuzz::joinFiles({transforms({1, 2, 3}, false).dump(2), transforms({0}, false).dump(2)}));
   seed(out, "blender", "instant_ngp_train", transforms({1, 2, 3, 4}, true).dump(2));
 
   for (int degree : {0, 3}) {
@@ -133,7 +134,8 @@ int main(int argc, char** argv) {
     seed(out, "points_ply", "ascii_extra_properties",
          "ply\nformat ascii 1.0\ncomment two faces follow\nelement vertex 2\nproperty float x\nproperty float y\n"
          "property float z\nproperty float confidence\nproperty uchar red\nproperty uchar green\nproperty uchar blue\n"
-         "element face 0\nproperty list uchar int vertex_indices\nend_header\n0 0 1 0.9 255 0 10\n0.25 0.5 1 0.1 3 200 99\n");
+         "element face 0\nproperty list uchar int vertex_indices\nend_header\n0 0 1 0.9 255 0 10\n0.25 0.5 1 0.1 3 200 "
+         "99\n");
   }
 
   for (int channels : {1, 3}) {
@@ -145,7 +147,8 @@ int main(int argc, char** argv) {
   }
 
   {
-    const std::vector<Correspondence> m = {{{0.5, 0.5}, {1.25, 0.75}}, {{12.5, 30.5}, {11.0, 29.5}}, {{63.5, 47.5}, {60.0, 44.0}}};
+    const std::vector<Correspondence> m = {
+        {{0.5, 0.5}, {1.25, 0.75}}, {{12.5, 30.5}, {11.0, 29.5}}, {{63.5, 47.5}, {60.0, 44.0}}};
     const std::string path = fuzz::scratchPath("seeds/matches.txt");
     writeMatches(path, m);
     seed(out, "matches", "three", fuzz::readBytes(path));

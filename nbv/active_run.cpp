@@ -42,12 +42,14 @@ ActiveRun::ActiveRun(const Scene& scene, const ActiveOptions& opt, std::string c
   to.residual.enabled = needs.residual;
   if (!opt_.replay.empty()) checkReplay();
   if (opt_.method == Method::kCustom && !opt_.custom_selector && opt_.replay.empty())
-    throw std::invalid_argument("method custom: a selector function written by the caller (the Python module's "
-                                "saresgs.ActiveRun(dataset, selector=f)); the command line has none");
+    throw std::invalid_argument(
+        "method custom: a selector function written by the caller (the Python module's "
+        "saresgs.ActiveRun(dataset, selector=f)); the command line has none");
   trainer_ = std::make_unique<Trainer>(scene_, to);
   // A replay selects nothing, so it needs no prefilter.
   if (needs.coverage && opt_.replay.empty()) prefilter_ = makeCoveragePrefilter(scene_, opt_.prefilter);
-  if (needs.surface && opt_.replay.empty() && opt_.hybrid_coverage != HybridCoverage::kViewDistance) surface_ = std::make_unique<SurfaceCoverage>(scene_, opt_.hybrid_surface);
+  if (needs.surface && opt_.replay.empty() && opt_.hybrid_coverage != HybridCoverage::kViewDistance)
+    surface_ = std::make_unique<SurfaceCoverage>(scene_, opt_.hybrid_surface);
 }
 
 // The replayed sequence must be one this run could have held: distinct train views, at
@@ -57,11 +59,13 @@ void ActiveRun::checkReplay() const {
   const int n_initial = std::min<int>(opt_.initial_views, static_cast<int>(scene_.train.size()));
   const int held = std::min<int>(std::max(opt_.max_views, n_initial), static_cast<int>(scene_.train.size()));
   if (static_cast<int>(r.size()) < held)
-    throw std::invalid_argument("replay: the replayed sequence holds " + std::to_string(r.size()) + " views, this run holds " +
-                                std::to_string(held) + " (--max-views " + std::to_string(opt_.max_views) + ")");
+    throw std::invalid_argument("replay: the replayed sequence holds " + std::to_string(r.size()) +
+                                " views, this run holds " + std::to_string(held) + " (--max-views " +
+                                std::to_string(opt_.max_views) + ")");
   for (std::size_t i = 0; i < r.size(); ++i) {
     if (std::find(scene_.train.begin(), scene_.train.end(), r[i]) == scene_.train.end())
-      throw std::invalid_argument("replay: view index " + std::to_string(r[i]) + " is not a train view of this dataset");
+      throw std::invalid_argument("replay: view index " + std::to_string(r[i]) +
+                                  " is not a train view of this dataset");
     if (std::find(r.begin(), r.begin() + static_cast<long>(i), r[i]) != r.begin() + static_cast<long>(i))
       throw std::invalid_argument("replay: view index " + std::to_string(r[i]) + " appears twice");
   }
@@ -79,14 +83,22 @@ TrainerOptions finalFitOptions(const ActiveOptions& o, bool method_training) {
 
 const char* toString(ActivePhase p) {
   switch (p) {
-    case ActivePhase::kTraining: return "training";
-    case ActivePhase::kLifting: return "lifting";
-    case ActivePhase::kPrefilter: return "prefilter";
-    case ActivePhase::kFisher: return "Fisher";
-    case ActivePhase::kExhaustiveFisher: return "exhaustive Fisher";
-    case ActivePhase::kFinalEvaluation: return "final evaluation";
-    case ActivePhase::kFinalFit: return "final fit";
-    case ActivePhase::kFinalFitViews: return "plain refit";
+    case ActivePhase::kTraining:
+      return "training";
+    case ActivePhase::kLifting:
+      return "lifting";
+    case ActivePhase::kPrefilter:
+      return "prefilter";
+    case ActivePhase::kFisher:
+      return "Fisher";
+    case ActivePhase::kExhaustiveFisher:
+      return "exhaustive Fisher";
+    case ActivePhase::kFinalEvaluation:
+      return "final evaluation";
+    case ActivePhase::kFinalFit:
+      return "final fit";
+    case ActivePhase::kFinalFitViews:
+      return "plain refit";
   }
   return "?";
 }
@@ -101,10 +113,14 @@ void ActiveRun::report(ActivePhase phase, int done, int total) {
 
 bool usesKmedianGate(const Scene& scene, const ActiveOptions& o) {
   switch (o.method) {
-    case Method::kKmedianFisher: return true;
-    case Method::kFvsFisher: return false;
-    case Method::kAdaptive: return captureClustering(scene) > o.adaptive_clustering;
-    default: throw std::invalid_argument(std::string("usesKmedianGate: ") + toString(o.method) + " has no gate");
+    case Method::kKmedianFisher:
+      return true;
+    case Method::kFvsFisher:
+      return false;
+    case Method::kAdaptive:
+      return captureClustering(scene) > o.adaptive_clustering;
+    default:
+      throw std::invalid_argument(std::string("usesKmedianGate: ") + toString(o.method) + " has no gate");
   }
 }
 
@@ -143,8 +159,10 @@ int ActiveRun::selectNext(SelectionLog& log) {
       log.prefiltered = pool;
     }
   }
-  SelectionStep step{scene_,   *trainer_, opt_,          selected_,
-                     candidates, std::move(pool), coverage, rng_,
+  SelectionStep step{scene_,         *trainer_,
+                     opt_,           selected_,
+                     candidates,     std::move(pool),
+                     coverage,       rng_,
                      surface_.get(), [this](ActivePhase p, int done, int total) { report(p, done, total); }};
   return selectorOf(opt_.method)(step, log);
 }
@@ -158,13 +176,16 @@ void ActiveRun::begin() {
   if (!loadCheckpoint()) {
     std::vector<Eigen::Vector3d> centers;
     for (int v : scene_.train) centers.push_back(scene_.views[static_cast<std::size_t>(v)].camera.center());
-    for (int i : farthestPointSampling(centers, opt_.initial_views, 0)) initial_.push_back(scene_.train[static_cast<std::size_t>(i)]);
-    if (!opt_.replay.empty()) initial_.assign(opt_.replay.begin(), opt_.replay.begin() + static_cast<long>(initial_.size()));
+    for (int i : farthestPointSampling(centers, opt_.initial_views, 0))
+      initial_.push_back(scene_.train[static_cast<std::size_t>(i)]);
+    if (!opt_.replay.empty())
+      initial_.assign(opt_.replay.begin(), opt_.replay.begin() + static_cast<long>(initial_.size()));
     selected_ = initial_;
   }
   progress_views_.clear();
   for (std::size_t i = 0; i < scene_.test.size() && static_cast<int>(i) < opt_.progress_test_views; ++i)
-    progress_views_.push_back(scene_.test[i * scene_.test.size() / std::min<std::size_t>(scene_.test.size(), opt_.progress_test_views)]);
+    progress_views_.push_back(
+        scene_.test[i * scene_.test.size() / std::min<std::size_t>(scene_.test.size(), opt_.progress_test_views)]);
   last_psnr_ = 0;
 }
 
@@ -210,7 +231,8 @@ void ActiveRun::trainPhase() {
 
 int ActiveRun::nextView(SelectionLog* out) {
   trainPhase();
-  if (finished_) throw std::logic_error("nextView: the run holds its last view (" + std::to_string(selected_.size()) + ")");
+  if (finished_)
+    throw std::logic_error("nextView: the run holds its last view (" + std::to_string(selected_.size()) + ")");
   if (!pending_) {
     SelectionLog log;
     log.seconds.training = phase_seconds_;
@@ -224,7 +246,8 @@ int ActiveRun::nextView(SelectionLog* out) {
 
 void ActiveRun::addView(int v) {
   trainPhase();
-  if (finished_) throw std::logic_error("addView: the run holds its last view (" + std::to_string(selected_.size()) + ")");
+  if (finished_)
+    throw std::logic_error("addView: the run holds its last view (" + std::to_string(selected_.size()) + ")");
   if (std::find(scene_.train.begin(), scene_.train.end(), v) == scene_.train.end())
     throw std::invalid_argument("addView: view " + std::to_string(v) + " is not a train view");
   if (std::find(selected_.begin(), selected_.end(), v) != selected_.end())
@@ -294,7 +317,10 @@ ActiveResult ActiveRun::finish() {
         last_.loss = p.loss_ema;
         report(phase, p.done, opt_.final_iterations);
       });
-      FinalFit f{opt_.final_iterations, to.residual.enabled, t->evaluate(scene_.test.empty() ? scene_.train : scene_.test), {}};
+      FinalFit f{opt_.final_iterations,
+                 to.residual.enabled,
+                 t->evaluate(scene_.test.empty() ? scene_.train : scene_.test),
+                 {}};
       std::vector<int> every(scene_.views.size());
       for (std::size_t i = 0; i < every.size(); ++i) every[i] = static_cast<int>(i);
       f.path = t->evaluate(every, /*keep_renders=*/false, /*with_ssim=*/false).views;
@@ -366,7 +392,8 @@ void ActiveRun::checkLoadedState() const {
   }
   // The phases so far trained k x interval iterations for k = initial .. held - 1.
   long long expected = 0;
-  for (std::size_t k = initial_.size(); k < selected_.size(); ++k) expected += static_cast<long long>(k) * opt_.interval;
+  for (std::size_t k = initial_.size(); k < selected_.size(); ++k)
+    expected += static_cast<long long>(k) * opt_.interval;
   if (iterations_done_ != expected)
     throw InputError(checkpoint_, "iterations_done",
                      std::to_string(iterations_done_) + ", expected " + std::to_string(expected) +
@@ -386,7 +413,8 @@ bool ActiveRun::loadCheckpoint() {
   if (text("method") != toString(opt_.method))
     throw InputError(f, "method", "written by method " + j["method"].dump() + ", this run is " + toString(opt_.method));
   constexpr long long kMaxCount = 2'000'000'000;
-  if (static_cast<std::uint64_t>(jsonInteger(field("seed"), f, "seed", 0, std::numeric_limits<long long>::max())) != opt_.seed)
+  if (static_cast<std::uint64_t>(jsonInteger(field("seed"), f, "seed", 0, std::numeric_limits<long long>::max())) !=
+      opt_.seed)
     throw InputError(f, "seed", "written with seed " + j["seed"].dump());
   if (jsonInteger(field("views"), f, "views", 0, kMaxCount) != static_cast<long long>(scene_.views.size()))
     throw InputError(f, "views", "written for another scene");
@@ -394,8 +422,9 @@ bool ActiveRun::loadCheckpoint() {
     nlohmann::json mine = backgroundJson(scene_);
     mine.erase("from");
     if (j["background"] != mine)
-      throw InputError(f, "background", "written with background " + j["background"].dump() + ", this run's is " +
-                                            mine.dump() + ": resume with the same --background");
+      throw InputError(f, "background",
+                       "written with background " + j["background"].dump() + ", this run's is " + mine.dump() +
+                           ": resume with the same --background");
   }
   // View indices are read in range of this scene's views; checkLoadedState checks the rest.
   const long long last_view = static_cast<long long>(scene_.views.size()) - 1;
@@ -417,8 +446,9 @@ bool ActiveRun::loadCheckpoint() {
   for (std::size_t i = 0; i < steps.size(); ++i)
     steps_.push_back(selectionLog(scene_, stepReportFromJson(steps[i], f, jsonPath("steps", i)), f));
   if (steps_.size() != selected_.size() - initial_.size())
-    throw InputError(f, "steps", std::to_string(steps_.size()) + " steps for " +
-                                     std::to_string(selected_.size() - initial_.size()) + " added views");
+    throw InputError(f, "steps",
+                     std::to_string(steps_.size()) + " steps for " +
+                         std::to_string(selected_.size() - initial_.size()) + " added views");
   const std::string tag = text("tag");
   if (tag != std::to_string(selected_.size()))
     throw InputError(f, "tag", "expected \"" + std::to_string(selected_.size()) + "\", the number of views held");

@@ -45,7 +45,7 @@ struct ActiveOptions {
   Method method = Method::kSaResgs;
   int initial_views = 4;
   int max_views = 20;
-  int interval = 100;             // iterations per view held
+  int interval = 100;  // iterations per view held
   // The loop's least total: the last phase trains what is left of it and never less than
   // its views x interval, so a run trains max(total_iterations, the phases' sum)
   // (`--min-iterations`; ActiveResult::iterations says what ran).
@@ -65,7 +65,8 @@ struct ActiveOptions {
   double hybrid_weight = 0.5;
   FisherCriterion hybrid_criterion = FisherCriterion::kLogDet;
   HybridCoverage hybrid_coverage = HybridCoverage::kFacility;
-  SurfaceCoverageOptions hybrid_surface{.grid = {.resolution = 64, .min_points = 2, .upsample = 2}, .stride = 4, .tolerance = 1};
+  SurfaceCoverageOptions hybrid_surface{
+      .grid = {.resolution = 64, .min_points = 2, .upsample = 2}, .stride = 4, .tolerance = 1};
   // The gated selectors (kmedian-fisher, fvs-fisher, adaptive): the fraction of the
   // candidates, best by the gate's spread score, that Fisher ranks (the paper's prefilter
   // keeps its top 20 %; the same cut here).
@@ -112,12 +113,21 @@ struct ActiveOptions {
 };
 
 // What an active run is doing; selection stages report per view or candidate handled.
-enum class ActivePhase { kTraining, kLifting, kPrefilter, kFisher, kExhaustiveFisher, kFinalEvaluation, kFinalFit, kFinalFitViews };
+enum class ActivePhase {
+  kTraining,
+  kLifting,
+  kPrefilter,
+  kFisher,
+  kExhaustiveFisher,
+  kFinalEvaluation,
+  kFinalFit,
+  kFinalFitViews
+};
 const char* toString(ActivePhase p);  // "training", "lifting", ...
 
 struct ActiveProgress {
   ActivePhase phase = ActivePhase::kTraining;
-  int phase_done = 0, phase_total = 0;      // within the phase: iterations, views or candidates
+  int phase_done = 0, phase_total = 0;  // within the phase: iterations, views or candidates
   int views = 0, max_views = 0;
   int iteration = 0, total_iterations = 0;  // over the whole run
   double loss = 0, psnr = 0;                // latest loss; PSNR after the last phase
@@ -144,9 +154,9 @@ struct ActiveResult {
   std::optional<FinalFit> final_fit_views;   // plain 3DGS on the same views (a copy of
                                              // final_fit when the method trains plainly)
   SelectionSeconds total_seconds;
-  int iterations = 0;  // training iterations over the whole run
+  int iterations = 0;                 // training iterations over the whole run
   std::vector<int> phase_iterations;  // per phase: k x interval for k views held, then the last
-  double seconds = 0;  // end to end, this process
+  double seconds = 0;                 // end to end, this process
 };
 
 // The gated selectors' gate (kmedian-fisher, fvs-fisher, adaptive): true when Fisher ranks
@@ -222,9 +232,9 @@ class ActiveRun {
   std::vector<int> initial_, selected_;
   std::vector<SelectionLog> steps_;
   int iterations_done_ = 0;
-  int observed_upto_ = 0;  // selected_[0..observed_upto_) are in the prefilter's grids
+  int observed_upto_ = 0;                                // selected_[0..observed_upto_) are in the prefilter's grids
   std::function<void(const ActiveProgress&)> progress_;  // during run()
-  ActiveProgress last_;                                   // what was last reported
+  ActiveProgress last_;                                  // what was last reported
   // Stepping state: begun, the current phase trained (and its seconds), the last phase
   // trained, the selection computed for the current phase.
   bool begun_ = false, phase_trained_ = false, finished_ = false;

@@ -38,7 +38,8 @@ std::optional<SparsificationCurves> sparsification(const std::vector<double>& er
   std::iota(by_u.begin(), by_u.end(), 0);
   std::iota(by_e.begin(), by_e.end(), 0);
   // Most uncertain (largest error) first: those are removed first.
-  std::stable_sort(by_u.begin(), by_u.end(), [&](std::size_t a, std::size_t b) { return uncertainty[a] > uncertainty[b]; });
+  std::stable_sort(by_u.begin(), by_u.end(),
+                   [&](std::size_t a, std::size_t b) { return uncertainty[a] > uncertainty[b]; });
   std::stable_sort(by_e.begin(), by_e.end(), [&](std::size_t a, std::size_t b) { return error[a] > error[b]; });
   SparsificationCurves c;
   c.by_uncertainty = curve(error, by_u, steps);

@@ -45,7 +45,8 @@ class SaPointPrefilter : public CoveragePrefilter {
 
   PrefilterRegime regime() const override {
     PrefilterRegime r{encodingName(config_.scoring), config_.resolution, config_.min_points, grids_->sceneCount(), {}};
-    if (config_.scoring.encoding == CoverageEncoding::Hashed) r.hash = hashLoad(grids_->sceneVoxels(), config_.scoring.table_size);
+    if (config_.scoring.encoding == CoverageEncoding::Hashed)
+      r.hash = hashLoad(grids_->sceneVoxels(), config_.scoring.table_size);
     return r;
   }
 
@@ -88,12 +89,14 @@ class SaPointPrefilter : public CoveragePrefilter {
   }
   void load(const std::string& bytes, const std::string& source) override {
     if (bytes.size() % sizeof(Eigen::Vector3d))
-      throw InputError(source, "points", "truncated: " + std::to_string(bytes.size()) + " bytes is not a whole number of points");
+      throw InputError(source, "points",
+                       "truncated: " + std::to_string(bytes.size()) + " bytes is not a whole number of points");
     observed_points_.resize(bytes.size() / sizeof(Eigen::Vector3d));
     // Vector3d is three packed doubles: the bytes are the points as save() wrote them.
     if (!bytes.empty()) std::memcpy(static_cast<void*>(observed_points_.data()), bytes.data(), bytes.size());
     for (std::size_t i = 0; i < observed_points_.size(); ++i)
-      if (!observed_points_[i].allFinite()) throw InputError(source, "points", "point " + std::to_string(i) + " is NaN or Inf");
+      if (!observed_points_[i].allFinite())
+        throw InputError(source, "points", "point " + std::to_string(i) + " is NaN or Inf");
     grids_->clearObserved();
     grids_->addObserved(observed_points_);
   }
@@ -152,9 +155,12 @@ LiftingSource parseLiftingSource(std::string_view text) {
 }
 const char* toString(LiftingSource s) {
   switch (s) {
-    case LiftingSource::kFlow: return "flow";
-    case LiftingSource::kDepth: return "depth";
-    case LiftingSource::kOracle: return "oracle";
+    case LiftingSource::kFlow:
+      return "flow";
+    case LiftingSource::kDepth:
+      return "depth";
+    case LiftingSource::kOracle:
+      return "oracle";
   }
   return "?";
 }
@@ -177,10 +183,12 @@ void parseCoverageEncoding(std::string_view text, CoverageScoring& scoring, int 
     scoring.table_size = 0;
     return;
   }
-  if (t.rfind("hash:", 0) != 0) throw std::invalid_argument("prefilter encoding '" + t + "': expected hash:auto, hash:K or exact");
+  if (t.rfind("hash:", 0) != 0)
+    throw std::invalid_argument("prefilter encoding '" + t + "': expected hash:auto, hash:K or exact");
   int bits = 0;
   const std::string digits = t.substr(5);
-  if (!digits.empty() && digits.size() <= 2 && std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
+  if (!digits.empty() && digits.size() <= 2 &&
+      std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
     bits = std::stoi(digits);
   if (bits < min_bits || bits > max_bits)
     throw std::invalid_argument("prefilter encoding '" + t + "': expected hash:auto, hash:" + std::to_string(min_bits) +
@@ -205,8 +213,9 @@ std::vector<int> topFraction(const std::vector<double>& scores, const std::vecto
     const double sa = std::isnan(scores[a]) ? -INFINITY : scores[a], sb = std::isnan(scores[b]) ? -INFINITY : scores[b];
     return sa != sb ? sa > sb : candidates[a] < candidates[b];
   });
-  const std::size_t k = std::clamp<std::size_t>(
-      static_cast<std::size_t>(std::ceil(fraction * static_cast<double>(scores.size()) - 1e-9)), 1, std::max<std::size_t>(1, scores.size()));
+  const std::size_t k =
+      std::clamp<std::size_t>(static_cast<std::size_t>(std::ceil(fraction * static_cast<double>(scores.size()) - 1e-9)),
+                              1, std::max<std::size_t>(1, scores.size()));
   std::vector<int> out;
   for (std::size_t i = 0; i < std::min(k, order.size()); ++i) out.push_back(candidates[order[i]]);
   std::sort(out.begin(), out.end());
@@ -214,7 +223,10 @@ std::vector<int> topFraction(const std::vector<double>& scores, const std::vecto
 }
 
 nlohmann::json toJson(const PrefilterRegime& r) {
-  nlohmann::json j = {{"encoding", r.encoding}, {"resolution", r.resolution}, {"min_points", r.min_points}, {"scene_voxels", r.scene_voxels}};
+  nlohmann::json j = {{"encoding", r.encoding},
+                      {"resolution", r.resolution},
+                      {"min_points", r.min_points},
+                      {"scene_voxels", r.scene_voxels}};
   if (r.hash) {
     j["table_size"] = r.hash->table_size;
     j["load_factor"] = r.hash->load;
@@ -247,7 +259,8 @@ std::optional<SceneType> sceneTypeOfDataset(const std::string& folder) {
   const std::string manifest = folder + "/manifest.json";
   if (folder.empty() || !std::filesystem::exists(manifest)) return std::nullopt;
   const nlohmann::json j = readJsonFile(manifest);
-  if (j.is_object() && j.contains("layout") && j["layout"].is_string()) return sceneTypeOfLayout(j["layout"].get<std::string>());
+  if (j.is_object() && j.contains("layout") && j["layout"].is_string())
+    return sceneTypeOfLayout(j["layout"].get<std::string>());
   return std::nullopt;
 }
 

@@ -90,8 +90,7 @@ std::string encodingName(const CoverageScoring& s);  // "exact" or "hash:K"
 
 // The top-N cut: the candidates in the top `fraction` (at least one) by score, in view
 // order; NaN scores rank last and ties go to the lower view index.
-std::vector<int> topFraction(const std::vector<double>& scores, const std::vector<int>& candidates,
-                             double fraction);
+std::vector<int> topFraction(const std::vector<double>& scores, const std::vector<int>& candidates, double fraction);
 
 // Builds candidate voxel sets of one kind on the static scene grid; the Embree tracer is
 // made on first use of the visible kind.

@@ -5,8 +5,7 @@
 
 namespace saresgs {
 
-std::vector<int> farthestPointSampling(const std::vector<Eigen::Vector3d>& centers, int count,
-                                       int first) {
+std::vector<int> farthestPointSampling(const std::vector<Eigen::Vector3d>& centers, int count, int first) {
   std::vector<int> chosen;
   if (centers.empty() || count <= 0) return chosen;
   if (first < 0 || first >= static_cast<int>(centers.size()))
@@ -15,8 +14,7 @@ std::vector<int> farthestPointSampling(const std::vector<Eigen::Vector3d>& cente
   int next = first;
   while (static_cast<int>(chosen.size()) < count && next >= 0) {
     chosen.push_back(next);
-    for (size_t i = 0; i < centers.size(); ++i)
-      dist[i] = std::min(dist[i], (centers[i] - centers[next]).squaredNorm());
+    for (size_t i = 0; i < centers.size(); ++i) dist[i] = std::min(dist[i], (centers[i] - centers[next]).squaredNorm());
     next = -1;
     double best = -1;
     for (size_t i = 0; i < centers.size(); ++i)

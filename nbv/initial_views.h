@@ -8,7 +8,6 @@ namespace saresgs {
 
 // Returns `count` indices into `centers` (fewer when there are fewer centres), the
 // first being `first`. Ties go to the lowest index, so the result is deterministic.
-std::vector<int> farthestPointSampling(const std::vector<Eigen::Vector3d>& centers, int count,
-                                       int first = 0);
+std::vector<int> farthestPointSampling(const std::vector<Eigen::Vector3d>& centers, int count, int first = 0);
 
 }  // namespace saresgs

@@ -12,7 +12,25 @@ namespace saresgs {
 struct SelectionStep;
 struct SelectionLog;
 
-enum class Method { kRandom, kFvs, kFisher, kCoverage, kSaHash, kSaResgs, kResgs, kFisherLogDet, kHybrid, kKmedian, kKmedianFisher, kFvsFisher, kAdaptive, kFisherKmedian, kOracle, kPathVariance, kCustom };
+enum class Method {
+  kRandom,
+  kFvs,
+  kFisher,
+  kCoverage,
+  kSaHash,
+  kSaResgs,
+  kResgs,
+  kFisherLogDet,
+  kHybrid,
+  kKmedian,
+  kKmedianFisher,
+  kFvsFisher,
+  kAdaptive,
+  kFisherKmedian,
+  kOracle,
+  kPathVariance,
+  kCustom
+};
 
 // What a method computes; everything else is left out of its run.
 struct MethodNeeds {

@@ -20,17 +20,25 @@ template <class T>
 T field(const nlohmann::json& j, const char* key, const std::string& source, const std::string& path) {
   const std::string name = jsonPath(path, key);
   const nlohmann::json& v = jsonMember(j, key, source, path);
-  if constexpr (std::is_same_v<T, std::string>) return jsonString(v, source, name);
-  else if constexpr (std::is_same_v<T, bool>) return jsonBool(v, source, name);
-  else if constexpr (std::is_same_v<T, double>) return jsonNumber(v, source, name);
+  if constexpr (std::is_same_v<T, std::string>)
+    return jsonString(v, source, name);
+  else if constexpr (std::is_same_v<T, bool>)
+    return jsonBool(v, source, name);
+  else if constexpr (std::is_same_v<T, double>)
+    return jsonNumber(v, source, name);
   else if constexpr (std::is_integral_v<T>)
-    return static_cast<T>(jsonInteger(v, source, name, 0, static_cast<long long>(std::min<std::uint64_t>(std::numeric_limits<T>::max(), std::numeric_limits<long long>::max()))));
-  else if constexpr (std::is_same_v<T, std::vector<std::string>>) return jsonStrings(v, source, name);
-  else if constexpr (std::is_same_v<T, std::vector<double>>) return jsonNumbers(v, source, name);
+    return static_cast<T>(jsonInteger(v, source, name, 0,
+                                      static_cast<long long>(std::min<std::uint64_t>(
+                                          std::numeric_limits<T>::max(), std::numeric_limits<long long>::max()))));
+  else if constexpr (std::is_same_v<T, std::vector<std::string>>)
+    return jsonStrings(v, source, name);
+  else if constexpr (std::is_same_v<T, std::vector<double>>)
+    return jsonNumbers(v, source, name);
   else {
     static_assert(std::is_same_v<T, std::vector<int>>);
     std::vector<int> out;
-    for (long long x : jsonIntegers(v, source, name, 0, std::numeric_limits<int>::max())) out.push_back(static_cast<int>(x));
+    for (long long x : jsonIntegers(v, source, name, 0, std::numeric_limits<int>::max()))
+      out.push_back(static_cast<int>(x));
     return out;
   }
 }

@@ -27,10 +27,10 @@ void readViews(const json& j, const std::string& src, const std::string& path, s
   for (std::size_t i = 0; i < j["views"].size(); ++i) {
     const std::string p = jsonPath(path, i);
     const json& v = j["views"][i];
-    out.push_back({field<std::string>(v, "name", src, p), field<double>(v, "psnr", src, p), field<double>(v, "ssim", src, p)});
+    out.push_back(
+        {field<std::string>(v, "name", src, p), field<double>(v, "psnr", src, p), field<double>(v, "ssim", src, p)});
   }
 }
-
 
 }  // namespace
 
@@ -59,8 +59,9 @@ RunReport makeRunReport(const Scene& scene, const ActiveOptions& opt, const Acti
   rep.ssim = r.test.ssim;
   rep.ause = r.ause;
   rep.initial_views = names(scene, r.initial_views);
-  rep.selected_views = names(scene, std::vector<int>(r.selected_views.begin() + static_cast<long>(r.initial_views.size()),
-                                                     r.selected_views.end()));
+  rep.selected_views = names(
+      scene,
+      std::vector<int>(r.selected_views.begin() + static_cast<long>(r.initial_views.size()), r.selected_views.end()));
   rep.selected_view_indices = r.selected_views;
   rep.seconds = r.total_seconds;
   rep.end_to_end_seconds = r.seconds;
@@ -73,8 +74,10 @@ RunReport makeRunReport(const Scene& scene, const ActiveOptions& opt, const Acti
   for (const SelectionLog& s : r.steps) rep.steps.push_back(stepReport(scene, s));
   auto fitReport = [&](const FinalFit& x) {
     FinalFitReport f{x.iterations, x.residual, x.test.psnr, x.test.ssim, {}, {}};
-    for (const ViewMetrics& m : x.test.views) f.views.push_back({scene.views.at(static_cast<std::size_t>(m.view)).name, m.psnr, m.ssim});
-    for (const ViewMetrics& m : x.path) f.path.push_back({scene.views.at(static_cast<std::size_t>(m.view)).name, m.psnr});
+    for (const ViewMetrics& m : x.test.views)
+      f.views.push_back({scene.views.at(static_cast<std::size_t>(m.view)).name, m.psnr, m.ssim});
+    for (const ViewMetrics& m : x.path)
+      f.path.push_back({scene.views.at(static_cast<std::size_t>(m.view)).name, m.psnr});
     return f;
   };
   if (r.final_fit) rep.final_fit = fitReport(*r.final_fit);
@@ -174,7 +177,8 @@ RunReport runReportFromJson(const json& j, const std::string& src) {
   r.threads = field<int>(j, "threads", src, "");
   readViews(j, src, "views", r.views);
   const json& steps = jsonArray(jsonMember(j, "steps", src, ""), src, "steps");
-  for (std::size_t i = 0; i < steps.size(); ++i) r.steps.push_back(stepReportFromJson(steps[i], src, jsonPath("steps", i)));
+  for (std::size_t i = 0; i < steps.size(); ++i)
+    r.steps.push_back(stepReportFromJson(steps[i], src, jsonPath("steps", i)));
   auto readFit = [&](const char* name) {
     const json& f = j[name];
     FinalFitReport ff;
@@ -187,13 +191,16 @@ RunReport runReportFromJson(const json& j, const std::string& src) {
       const std::string at = std::string(name) + ".path";
       const json& path = jsonArray(f["path"], src, at);
       for (std::size_t i = 0; i < path.size(); ++i)
-        ff.path.push_back({field<std::string>(path[i], "name", src, jsonPath(at, i)), field<double>(path[i], "psnr", src, jsonPath(at, i))});
+        ff.path.push_back({field<std::string>(path[i], "name", src, jsonPath(at, i)),
+                           field<double>(path[i], "psnr", src, jsonPath(at, i))});
     }
     return ff;
   };
   if (j.contains("final_fit")) r.final_fit = readFit("final_fit");
-  if (j.contains("final_fit_views")) r.final_fit_views = readFit("final_fit_views");
-  else if (r.final_fit && !r.final_fit->residual) r.final_fit_views = r.final_fit;  // written before it was recorded
+  if (j.contains("final_fit_views"))
+    r.final_fit_views = readFit("final_fit_views");
+  else if (r.final_fit && !r.final_fit->residual)
+    r.final_fit_views = r.final_fit;  // written before it was recorded
   if (j.contains("replay_of")) r.replay_of = field<std::string>(j, "replay_of", src, "");
   if (j.contains("prefilter_regime")) r.prefilter_regime = jsonObject(j["prefilter_regime"], src, "prefilter_regime");
   if (j.contains("frame")) r.frame = sceneFrameFromJson(j["frame"], src, "frame");

@@ -56,8 +56,8 @@ struct RunReport {
   std::string dataset, method, preset;
   std::uint64_t seed = 0;
   RunOptionsReport options;
-  double psnr = 0, ssim = 0;       // mean over the test views (the paper's in-loop model)
-  std::optional<double> ause;      // none without ground-truth depth
+  double psnr = 0, ssim = 0;   // mean over the test views (the paper's in-loop model)
+  std::optional<double> ause;  // none without ground-truth depth
   std::vector<std::string> initial_views;
   std::vector<std::string> selected_views;  // the views added after the initial ones
   std::vector<int> selected_view_indices;   // every view held at the end, initial first

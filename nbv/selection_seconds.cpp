@@ -18,15 +18,16 @@ SelectionSeconds& SelectionSeconds::operator+=(const SelectionSeconds& o) {
 }
 
 nlohmann::json toJson(const SelectionSeconds& s) {
-  return {{"lifting", s.lifting},   {"triangulation", s.triangulation}, {"prefilter", s.prefilter},
-          {"fisher", s.fisher},     {"training", s.training},           {"exhaustive_fisher", s.exhaustive_fisher},
+  return {{"lifting", s.lifting},  {"triangulation", s.triangulation}, {"prefilter", s.prefilter},
+          {"fisher", s.fisher},    {"training", s.training},           {"exhaustive_fisher", s.exhaustive_fisher},
           {"coverage", s.coverage}};
 }
 
 SelectionSeconds secondsFrom(const nlohmann::json& j, const std::string& file, const std::string& field) {
   SelectionSeconds s;
   auto stage = [&](const char* key) {
-    return jsonNumberIn(jsonMember(j, key, file, field), file, jsonPath(field, key), 0, std::numeric_limits<double>::max());
+    return jsonNumberIn(jsonMember(j, key, file, field), file, jsonPath(field, key), 0,
+                        std::numeric_limits<double>::max());
   };
   s.lifting = stage("lifting");
   s.triangulation = stage("triangulation");

@@ -47,17 +47,15 @@ int selectOracleView(SelectionStep& step, SelectionLog& log) {
 
 int selectPathVarianceView(SelectionStep& step, SelectionLog& log) {
   const auto t0 = Clock::now();
-  std::vector<double> scores = pathVarianceScores(
-      step.trainer.gaussians(), step.trainer.rasterSettings(), step.scene, step.held, step.candidates,
-      {step.options.fisher_lambda, step.options.path_variance_kappa},
-      [&step](int done, int total) { step.report(ActivePhase::kFisher, done, total); });
+  std::vector<double> scores =
+      pathVarianceScores(step.trainer.gaussians(), step.trainer.rasterSettings(), step.scene, step.held,
+                         step.candidates, {step.options.fisher_lambda, step.options.path_variance_kappa},
+                         [&step](int done, int total) { step.report(ActivePhase::kFisher, done, total); });
   log.seconds.fisher += secondsSince(t0);
   return best(step.candidates, std::move(scores), log);
 }
 
-int selectCoverageView(SelectionStep& step, SelectionLog& log) {
-  return best(step.candidates, step.coverage, log);
-}
+int selectCoverageView(SelectionStep& step, SelectionLog& log) { return best(step.candidates, step.coverage, log); }
 
 int selectFisherView(SelectionStep& step, SelectionLog& log) {
   const ActiveOptions& o = step.options;
@@ -68,8 +66,9 @@ int selectFisherView(SelectionStep& step, SelectionLog& log) {
   const FisherCriterion criterion = o.method == Method::kFisherLogDet ? FisherCriterion::kLogDet
                                     : o.method == Method::kHybrid     ? o.hybrid_criterion
                                                                       : FisherCriterion::kTrace;
-  log.scores = fisherScores(step.trainer.gaussians(), s, step.scene, step.held, pool, o.fisher_lambda,
-                            [&step](int done, int total) { step.report(ActivePhase::kFisher, done, total); }, criterion);
+  log.scores = fisherScores(
+      step.trainer.gaussians(), s, step.scene, step.held, pool, o.fisher_lambda,
+      [&step](int done, int total) { step.report(ActivePhase::kFisher, done, total); }, criterion);
   log.seconds.fisher += secondsSince(t0);
   if (o.method == Method::kFisherKmedian) {
     // Fisher scored every candidate; the k-median gain over them, each weighted by its score
@@ -87,10 +86,12 @@ int selectFisherView(SelectionStep& step, SelectionLog& log) {
     log.fisher_scores = log.scores;
     if (step.surface) {
       step.surface->observe(step.held);
-      log.new_surface = o.hybrid_coverage == HybridCoverage::kFacility ? step.surface->facilityGain(pool, step.scene.train)
-                                                                       : step.surface->newSurface(pool);
+      log.new_surface = o.hybrid_coverage == HybridCoverage::kFacility
+                            ? step.surface->facilityGain(pool, step.scene.train)
+                            : step.surface->newSurface(pool);
     } else {
-      log.view_distance = farthestViewScores(step.scene, step.held, pool, ViewDistance::kEuclidean, Eigen::Vector3d::Zero());
+      log.view_distance =
+          farthestViewScores(step.scene, step.held, pool, ViewDistance::kEuclidean, Eigen::Vector3d::Zero());
     }
     log.scores = hybridScores(log.fisher_scores, step.surface ? log.new_surface : log.view_distance, o.hybrid_weight);
     log.seconds.coverage += secondsSince(t0);

@@ -17,11 +17,11 @@ struct SelectionStep {
   const Trainer& trainer;
   const ActiveOptions& options;
   const std::vector<int>& held;
-  const std::vector<int>& candidates;  // every train view not held
-  std::vector<int> pool;               // what Fisher ranks: the candidates, or the prefilter's cut
+  const std::vector<int>& candidates;   // every train view not held
+  std::vector<int> pool;                // what Fisher ranks: the candidates, or the prefilter's cut
   const std::vector<double>& coverage;  // the prefilter's score per candidate (coverage methods), else empty
   std::mt19937_64& rng;
-  SurfaceCoverage* surface;            // the hybrid's visible-surface sets, when it uses them
+  SurfaceCoverage* surface;  // the hybrid's visible-surface sets, when it uses them
   std::function<void(ActivePhase, int, int)> report;
 };
 

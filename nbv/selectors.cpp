@@ -89,14 +89,17 @@ double captureClustering(const Scene& scene, int k) {
 }
 
 std::vector<double> kmedianGains(const Scene& scene, const std::vector<int>& chosen, const std::vector<int>& candidates,
-                                 const std::vector<int>& population, double angle_scale, const std::vector<double>& weights) {
+                                 const std::vector<int>& population, double angle_scale,
+                                 const std::vector<double>& weights) {
   if (!(angle_scale >= 0) || !std::isfinite(angle_scale))
-    throw std::invalid_argument("kmedianGains: angle scale " + std::to_string(angle_scale) + " is not a finite value >= 0");
+    throw std::invalid_argument("kmedianGains: angle scale " + std::to_string(angle_scale) +
+                                " is not a finite value >= 0");
   if (!weights.empty() && weights.size() != population.size())
     throw std::invalid_argument("kmedianGains: " + std::to_string(weights.size()) + " weights for a population of " +
                                 std::to_string(population.size()));
   for (double w : weights)
-    if (!(w >= 0) || !std::isfinite(w)) throw std::invalid_argument("kmedianGains: weight " + std::to_string(w) + " is not finite and >= 0");
+    if (!(w >= 0) || !std::isfinite(w))
+      throw std::invalid_argument("kmedianGains: weight " + std::to_string(w) + " is not finite and >= 0");
   auto d = [&](int a, int b) { return poseDistance(scene.views.at(a).camera, scene.views.at(b).camera, angle_scale); };
   std::vector<double> near(population.size(), 0.0);
   for (std::size_t i = 0; i < population.size(); ++i) {
@@ -119,8 +122,8 @@ std::vector<double> kmedianGains(const Scene& scene, const std::vector<int>& cho
 }
 
 std::vector<double> fisherScores(const Gaussians& g, const RasterSettings& s, const Scene& scene,
-                                 const std::vector<int>& chosen, const std::vector<int>& candidates,
-                                 double lambda, const std::function<void(int, int)>& tick, FisherCriterion criterion) {
+                                 const std::vector<int>& chosen, const std::vector<int>& candidates, double lambda,
+                                 const std::function<void(int, int)>& tick, FisherCriterion criterion) {
   Gaussians H = g.zerosLike();
   for (int v : chosen) addViewInformation(g, scene.views.at(v).camera, s, H);
   Gaussians Hv = g.zerosLike();

@@ -19,9 +19,9 @@ struct StepReport {
   double progress_psnr = 0;  // on the progress test views, before selection
   SelectionSeconds seconds;
   std::string selected;
-  std::vector<std::string> candidates;   // what the final scorer saw
-  std::vector<double> scores;            // their scores
-  std::vector<std::string> prefiltered;  // coverage methods: the kept top N %
+  std::vector<std::string> candidates;                            // what the final scorer saw
+  std::vector<double> scores;                                     // their scores
+  std::vector<std::string> prefiltered;                           // coverage methods: the kept top N %
   std::vector<double> fisher_scores, new_surface, view_distance;  // hybrid: its evidence
 };
 

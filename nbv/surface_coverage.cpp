@@ -11,7 +11,9 @@ namespace {
 
 OccupancyGrids sceneGrid(const Scene& scene, const OccupancyOptions& o) {
   if (scene.points.empty())
-    throw InputError(scene.source, "points", "the hybrid selector (the default --method) needs sparse SfM points for its surface coverage (points3D or points3d.ply); give the dataset points, or choose --method fisher or fvs");
+    throw InputError(scene.source, "points",
+                     "the hybrid selector (the default --method) needs sparse SfM points for its surface coverage "
+                     "(points3D or points3d.ply); give the dataset points, or choose --method fisher or fvs");
   std::vector<Eigen::Vector3d> pts;
   pts.reserve(scene.points.size());
   for (const auto& p : scene.points) pts.push_back(p.xyz);
@@ -33,7 +35,8 @@ std::size_t SurfaceCoverage::surfaceCount() const { return grids_->sceneCount();
 const VoxelSet& SurfaceCoverage::visible(int view) const {
   auto it = cache_.find(view);
   if (it == cache_.end())
-    it = cache_.emplace(view, tracer_->visibleSet(scene_.views.at(static_cast<std::size_t>(view)).camera, opt_.stride)).first;
+    it = cache_.emplace(view, tracer_->visibleSet(scene_.views.at(static_cast<std::size_t>(view)).camera, opt_.stride))
+             .first;
   return it->second;
 }
 
@@ -56,7 +59,8 @@ double SurfaceCoverage::similarity(int a, int b) const {
   return j;
 }
 
-std::vector<double> SurfaceCoverage::facilityGain(const std::vector<int>& candidates, const std::vector<int>& population) const {
+std::vector<double> SurfaceCoverage::facilityGain(const std::vector<int>& candidates,
+                                                  const std::vector<int>& population) const {
   std::vector<double> covered(population.size(), 0.0);
   for (std::size_t i = 0; i < population.size(); ++i)
     for (int s : held_) covered[i] = std::max(covered[i], similarity(population[i], s));
@@ -64,7 +68,8 @@ std::vector<double> SurfaceCoverage::facilityGain(const std::vector<int>& candid
   out.reserve(candidates.size());
   for (int x : candidates) {
     double gain = 0;  // summed in population order: deterministic
-    for (std::size_t i = 0; i < population.size(); ++i) gain += std::max(0.0, similarity(population[i], x) - covered[i]);
+    for (std::size_t i = 0; i < population.size(); ++i)
+      gain += std::max(0.0, similarity(population[i], x) - covered[i]);
     out.push_back(gain);
   }
   return out;

@@ -146,8 +146,10 @@ GridPageResult writeGridPage(const std::string& grid_dir, const GridPageOptions&
   for (const fs::path& p : md) {
     nlohmann::json blocks = nlohmann::json::array();
     for (const MarkdownBlock& b : parseMarkdown(readText(p))) {
-      if (b.kind == MarkdownBlock::Kind::kHeading) blocks.push_back({{"heading", b.text}, {"level", b.level}});
-      else if (b.kind == MarkdownBlock::Kind::kParagraph) blocks.push_back({{"text", b.text}});
+      if (b.kind == MarkdownBlock::Kind::kHeading)
+        blocks.push_back({{"heading", b.text}, {"level", b.level}});
+      else if (b.kind == MarkdownBlock::Kind::kParagraph)
+        blocks.push_back({{"text", b.text}});
       else {
         blocks.push_back({{"table", b.rows}});
         ++res.tables;
@@ -163,17 +165,20 @@ GridPageResult writeGridPage(const std::string& grid_dir, const GridPageOptions&
   std::sort(job_dirs.begin(), job_dirs.end());
   // links relative to where the page is written, so that they work from any --out
   const fs::path page_dir = fs::absolute(fs::path(res.path)).parent_path();
-  const auto link = [&](const fs::path& file) { return fs::absolute(file).lexically_normal().lexically_relative(page_dir).generic_string(); };
+  const auto link = [&](const fs::path& file) {
+    return fs::absolute(file).lexically_normal().lexically_relative(page_dir).generic_string();
+  };
   nlohmann::json jobs = nlohmann::json::array();
   // scene -> method label -> views -> progress PSNRs over seeds
   std::map<std::string, std::map<std::string, std::map<int, std::vector<double>>>> curves;
   for (const fs::path& jd : job_dirs) {
     const std::string name = jd.filename().string();
     const JobName jn = splitJob(name);
-    nlohmann::json j = {{"name", name}, {"scene", jn.scene}, {"method", jn.method}, {"variant", jn.variant},
-                        {"seed", jn.seed}};
+    nlohmann::json j = {
+        {"name", name}, {"scene", jn.scene}, {"method", jn.method}, {"variant", jn.variant}, {"seed", jn.seed}};
     // an active job's results.json, a prefilter sweep's sweep.json
-    const fs::path rp = fs::exists(jd / "sweep.json") && !fs::exists(jd / "results.json") ? jd / "sweep.json" : jd / "results.json";
+    const fs::path rp =
+        fs::exists(jd / "sweep.json") && !fs::exists(jd / "results.json") ? jd / "sweep.json" : jd / "results.json";
     if (!fs::exists(rp)) {
       j["status"] = fs::exists(jd / "checkpoint.json") ? "running or interrupted" : "not started";
       jobs.push_back(std::move(j));
@@ -221,7 +226,8 @@ GridPageResult writeGridPage(const std::string& grid_dir, const GridPageOptions&
     const std::string label = jn.variant.empty() || jn.variant == "default" ? jn.method : jn.method + " " + jn.variant;
     if (r["steps"].is_array())
       for (const auto& s : r["steps"])
-        if (s.is_object() && s.contains("views_before") && s.contains("progress_psnr") && s["progress_psnr"].is_number())
+        if (s.is_object() && s.contains("views_before") && s.contains("progress_psnr") &&
+            s["progress_psnr"].is_number())
           curves[jn.scene][label][s["views_before"].get<int>()].push_back(s["progress_psnr"].get<double>());
     jobs.push_back(std::move(j));
   }
@@ -248,14 +254,19 @@ GridPageResult writeGridPage(const std::string& grid_dir, const GridPageOptions&
     for (const auto& e : fs::directory_iterator(dir / "plots"))
       if (e.path().extension() == ".png") pngs.push_back(e.path());
   std::sort(pngs.begin(), pngs.end());
-  for (const fs::path& p : pngs) plots.push_back({{"name", p.stem().string()}, {"src", dataUrl("image/png", readText(p))}});
+  for (const fs::path& p : pngs)
+    plots.push_back({{"name", p.stem().string()}, {"src", dataUrl("image/png", readText(p))}});
 
   fs::path named = fs::absolute(dir).lexically_normal();
   if (named.filename().empty()) named = named.parent_path();
-  nlohmann::json data = {{"kind", "grid"},       {"title", "grid " + named.filename().string()},
-                         {"grid_dir", dir.string()}, {"tables", tables},
-                         {"jobs", jobs},         {"curves", curve_json},
-                         {"plots", plots},       {"problems", res.problems}};
+  nlohmann::json data = {{"kind", "grid"},
+                         {"title", "grid " + named.filename().string()},
+                         {"grid_dir", dir.string()},
+                         {"tables", tables},
+                         {"jobs", jobs},
+                         {"curves", curve_json},
+                         {"plots", plots},
+                         {"problems", res.problems}};
   PageParts parts;
   parts.title = "saresgs report: " + data["title"].get<std::string>();
   parts.data = std::move(data);

@@ -35,8 +35,8 @@ std::vector<std::string> jobNameParts(const std::string& name);
 // (a table's cells trimmed, its alignment row dropped). Exposed for its tests.
 struct MarkdownBlock {
   enum class Kind { kHeading, kParagraph, kTable } kind = Kind::kParagraph;
-  int level = 0;     // headings: the number of '#'
-  std::string text;  // headings and paragraphs
+  int level = 0;                               // headings: the number of '#'
+  std::string text;                            // headings and paragraphs
   std::vector<std::vector<std::string>> rows;  // tables: the header first
 };
 std::vector<MarkdownBlock> parseMarkdown(const std::string& text);

@@ -44,10 +44,14 @@ std::string jsonForScript(const nlohmann::json& j) {
   out.reserve(text.size());
   for (char c : text) {
     // these occur only inside JSON strings, where the escape means the same character
-    if (c == '<') out += "\\u003c";
-    else if (c == '>') out += "\\u003e";
-    else if (c == '&') out += "\\u0026";
-    else out += c;
+    if (c == '<')
+      out += "\\u003c";
+    else if (c == '>')
+      out += "\\u003e";
+    else if (c == '&')
+      out += "\\u0026";
+    else
+      out += c;
   }
   return out;
 }
@@ -57,12 +61,23 @@ std::string htmlEscape(std::string_view s) {
   out.reserve(s.size());
   for (char c : s) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&#39;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&#39;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -70,9 +85,12 @@ std::string htmlEscape(std::string_view s) {
 
 ViewerScript findViewerScript(const std::string& explicit_path) {
   ViewerScript v;
-  if (!explicit_path.empty()) v.path = explicit_path;
-  else if (const char* env = std::getenv("SARESGS_REPORT_VIEWER"); env && *env) v.path = env;
-  else v.path = SARESGS_REPORT_VIEWER_DEFAULT;
+  if (!explicit_path.empty())
+    v.path = explicit_path;
+  else if (const char* env = std::getenv("SARESGS_REPORT_VIEWER"); env && *env)
+    v.path = env;
+  else
+    v.path = SARESGS_REPORT_VIEWER_DEFAULT;
   std::ifstream in(v.path, std::ios::binary);
   if (!in) return v;
   std::ostringstream s;

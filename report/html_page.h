@@ -38,9 +38,9 @@ struct ViewerScript {
 ViewerScript findViewerScript(const std::string& explicit_path = "");
 
 struct PageParts {
-  std::string title;        // plain text
-  nlohmann::json data;      // what app.js draws, as window.SARESGS_DATA-like JSON
-  std::string model_base64; // the model's bytes for the viewer, or empty
+  std::string title;          // plain text
+  nlohmann::json data;        // what app.js draws, as window.SARESGS_DATA-like JSON
+  std::string model_base64;   // the model's bytes for the viewer, or empty
   std::string viewer_script;  // ViewerScript::script, or empty (the page says so)
 };
 // The whole page. The viewer script is inlined as is except that any "</script" in it is

@@ -43,8 +43,7 @@ std::string readBytes(const fs::path& p) {
 
 // A perceptual dark-to-bright ramp (black, purple, red, orange, pale yellow) for errors.
 std::array<std::uint8_t, 3> ramp(float u) {
-  static constexpr float kStops[5][3] = {
-      {0, 0, 4}, {87, 16, 110}, {188, 55, 84}, {249, 142, 9}, {252, 255, 164}};
+  static constexpr float kStops[5][3] = {{0, 0, 4}, {87, 16, 110}, {188, 55, 84}, {249, 142, 9}, {252, 255, 164}};
   u = std::clamp(u, 0.0f, 1.0f) * 4.0f;
   const int k = std::min(3, static_cast<int>(u));
   const float f = u - static_cast<float>(k);
@@ -69,7 +68,8 @@ Image8 errorImage(const ImageF& render, const Image8& truth) {
 
 Image8 forDisplay(const Image8& img) {
   if (img.width <= kMaxPictureWidth) return img;
-  const int h = std::max(1, static_cast<int>(std::lround(static_cast<double>(img.height) * kMaxPictureWidth / img.width)));
+  const int h =
+      std::max(1, static_cast<int>(std::lround(static_cast<double>(img.height) * kMaxPictureWidth / img.width)));
   return resizeImage(img, kMaxPictureWidth, h);
 }
 
@@ -82,9 +82,17 @@ nlohmann::json cameraJson(const Camera& c, const std::string& name, const std::s
                           bool train) {
   nlohmann::json R = nlohmann::json::array();
   for (int r = 0; r < 3; ++r) R.push_back({c.R(r, 0), c.R(r, 1), c.R(r, 2)});
-  nlohmann::json j = {{"name", name}, {"role", role},     {"width", c.K.width}, {"height", c.K.height},
-                      {"fx", c.K.fx}, {"fy", c.K.fy},     {"cx", c.K.cx},       {"cy", c.K.cy},
-                      {"R", R},       {"t", {c.t.x(), c.t.y(), c.t.z()}}, {"train", train}};
+  nlohmann::json j = {{"name", name},
+                      {"role", role},
+                      {"width", c.K.width},
+                      {"height", c.K.height},
+                      {"fx", c.K.fx},
+                      {"fy", c.K.fy},
+                      {"cx", c.K.cx},
+                      {"cy", c.K.cy},
+                      {"R", R},
+                      {"t", {c.t.x(), c.t.y(), c.t.z()}},
+                      {"train", train}};
   j["order"] = order ? nlohmann::json(*order) : nlohmann::json();
   return j;
 }
@@ -102,8 +110,9 @@ std::optional<Model> loadModel(const fs::path& dir, const RunReport& rep, std::v
   for (const auto& [file, which] : order) {
     const fs::path p = dir / file;
     if (!fs::exists(p)) {
-      missing.push_back(file + " is missing" +
-                        (file == "final_fit.ply" ? std::string(": the page shows the in-loop model instead") : std::string()));
+      missing.push_back(
+          file + " is missing" +
+          (file == "final_fit.ply" ? std::string(": the page shows the in-loop model instead") : std::string()));
       continue;
     }
     try {
@@ -141,7 +150,8 @@ nlohmann::json gridSiblingCurves(const fs::path& dir) {
       for (const auto& st : r.at("steps")) pts.push_back({st.at("views_before"), st.at("progress_psnr")});
       const std::string label = theirs[2] == "default" ? theirs[1] : theirs[1] + " " + theirs[2];
       nlohmann::json final_psnr;
-      if (r.contains("final_fit") && r["final_fit"].is_object()) final_psnr = r["final_fit"].value("psnr", nlohmann::json());
+      if (r.contains("final_fit") && r["final_fit"].is_object())
+        final_psnr = r["final_fit"].value("psnr", nlohmann::json());
       out.push_back({{"name", label}, {"job", p.filename().string()}, {"points", pts}, {"final", final_psnr}});
     } catch (const std::exception&) {
       // a sibling that cannot be read is left out of the curve; the grid page lists it
@@ -156,7 +166,8 @@ std::optional<Scene> loadRunDataset(const fs::path& dir, const nlohmann::json& r
   if (const auto* bg = results.is_object() && results.contains("background") ? &results["background"] : nullptr;
       bg && bg->is_object() && bg->contains("color") && (*bg)["color"].is_array() && (*bg)["color"].size() == 3) {
     BackgroundChoice b;
-    for (int c = 0; c < 3; ++c) b.color[static_cast<std::size_t>(c)] = (*bg)["color"][static_cast<std::size_t>(c)].get<float>();
+    for (int c = 0; c < 3; ++c)
+      b.color[static_cast<std::size_t>(c)] = (*bg)["color"][static_cast<std::size_t>(c)].get<float>();
     b.random = bg->value("random", false);
     dopt.background = b;
   }
@@ -194,7 +205,8 @@ RunPageResult writeRunPage(const std::string& run_dir, const Scene* given, const
       throw InputError(results_path.string(), "file",
                        "missing: the run was interrupted before its end (checkpoint.json is there); finish it with "
                        "`saresgs active ... --resume` and report again");
-    throw InputError(results_path.string(), "file", "missing: expected the results.json `saresgs active` writes at its end");
+    throw InputError(results_path.string(), "file",
+                     "missing: expected the results.json `saresgs active` writes at its end");
   }
   const nlohmann::json results = readJsonFile(results_path.string());
   const RunReport rep = runReportFromJson(results, results_path.string());
@@ -204,7 +216,8 @@ RunPageResult writeRunPage(const std::string& run_dir, const Scene* given, const
   std::vector<std::string>& missing = res.missing;
   nlohmann::json notes = nlohmann::json::array();
   if (!rep.final_fit)
-    notes.push_back("This run made no final fit (--final-iterations 0): the model shown is the one trained in the loop.");
+    notes.push_back(
+        "This run made no final fit (--final-iterations 0): the model shown is the one trained in the loop.");
 
   std::optional<Model> model = loadModel(dir, rep, missing);
 
@@ -218,7 +231,8 @@ RunPageResult writeRunPage(const std::string& run_dir, const Scene* given, const
 
   // Cameras, in world coordinates, with their role in the run.
   std::map<std::string, int> chosen_order;
-  for (std::size_t k = 0; k < rep.selected_views.size(); ++k) chosen_order[rep.selected_views[k]] = static_cast<int>(k + 1);
+  for (std::size_t k = 0; k < rep.selected_views.size(); ++k)
+    chosen_order[rep.selected_views[k]] = static_cast<int>(k + 1);
   std::map<std::string, bool> initial, test;
   for (const std::string& n : rep.initial_views) initial[n] = true;
   for (const ViewReport& v : rep.views) test[v.name] = true;
@@ -234,9 +248,12 @@ RunPageResult writeRunPage(const std::string& run_dir, const Scene* given, const
       const Camera w = scene->frame.toWorld(v.camera);
       std::string role = "candidate";
       std::optional<int> order;
-      if (initial.count(v.name)) role = "initial";
-      else if (auto it = chosen_order.find(v.name); it != chosen_order.end()) role = "chosen", order = it->second;
-      else if (test.count(v.name)) role = "test";
+      if (initial.count(v.name))
+        role = "initial";
+      else if (auto it = chosen_order.find(v.name); it != chosen_order.end())
+        role = "chosen", order = it->second;
+      else if (test.count(v.name))
+        role = "test";
       cameras.push_back(cameraJson(w, v.name, role, order, is_train[i]));
     }
   }
@@ -320,7 +337,9 @@ RunPageResult writeRunPage(const std::string& run_dir, const Scene* given, const
   nlohmann::json model_info;
   std::string model_bytes;
   if (model) {
-    model_info = {{"file", model->file}, {"which", model->which}, {"gaussians", model->g.size()},
+    model_info = {{"file", model->file},
+                  {"which", model->which},
+                  {"gaussians", model->g.size()},
                   {"sh_degree", model->g.max_sh_degree}};
     std::string ply = readBytes(dir / model->file);
     if (ply.size() <= o.model_budget_bytes) {
@@ -330,14 +349,16 @@ RunPageResult writeRunPage(const std::string& run_dir, const Scene* given, const
     } else {
       Gaussians g = model->g;
       std::size_t keep = std::min(g.size(), o.model_budget_bytes / kSplatRecordBytes);
-      std::string note = "the .ply (" + std::to_string(ply.size() >> 20) +
-                         " MB) is larger than the page's budget: shown as a .splat (degree-0 colour, 8-bit colour, opacity "
-                         "and rotation)";
+      std::string note =
+          "the .ply (" + std::to_string(ply.size() >> 20) +
+          " MB) is larger than the page's budget: shown as a .splat (degree-0 colour, 8-bit colour, opacity "
+          "and rotation)";
       if (keep < g.size()) {
         // the most opaque Gaussians, in the model's order
         std::vector<std::size_t> idx(g.size());
         std::iota(idx.begin(), idx.end(), std::size_t{0});
-        std::stable_sort(idx.begin(), idx.end(), [&](std::size_t a, std::size_t b) { return g.opacities[a] > g.opacities[b]; });
+        std::stable_sort(idx.begin(), idx.end(),
+                         [&](std::size_t a, std::size_t b) { return g.opacities[a] > g.opacities[b]; });
         idx.resize(keep);
         std::sort(idx.begin(), idx.end());
         Gaussians t;
@@ -353,7 +374,8 @@ RunPageResult writeRunPage(const std::string& run_dir, const Scene* given, const
           std::copy_n(&g.sh[3 * k * i], 3 * k, &t.sh[3 * k * n]);
         }
         g = std::move(t);
-        note += ", and only its " + std::to_string(keep) + " most opaque Gaussians of " + std::to_string(model->g.size());
+        note +=
+            ", and only its " + std::to_string(keep) + " most opaque Gaussians of " + std::to_string(model->g.size());
       }
       model_bytes = splatFileBytes(g);
       model_info["format"] = "splat";

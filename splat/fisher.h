@@ -95,7 +95,8 @@ double unseenShare(const GaussiansT<T>& Hv, const GaussiansT<T>& H, double lambd
     return std::any_of(h.begin(), h.end(), [](T x) { return x > T(0); }) ? c : std::numeric_limits<double>::infinity();
   };
   GroupDamping cut = relativeDamping(H, rel, 0.0);
-  cut = {cutOf(H.means, cut.means), cutOf(H.log_scales, cut.log_scales), cutOf(H.opacities, cut.opacities), cutOf(H.sh, cut.sh)};
+  cut = {cutOf(H.means, cut.means), cutOf(H.log_scales, cut.log_scales), cutOf(H.opacities, cut.opacities),
+         cutOf(H.sh, cut.sh)};
   double unseen = 0, all = 0;
   auto add = [&](const std::vector<T>& v, const std::vector<T>& h, double threshold) {
     for (std::size_t k = 0; k < v.size(); ++k)
@@ -122,7 +123,8 @@ double unseenShare(const GaussiansT<T>& Hv, const GaussiansT<T>& H, double lambd
 // near-duplicates of held views and views of what nobody will look at score low.
 // Rotations excluded, as in fisherScore; double, fixed order.
 template <typename T>
-double pathVarianceScore(const GaussiansT<T>& Hc, const GaussiansT<T>& H, const GaussiansT<T>& W, const GroupDamping& l) {
+double pathVarianceScore(const GaussiansT<T>& Hc, const GaussiansT<T>& H, const GaussiansT<T>& W,
+                         const GroupDamping& l) {
   double score = 0;
   auto add = [&](const std::vector<T>& c, const std::vector<T>& h, const std::vector<T>& w, double lambda) {
     for (std::size_t k = 0; k < c.size(); ++k)

@@ -11,8 +11,7 @@ namespace saresgs {
 // The squared-gradient pass reads the render's state (final transmittance, walk lengths),
 // never its depth or contributor counts, so the render leaves them out.
 template <typename T>
-void addViewInformationT(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& settings,
-                         GaussiansT<T>& H) {
+void addViewInformationT(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& settings, GaussiansT<T>& H) {
   RasterSettings s = settings;
   s.depth_and_contributors = false;
   const RenderOutputT<T> fwd = rasterizeT(g, cam, s);

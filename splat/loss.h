@@ -23,11 +23,9 @@ struct LossResult {
 };
 
 // Throws std::invalid_argument when the images are empty or differ in shape.
-LossResult photometricLoss(const ImageF& render, const ImageF& target, double lambda_ssim = 0.2,
-                           bool want_grad = true);
+LossResult photometricLoss(const ImageF& render, const ImageF& target, double lambda_ssim = 0.2, bool want_grad = true);
 // The same into `into`, whose gradient image is reused (no allocation once it has held
 // one this large).
-void photometricLoss(const ImageF& render, const ImageF& target, double lambda_ssim, bool want_grad,
-                     LossResult& into);
+void photometricLoss(const ImageF& render, const ImageF& target, double lambda_ssim, bool want_grad, LossResult& into);
 
 }  // namespace saresgs

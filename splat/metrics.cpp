@@ -41,8 +41,7 @@ double ssim(const ImageF& a, const ImageF& b) {
     x[i] = clamp01(a.data[i]);
     y[i] = clamp01(b.data[i]);
   }
-  const SsimL1Sums s =
-      ssimL1(x.data(), y.data(), a.width, a.height, a.channels, nullptr, 0.0, 0.0);
+  const SsimL1Sums s = ssimL1(x.data(), y.data(), a.width, a.height, a.channels, nullptr, 0.0, 0.0);
   return 1.0 - s.one_minus_ssim / (static_cast<double>(a.width) * a.height * a.channels);
 }
 

@@ -28,8 +28,7 @@ int fRestCount(int degree) { return 3 * (shCoeffCount(degree) - 1); }
 void checkModel(const Gaussians& g) {
   const std::size_t n = g.size();
   if (g.max_sh_degree < 0 || g.max_sh_degree > 3)
-    throw std::invalid_argument("writeGaussiansPly: SH degree " + std::to_string(g.max_sh_degree) +
-                                " outside 0..3");
+    throw std::invalid_argument("writeGaussiansPly: SH degree " + std::to_string(g.max_sh_degree) + " outside 0..3");
   if (g.means.size() != 3 * n || g.log_scales.size() != 3 * n || g.rotations.size() != 4 * n ||
       g.sh.size() != static_cast<std::size_t>(g.shCoeffs()) * 3 * n)
     throw std::invalid_argument("writeGaussiansPly: model arrays disagree on the Gaussian count");
@@ -41,12 +40,10 @@ enum class Type { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64 };
 
 std::optional<Type> parseType(const std::string& s) {
   static const std::map<std::string, Type> types = {
-      {"char", Type::Int8},     {"int8", Type::Int8},       {"uchar", Type::UInt8},
-      {"uint8", Type::UInt8},   {"short", Type::Int16},     {"int16", Type::Int16},
-      {"ushort", Type::UInt16}, {"uint16", Type::UInt16},   {"int", Type::Int32},
-      {"int32", Type::Int32},   {"uint", Type::UInt32},     {"uint32", Type::UInt32},
-      {"float", Type::Float32}, {"float32", Type::Float32}, {"double", Type::Float64},
-      {"float64", Type::Float64}};
+      {"char", Type::Int8},     {"int8", Type::Int8},       {"uchar", Type::UInt8},    {"uint8", Type::UInt8},
+      {"short", Type::Int16},   {"int16", Type::Int16},     {"ushort", Type::UInt16},  {"uint16", Type::UInt16},
+      {"int", Type::Int32},     {"int32", Type::Int32},     {"uint", Type::UInt32},    {"uint32", Type::UInt32},
+      {"float", Type::Float32}, {"float32", Type::Float32}, {"double", Type::Float64}, {"float64", Type::Float64}};
   const auto it = types.find(s);
   if (it == types.end()) return std::nullopt;
   return it->second;
@@ -55,13 +52,17 @@ std::optional<Type> parseType(const std::string& s) {
 std::size_t typeSize(Type t) {
   switch (t) {
     case Type::Int8:
-    case Type::UInt8: return 1;
+    case Type::UInt8:
+      return 1;
     case Type::Int16:
-    case Type::UInt16: return 2;
+    case Type::UInt16:
+      return 2;
     case Type::Int32:
     case Type::UInt32:
-    case Type::Float32: return 4;
-    case Type::Float64: return 8;
+    case Type::Float32:
+      return 4;
+    case Type::Float64:
+      return 8;
   }
   return 0;
 }
@@ -97,8 +98,7 @@ std::string stripCr(std::string s) {
 void readMagic(std::istream& in, const std::string& path) {
   char magic[4] = {};
   in.read(magic, 4);
-  if (in.gcount() < 3 || std::string(magic, 3) != "ply" ||
-      (in.gcount() == 4 && magic[3] != '\n' && magic[3] != '\r'))
+  if (in.gcount() < 3 || std::string(magic, 3) != "ply" || (in.gcount() == 4 && magic[3] != '\n' && magic[3] != '\r'))
     throw InputError(path, "header", "not a PLY file (does not start with the line 'ply')");
   if (magic[3] == '\r' && in.peek() == '\n') in.get();  // "\r\n" line ending
 }
@@ -199,7 +199,7 @@ struct Source {
   // of an empty model have no storage to point into.
   std::vector<float>* array = nullptr;
   std::size_t first = 0;
-  std::size_t step = 0;   // floats between consecutive Gaussians
+  std::size_t step = 0;  // floats between consecutive Gaussians
 };
 
 }  // namespace
@@ -215,8 +215,7 @@ void writeGaussiansPly(const std::string& path, const Gaussians& g) {
   for (const char* p : {"x", "y", "z", "nx", "ny", "nz", "f_dc_0", "f_dc_1", "f_dc_2"})
     header += std::string("property float ") + p + "\n";
   for (int i = 0; i < rest; ++i) header += "property float f_rest_" + std::to_string(i) + "\n";
-  for (const char* p : {"opacity", "scale_0", "scale_1", "scale_2", "rot_0", "rot_1", "rot_2",
-                        "rot_3"})
+  for (const char* p : {"opacity", "scale_0", "scale_1", "scale_2", "rot_0", "rot_1", "rot_2", "rot_3"})
     header += std::string("property float ") + p + "\n";
   header += "end_header\n";
 
@@ -265,17 +264,14 @@ Gaussians readGaussiansPly(const std::string& path) {
       break;
     }
     if (e.has_list)
-      throw InputError(path, "element " + e.name,
-                       "has a list property and precedes element vertex; cannot skip it");
+      throw InputError(path, "element " + e.name, "has a list property and precedes element vertex; cannot skip it");
     if (e.stride != 0 && e.count > (file_size - std::min(file_size, offset)) / e.stride)
       throw InputError(path, "element " + e.name, "truncated data");
     offset += e.count * e.stride;
   }
   if (!vertex) throw InputError(path, "element vertex", "missing");
   for (const auto& p : vertex->props)
-    if (p.is_list)
-      throw InputError(path, "property " + p.name,
-                       "list properties in element vertex are not supported");
+    if (p.is_list) throw InputError(path, "property " + p.name, "list properties in element vertex are not supported");
 
   auto find = [&](const std::string& name) -> const Property* {
     for (const auto& p : vertex->props)
@@ -290,8 +286,7 @@ Gaussians readGaussiansPly(const std::string& path) {
   for (int d = 0; d <= 3; ++d)
     if (fRestCount(d) == rest) degree = d;
   if (degree < 0)
-    throw InputError(path, "f_rest",
-                     std::to_string(rest) + " f_rest properties, expected 0, 9, 24 or 45");
+    throw InputError(path, "f_rest", std::to_string(rest) + " f_rest properties, expected 0, 9, 24 or 45");
 
   const std::uint64_t n = vertex->count;
   const std::size_t stride = vertex->stride;
@@ -299,9 +294,9 @@ Gaussians readGaussiansPly(const std::string& path) {
   if (stride == 0 && n > 0) throw InputError(path, "element vertex", "has no properties");
   if (stride != 0 && n > available / stride)
     throw InputError(path, "vertex data",
-                     "truncated: " + std::to_string(n) + " vertices of " + std::to_string(stride) +
-                         " bytes need " + std::to_string(n * stride) + " bytes, the file has " +
-                         std::to_string(available) + " after the header");
+                     "truncated: " + std::to_string(n) + " vertices of " + std::to_string(stride) + " bytes need " +
+                         std::to_string(n * stride) + " bytes, the file has " + std::to_string(available) +
+                         " after the header");
 
   Gaussians g;
   g.max_sh_degree = degree;
@@ -319,8 +314,7 @@ Gaussians readGaussiansPly(const std::string& path) {
   for (int a = 0; a < 3; ++a) want(std::string(1, "xyz"[a]), g.means, a, 3);
   for (int c = 0; c < 3; ++c) want("f_dc_" + std::to_string(c), g.sh, c, 3 * K);
   for (int c = 0; c < 3; ++c)
-    for (int k = 1; k < K; ++k)
-      want("f_rest_" + std::to_string(c * (K - 1) + (k - 1)), g.sh, k * 3 + c, 3 * K);
+    for (int k = 1; k < K; ++k) want("f_rest_" + std::to_string(c * (K - 1) + (k - 1)), g.sh, k * 3 + c, 3 * K);
   want("opacity", g.opacities, 0, 1);
   for (int a = 0; a < 3; ++a) want("scale_" + std::to_string(a), g.log_scales, a, 3);
   for (int a = 0; a < 4; ++a) want("rot_" + std::to_string(a), g.rotations, a, 4);
@@ -343,17 +337,14 @@ Gaussians readGaussiansPly(const std::string& path) {
         if (s.is_double) {
           const double d = byte_order::load<double>(p, std::endian::little);
           if (!std::isfinite(d))
-            throw InputError(path, s.name,
-                             "vertex " + std::to_string(vi) + " is " + (std::isnan(d) ? "NaN" : "Inf"));
+            throw InputError(path, s.name, "vertex " + std::to_string(vi) + " is " + (std::isnan(d) ? "NaN" : "Inf"));
           if (std::abs(d) > std::numeric_limits<float>::max())
-            throw InputError(path, s.name,
-                             "vertex " + std::to_string(vi) + ": value outside the float range");
+            throw InputError(path, s.name, "vertex " + std::to_string(vi) + ": value outside the float range");
           v = static_cast<float>(d);
         } else {
           v = byte_order::load<float>(p, std::endian::little);
           if (!std::isfinite(v))
-            throw InputError(path, s.name,
-                             "vertex " + std::to_string(vi) + " is " + (std::isnan(v) ? "NaN" : "Inf"));
+            throw InputError(path, s.name, "vertex " + std::to_string(vi) + " is " + (std::isnan(v) ? "NaN" : "Inf"));
         }
         (*s.array)[s.first + vi * s.step] = v;
       }

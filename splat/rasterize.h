@@ -70,11 +70,11 @@ template <typename T>
 struct RasterStateT;
 
 struct RenderResult {
-  ImageF rgb;     // 3 channels
-  ImageF alpha;   // 1 channel, accumulated opacity
-  ImageF depth;   // 1 channel, expected camera-z depth (see rule 7)
-  std::vector<int> contributors;  // per pixel: Gaussians composited
-  std::vector<float> radii;       // per Gaussian: max(hx, hy) in px, 0 when culled
+  ImageF rgb;                         // 3 channels
+  ImageF alpha;                       // 1 channel, accumulated opacity
+  ImageF depth;                       // 1 channel, expected camera-z depth (see rule 7)
+  std::vector<int> contributors;      // per pixel: Gaussians composited
+  std::vector<float> radii;           // per Gaussian: max(hx, hy) in px, 0 when culled
   std::vector<std::uint8_t> visible;  // per Gaussian: survived culling (1) or not (0)
   std::shared_ptr<const RasterStateT<float>> state;
 };
@@ -91,14 +91,13 @@ void rasterize(const Gaussians& g, const Camera& cam, const RasterSettings& s, s
                RenderResult& into);
 // Adds to `grad` the gradient of a loss whose gradient w.r.t. fwd.rgb is dL_drgb; adds
 // the 2D-mean gradient (pixels, 2 per Gaussian) to *grad_mean2d when given.
-void rasterizeBackward(const Gaussians& g, const Camera& cam, const RasterSettings& s,
-                       const RenderResult& fwd, const ImageF& dL_drgb, Gaussians& grad,
-                       std::vector<float>* grad_mean2d = nullptr);
+void rasterizeBackward(const Gaussians& g, const Camera& cam, const RasterSettings& s, const RenderResult& fwd,
+                       const ImageF& dL_drgb, Gaussians& grad, std::vector<float>* grad_mean2d = nullptr);
 // Adds, per parameter, the sum over pixels of the squared per-pixel gradient of the
 // rendered colour (channels summed): FisherRF's diagonal information. Rotations are
 // excluded (left untouched), as in FisherRF.
-void rasterizeSquaredGradients(const Gaussians& g, const Camera& cam, const RasterSettings& s,
-                               const RenderResult& fwd, Gaussians& sq);
+void rasterizeSquaredGradients(const Gaussians& g, const Camera& cam, const RasterSettings& s, const RenderResult& fwd,
+                               Gaussians& sq);
 
 // SA-ResGS's residual supervision renders, per step, the model and a subset of its
 // Gaussians (splat/train/residual.h). The subset is a mask over the same projection,
@@ -123,9 +122,8 @@ void rasterizeWithSubset(const Gaussians& g, const Camera& cam, const RasterSett
 // its image), up to float rounding: each Gaussian's two projected gradients are summed
 // before the chain rule instead of after. Deterministic (fixed-order sums), whatever the
 // thread count.
-void rasterizeBackwardWithSubset(const Gaussians& g, const Camera& cam, const RasterSettings& s,
-                                 const RenderPair& fwd, const ImageF& dL_drgb_full,
-                                 const ImageF& dL_drgb_subset, Gaussians& grad,
+void rasterizeBackwardWithSubset(const Gaussians& g, const Camera& cam, const RasterSettings& s, const RenderPair& fwd,
+                                 const ImageF& dL_drgb_full, const ImageF& dL_drgb_subset, Gaussians& grad,
                                  std::vector<float>* grad_mean2d = nullptr);
 
 }  // namespace saresgs

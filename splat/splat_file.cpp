@@ -18,7 +18,8 @@ std::uint8_t unitToByte(double v) { return static_cast<std::uint8_t>(std::lround
 std::string splatFileBytes(const Gaussians& g) {
   const std::size_t n = g.size();
   const std::size_t k = static_cast<std::size_t>(g.shCoeffs());
-  if (g.means.size() != 3 * n || g.log_scales.size() != 3 * n || g.rotations.size() != 4 * n || g.sh.size() != k * 3 * n)
+  if (g.means.size() != 3 * n || g.log_scales.size() != 3 * n || g.rotations.size() != 4 * n ||
+      g.sh.size() != k * 3 * n)
     throw std::invalid_argument("splatFileBytes: the model's arrays are inconsistent");
   std::string out(n * kSplatRecordBytes, '\0');
   for (std::size_t i = 0; i < n; ++i) {

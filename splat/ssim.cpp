@@ -125,8 +125,7 @@ using Taps = std::array<float, kRadius + 1>;
 
 // out[i] = sum_k g_|k| rows[kRadius + k][i]; rows outside the image point at a zero row.
 // Summed from the outer (small) taps inwards.
-SARESGS_KERNEL void verticalBody(const float* const* rows, float* __restrict out, std::size_t n,
-                                 const Taps& g) {
+SARESGS_KERNEL void verticalBody(const float* const* rows, float* __restrict out, std::size_t n, const Taps& g) {
   const float* __restrict u5 = rows[0];
   const float* __restrict u4 = rows[1];
   const float* __restrict u3 = rows[2];
@@ -140,16 +139,15 @@ SARESGS_KERNEL void verticalBody(const float* const* rows, float* __restrict out
   const float* __restrict d5 = rows[10];
   const float g0 = g[0], g1 = g[1], g2 = g[2], g3 = g[3], g4 = g[4], g5 = g[5];
   for (std::size_t i = 0; i < n; ++i)
-    out[i] = g5 * (u5[i] + d5[i]) + g4 * (u4[i] + d4[i]) + g3 * (u3[i] + d3[i]) +
-             g2 * (u2[i] + d2[i]) + g1 * (u1[i] + d1[i]) + g0 * c0[i];
+    out[i] = g5 * (u5[i] + d5[i]) + g4 * (u4[i] + d4[i]) + g3 * (u3[i] + d3[i]) + g2 * (u2[i] + d2[i]) +
+             g1 * (u1[i] + d1[i]) + g0 * c0[i];
 }
 
 // verticalBody for four consecutive output rows (rows[0..13] = input rows r-5 .. r+8):
 // each output is the same expression as there, so the same bits, but every input row is
 // loaded once for four outputs instead of four times.
-SARESGS_KERNEL void vertical4Body(const float* const* rows, float* __restrict out0,
-                                  float* __restrict out1, float* __restrict out2,
-                                  float* __restrict out3, std::size_t n, const Taps& g) {
+SARESGS_KERNEL void vertical4Body(const float* const* rows, float* __restrict out0, float* __restrict out1,
+                                  float* __restrict out2, float* __restrict out3, std::size_t n, const Taps& g) {
   const float* __restrict r0 = rows[0];
   const float* __restrict r1 = rows[1];
   const float* __restrict r2 = rows[2];
@@ -169,34 +167,29 @@ SARESGS_KERNEL void vertical4Body(const float* const* rows, float* __restrict ou
     const float a0 = r0[i], a1 = r1[i], a2 = r2[i], a3 = r3[i], a4 = r4[i], a5 = r5[i];
     const float a6 = r6[i], a7 = r7[i], a8 = r8[i], a9 = r9[i], a10 = r10[i], a11 = r11[i];
     const float a12 = r12[i], a13 = r13[i];
-    out0[i] = g5 * (a0 + a10) + g4 * (a1 + a9) + g3 * (a2 + a8) + g2 * (a3 + a7) +
-              g1 * (a4 + a6) + g0 * a5;
-    out1[i] = g5 * (a1 + a11) + g4 * (a2 + a10) + g3 * (a3 + a9) + g2 * (a4 + a8) +
-              g1 * (a5 + a7) + g0 * a6;
-    out2[i] = g5 * (a2 + a12) + g4 * (a3 + a11) + g3 * (a4 + a10) + g2 * (a5 + a9) +
-              g1 * (a6 + a8) + g0 * a7;
-    out3[i] = g5 * (a3 + a13) + g4 * (a4 + a12) + g3 * (a5 + a11) + g2 * (a6 + a10) +
-              g1 * (a7 + a9) + g0 * a8;
+    out0[i] = g5 * (a0 + a10) + g4 * (a1 + a9) + g3 * (a2 + a8) + g2 * (a3 + a7) + g1 * (a4 + a6) + g0 * a5;
+    out1[i] = g5 * (a1 + a11) + g4 * (a2 + a10) + g3 * (a3 + a9) + g2 * (a4 + a8) + g1 * (a5 + a7) + g0 * a6;
+    out2[i] = g5 * (a2 + a12) + g4 * (a3 + a11) + g3 * (a4 + a10) + g2 * (a5 + a9) + g1 * (a6 + a8) + g0 * a7;
+    out3[i] = g5 * (a3 + a13) + g4 * (a4 + a12) + g3 * (a5 + a11) + g2 * (a6 + a10) + g1 * (a7 + a9) + g0 * a8;
   }
 }
 
 // out[i] = sum_k g_|k| t[i + k * stride]; t has kRadius * stride zeros before and after.
-SARESGS_KERNEL void horizontalBody(const float* __restrict t, float* __restrict out,
-                                   std::size_t n, std::ptrdiff_t s, const Taps& g) {
+SARESGS_KERNEL void horizontalBody(const float* __restrict t, float* __restrict out, std::size_t n, std::ptrdiff_t s,
+                                   const Taps& g) {
   const float g0 = g[0], g1 = g[1], g2 = g[2], g3 = g[3], g4 = g[4], g5 = g[5];
   for (std::size_t i = 0; i < n; ++i) {
     const float* c = t + i;
-    out[i] = g5 * (c[-5 * s] + c[5 * s]) + g4 * (c[-4 * s] + c[4 * s]) +
-             g3 * (c[-3 * s] + c[3 * s]) + g2 * (c[-2 * s] + c[2 * s]) +
-             g1 * (c[-s] + c[s]) + g0 * c[0];
+    out[i] = g5 * (c[-5 * s] + c[5 * s]) + g4 * (c[-4 * s] + c[4 * s]) + g3 * (c[-3 * s] + c[3 * s]) +
+             g2 * (c[-2 * s] + c[2 * s]) + g1 * (c[-s] + c[s]) + g0 * c[0];
   }
 }
 
 // Inputs of the five filters for one row: x', y', x - y, x' y', (x - y)^2. The difference
 // is taken from the unshifted values, so it is exactly zero where render == target.
-SARESGS_KERNEL void productsBody(const float* __restrict x, const float* __restrict y,
-                                 float* __restrict xs, float* __restrict ys, float* __restrict d,
-                                 float* __restrict p, float* __restrict q, std::size_t n) {
+SARESGS_KERNEL void productsBody(const float* __restrict x, const float* __restrict y, float* __restrict xs,
+                                 float* __restrict ys, float* __restrict d, float* __restrict p, float* __restrict q,
+                                 std::size_t n) {
   for (std::size_t i = 0; i < n; ++i) {
     const float a = x[i] - kShift, b = y[i] - kShift, e = x[i] - y[i];
     xs[i] = a;
@@ -232,8 +225,7 @@ SARESGS_KERNEL Terms ssimTerms(float mxs, float mys, float md, float pxy, float 
   const float my = mys + kShift * wgt;
   t.md = md;
   t.md2 = md * md;
-  const float cxy =
-      (pxy - mxs * mys) + (kShift * out * (mxs + mys) + kShift * kShift * wgt * out);
+  const float cxy = (pxy - mxs * mys) + (kShift * out * (mxs + mys) + kShift * kShift * wgt * out);
   t.A1 = 2.0f * (t.mx * my) + kC1;
   t.B1 = t.A1 + t.md2;
   t.A2 = 2.0f * cxy + kC2;
@@ -252,15 +244,13 @@ SARESGS_KERNEL void pointBody(const Filtered& f, float* __restrict om, std::size
   const float* __restrict dd = f.dd;
   const float* __restrict wx = f.wx;
   const float wy = f.wy;
-  for (std::size_t i = 0; i < n; ++i)
-    om[i] = ssimTerms(mxs[i], mys[i], md[i], pxy[i], dd[i], wy * wx[i]).om;
+  for (std::size_t i = 0; i < n; ++i) om[i] = ssimTerms(mxs[i], mys[i], md[i], pxy[i], dd[i], wy * wx[i]).om;
 }
 
 // As pointBody (the same om), plus the partials with respect to the filtered render
 // quantities, times `scale`: a = dS/dmx' (= dS/dmx + c dS/dpxy), b = dS/ddd, c = dS/dpxy'.
-SARESGS_KERNEL void pointGradBody(const Filtered& f, float* __restrict om, float* __restrict a,
-                                  float* __restrict b, float* __restrict c, std::size_t n,
-                                  float scale) {
+SARESGS_KERNEL void pointGradBody(const Filtered& f, float* __restrict om, float* __restrict a, float* __restrict b,
+                                  float* __restrict c, std::size_t n, float scale) {
   const float* __restrict mxs = f.mxs;
   const float* __restrict mys = f.mys;
   const float* __restrict md = f.md;
@@ -272,8 +262,7 @@ SARESGS_KERNEL void pointGradBody(const Filtered& f, float* __restrict om, float
     const Terms t = ssimTerms(mxs[i], mys[i], md[i], pxy[i], dd[i], wy * wx[i]);
     const float S = 1.0f - t.om;
     om[i] = t.om;
-    const float dmx = 2.0f * t.inv *
-                      ((t.A2 - t.A1) * (t.mx * t.om - t.md) - t.mx * S * (t.vd - t.md2));
+    const float dmx = 2.0f * t.inv * ((t.A2 - t.A1) * (t.mx * t.om - t.md) - t.mx * S * (t.vd - t.md2));
     const float dpxy = 2.0f * t.A1 * t.B1 * t.vd * t.inv * t.inv;
     a[i] = scale * (dmx + kShift * dpxy);
     b[i] = scale * (-(S * t.B1) * t.inv);
@@ -282,9 +271,8 @@ SARESGS_KERNEL void pointGradBody(const Filtered& f, float* __restrict om, float
 }
 
 // The chain rule for one row: grad = l1 + G*a + y' G*c + 2 (x - y) G*b.
-SARESGS_KERNEL void combineBody(const float* __restrict x, const float* __restrict y,
-                                const float* __restrict ga, const float* __restrict gb,
-                                const float* __restrict gc, float* __restrict grad,
+SARESGS_KERNEL void combineBody(const float* __restrict x, const float* __restrict y, const float* __restrict ga,
+                                const float* __restrict gb, const float* __restrict gc, float* __restrict grad,
                                 std::size_t n, float l1_scale) {
   for (std::size_t i = 0; i < n; ++i) {
     const float d = x[i] - y[i];
@@ -294,59 +282,48 @@ SARESGS_KERNEL void combineBody(const float* __restrict x, const float* __restri
 }
 
 // The L1 part alone (lambda == 0): l1_scale * sign(x - y), from the row of differences.
-SARESGS_KERNEL void signBody(const float* __restrict d, float* __restrict grad, std::size_t n,
-                             float l1_scale) {
-  for (std::size_t i = 0; i < n; ++i)
-    grad[i] = d[i] > 0 ? l1_scale : (d[i] < 0 ? -l1_scale : 0.0f);
+SARESGS_KERNEL void signBody(const float* __restrict d, float* __restrict grad, std::size_t n, float l1_scale) {
+  for (std::size_t i = 0; i < n; ++i) grad[i] = d[i] > 0 ? l1_scale : (d[i] < 0 ? -l1_scale : 0.0f);
 }
 
 struct Kernels {
   void (*vertical)(const float* const*, float*, std::size_t, const Taps&);
-  void (*vertical4)(const float* const*, float*, float*, float*, float*, std::size_t,
-                    const Taps&);
+  void (*vertical4)(const float* const*, float*, float*, float*, float*, std::size_t, const Taps&);
   void (*horizontal)(const float*, float*, std::size_t, std::ptrdiff_t, const Taps&);
-  void (*products)(const float*, const float*, float*, float*, float*, float*, float*,
-                   std::size_t);
+  void (*products)(const float*, const float*, float*, float*, float*, float*, float*, std::size_t);
   void (*point)(const Filtered&, float*, std::size_t);
   void (*pointGrad)(const Filtered&, float*, float*, float*, float*, std::size_t, float);
-  void (*combine)(const float*, const float*, const float*, const float*, const float*, float*,
-                  std::size_t, float);
+  void (*combine)(const float*, const float*, const float*, const float*, const float*, float*, std::size_t, float);
   void (*sign)(const float*, float*, std::size_t, float);
 };
 
 // Instantiates the bodies for one target; ATTR is empty (baseline) or a target attribute.
-#define SARESGS_KERNEL_SET(NAME, ATTR)                                                         \
-  ATTR void vertical##NAME(const float* const* rows, float* out, std::size_t n,               \
-                           const Taps& g) {                                                   \
-    verticalBody(rows, out, n, g);                                                            \
-  }                                                                                           \
-  ATTR void vertical4##NAME(const float* const* rows, float* out0, float* out1, float* out2,  \
-                            float* out3, std::size_t n, const Taps& g) {                      \
-    vertical4Body(rows, out0, out1, out2, out3, n, g);                                        \
-  }                                                                                           \
-  ATTR void horizontal##NAME(const float* t, float* out, std::size_t n, std::ptrdiff_t s,     \
-                             const Taps& g) {                                                 \
-    horizontalBody(t, out, n, s, g);                                                          \
-  }                                                                                           \
-  ATTR void products##NAME(const float* x, const float* y, float* xs, float* ys, float* d,    \
-                           float* p, float* q, std::size_t n) {                               \
-    productsBody(x, y, xs, ys, d, p, q, n);                                                   \
-  }                                                                                           \
-  ATTR void point##NAME(const Filtered& f, float* om, std::size_t n) { pointBody(f, om, n); } \
-  ATTR void pointGrad##NAME(const Filtered& f, float* om, float* a, float* b, float* c,       \
-                            std::size_t n, float scale) {                                     \
-    pointGradBody(f, om, a, b, c, n, scale);                                                  \
-  }                                                                                           \
-  ATTR void combine##NAME(const float* x, const float* y, const float* ga, const float* gb,   \
-                          const float* gc, float* grad, std::size_t n, float l1_scale) {      \
-    combineBody(x, y, ga, gb, gc, grad, n, l1_scale);                                         \
-  }                                                                                           \
-  ATTR void sign##NAME(const float* d, float* grad, std::size_t n, float l1_scale) {          \
-    signBody(d, grad, n, l1_scale);                                                           \
-  }                                                                                           \
-  constexpr Kernels kKernels##NAME = {vertical##NAME,  vertical4##NAME, horizontal##NAME,     \
-                                      products##NAME,  point##NAME,     pointGrad##NAME,      \
-                                      combine##NAME,   sign##NAME};
+#define SARESGS_KERNEL_SET(NAME, ATTR)                                                                                 \
+  ATTR void vertical##NAME(const float* const* rows, float* out, std::size_t n, const Taps& g) {                       \
+    verticalBody(rows, out, n, g);                                                                                     \
+  }                                                                                                                    \
+  ATTR void vertical4##NAME(const float* const* rows, float* out0, float* out1, float* out2, float* out3,              \
+                            std::size_t n, const Taps& g) {                                                            \
+    vertical4Body(rows, out0, out1, out2, out3, n, g);                                                                 \
+  }                                                                                                                    \
+  ATTR void horizontal##NAME(const float* t, float* out, std::size_t n, std::ptrdiff_t s, const Taps& g) {             \
+    horizontalBody(t, out, n, s, g);                                                                                   \
+  }                                                                                                                    \
+  ATTR void products##NAME(const float* x, const float* y, float* xs, float* ys, float* d, float* p, float* q,         \
+                           std::size_t n) {                                                                            \
+    productsBody(x, y, xs, ys, d, p, q, n);                                                                            \
+  }                                                                                                                    \
+  ATTR void point##NAME(const Filtered& f, float* om, std::size_t n) { pointBody(f, om, n); }                          \
+  ATTR void pointGrad##NAME(const Filtered& f, float* om, float* a, float* b, float* c, std::size_t n, float scale) {  \
+    pointGradBody(f, om, a, b, c, n, scale);                                                                           \
+  }                                                                                                                    \
+  ATTR void combine##NAME(const float* x, const float* y, const float* ga, const float* gb, const float* gc,           \
+                          float* grad, std::size_t n, float l1_scale) {                                                \
+    combineBody(x, y, ga, gb, gc, grad, n, l1_scale);                                                                  \
+  }                                                                                                                    \
+  ATTR void sign##NAME(const float* d, float* grad, std::size_t n, float l1_scale) { signBody(d, grad, n, l1_scale); } \
+  constexpr Kernels kKernels##NAME = {vertical##NAME, vertical4##NAME, horizontal##NAME, products##NAME,               \
+                                      point##NAME,    pointGrad##NAME, combine##NAME,    sign##NAME};
 
 SARESGS_KERNEL_SET(Base, )
 #if SARESGS_SSIM_AVX2
@@ -407,14 +384,14 @@ struct Job {
   const float* y;
   int h;
   int channels;
-  std::size_t W;       // floats per row
-  std::size_t pad;     // kRadius * channels
-  float* grad;         // null: no gradient
+  std::size_t W;    // floats per row
+  std::size_t pad;  // kRadius * channels
+  float* grad;      // null: no gradient
   float l1_scale;
   float ssim_scale;
-  bool ssim_grad;      // grad && ssim_scale != 0
-  float* da;           // scaled partial maps (h rows of dstride floats) when ssim_grad,
-  float* db;           // see pointGradBody
+  bool ssim_grad;  // grad && ssim_scale != 0
+  float* da;       // scaled partial maps (h rows of dstride floats) when ssim_grad,
+  float* db;       // see pointGradBody
   float* dc;
   std::size_t dstride;
   const Kernels* k;    // the kernel set for this CPU
@@ -495,20 +472,16 @@ float* paddedRows(const Job& J, float* at, float** v) {
 void forwardBlock(const Job& J, int r0, int r1) {
   constexpr int kMaps = 5;
   const std::size_t W = J.W, S = rowStride(W), ring = kRing * S;
-  std::vector<float>& buf =
-      scratch(kMaps * ring + kGroup * rowStride(W + 2 * J.pad) + (kGroup * kMaps + 1) * S);
+  std::vector<float>& buf = scratch(kMaps * ring + kGroup * rowStride(W + 2 * J.pad) + (kGroup * kMaps + 1) * S);
   float* prod = buf.data();  // kMaps rings; input row j in slot j % kRing
   float* v[kGroup];
   float* hrow = paddedRows(J, prod + kMaps * ring, v);  // kGroup x kMaps filtered rows
   float* om = hrow + kGroup * kMaps * S;
-  auto slot = [&](int m, int j) {
-    return prod + m * ring + static_cast<std::size_t>(j % kRing) * S;
-  };
+  auto slot = [&](int m, int j) { return prod + m * ring + static_cast<std::size_t>(j % kRing) * S; };
   auto fillRow = [&](int j) {
     if (j >= J.h) return;
     const std::size_t off = static_cast<std::size_t>(j) * W;
-    J.k->products(J.x + off, J.y + off, slot(0, j), slot(1, j), slot(2, j), slot(3, j),
-                  slot(4, j), W);
+    J.k->products(J.x + off, J.y + off, slot(0, j), slot(1, j), slot(2, j), slot(3, j), slot(4, j), W);
   };
 
   for (int j = std::max(0, r0 - kRadius); j < r0 + kRadius; ++j) fillRow(j);
@@ -518,7 +491,8 @@ void forwardBlock(const Job& J, int r0, int r1) {
     for (int m = 0; m < kMaps; ++m) {
       float* out[kGroup];
       for (int t = 0; t < kGroup; ++t) out[t] = hrow + (t * kMaps + m) * S;
-      filterMap(J, [&](int j) { return slot(m, j); }, p, v, out);
+      filterMap(
+          J, [&](int j) { return slot(m, j); }, p, v, out);
     }
     for (int t = 0; t < p.count; ++t) {
       const int row = r + t;
@@ -526,8 +500,7 @@ void forwardBlock(const Job& J, int r0, int r1) {
       const float* h = hrow + t * kMaps * S;
       const Filtered f{h, h + S, h + 2 * S, h + 3 * S, h + 4 * S, J.wx, J.wy[row]};
       if (J.ssim_grad)
-        J.k->pointGrad(f, om, J.da + row * J.dstride, J.db + row * J.dstride,
-                       J.dc + row * J.dstride, W, J.ssim_scale);
+        J.k->pointGrad(f, om, J.da + row * J.dstride, J.db + row * J.dstride, J.dc + row * J.dstride, W, J.ssim_scale);
       else
         J.k->point(f, om, W);
       J.row_om[row] = sumChunked<false>(om, W);
@@ -552,8 +525,8 @@ void backwardBlock(const Job& J, int r0, int r1) {
     for (int m = 0; m < 3; ++m) {
       float* out[kGroup];
       for (int t = 0; t < kGroup; ++t) out[t] = hrow + (t * 3 + m) * S;
-      filterMap(J, [&](int j) { return maps[m] + static_cast<std::size_t>(j) * J.dstride; }, p,
-                v, out);
+      filterMap(
+          J, [&](int j) { return maps[m] + static_cast<std::size_t>(j) * J.dstride; }, p, v, out);
     }
     for (int t = 0; t < p.count; ++t) {
       const std::size_t off = static_cast<std::size_t>(r + t) * W;
@@ -571,8 +544,7 @@ void forRowBlocks(int h, F&& f) {
       tbb::blocked_range<int>(0, blocks, 1),
       [&](const tbb::blocked_range<int>& br) {
         const FloatEnvGuard fenv;  // geometry/float_env.h
-        for (int b = br.begin(); b != br.end(); ++b)
-          f(b * kBlockRows, std::min(h, (b + 1) * kBlockRows));
+        for (int b = br.begin(); b != br.end(); ++b) f(b * kBlockRows, std::min(h, (b + 1) * kBlockRows));
       },
       tbb::simple_partitioner());
 }
@@ -594,8 +566,8 @@ SsimIsa ssimBestIsa() {
 
 void ssimLimitIsa(SsimIsa widest) { g_widest.store(static_cast<int>(widest), std::memory_order_relaxed); }
 
-SsimL1Sums ssimL1(const float* x, const float* y, int w, int h, int channels, float* grad,
-                  double l1_scale, double ssim_scale) {
+SsimL1Sums ssimL1(const float* x, const float* y, int w, int h, int channels, float* grad, double l1_scale,
+                  double ssim_scale) {
   Job J{};
   J.x = x;
   J.y = y;

@@ -24,8 +24,8 @@ struct SsimL1Sums {
 //   grad[i] = l1_scale * sign(x[i] - y[i]) + ssim_scale * d(sum_p S_p) / dx[i]
 // (sign(0) = 0); with ssim_scale == 0 the SSIM backward is skipped. The sums are the
 // same, bit for bit, whether or not the gradient is asked for.
-SsimL1Sums ssimL1(const float* x, const float* y, int w, int h, int channels, float* grad,
-                  double l1_scale, double ssim_scale);
+SsimL1Sums ssimL1(const float* x, const float* y, int w, int h, int channels, float* grad, double l1_scale,
+                  double ssim_scale);
 
 // The loops run as the widest vector code the CPU has: AVX-512 (16 floats per
 // instruction), AVX2 (8) or baseline SSE2 (4), never with FMA; all give bit-identical

@@ -87,7 +87,8 @@ static void tile(float smin, float smax) {
   std::vector<float> rgb(256 * 3), alpha(256), depth(256), T(256);
   std::vector<int> count(256);
   std::vector<std::uint32_t> walked(256);
-  const saresgs::raster_kernels::ForwardOut out{16, rgb.data(), alpha.data(), depth.data(), count.data(), T.data(), walked.data()};
+  const saresgs::raster_kernels::ForwardOut out{16,           rgb.data(), alpha.data(), depth.data(),
+                                                count.data(), T.data(),   walked.data()};
   const float bg[3] = {0, 0, 0};
   const long lanes = evaluatedLanes(q);
   const int reps = 2000;

@@ -36,12 +36,11 @@ Intrinsics Intrinsics::scaled(double factor) const {
 }
 
 bool Intrinsics::valid() const {
-  return width > 0 && height > 0 && width <= kMaxImageSide && height <= kMaxImageSide && std::isfinite(fx) && std::isfinite(fy) && fx > 0 &&
-         fy > 0 && std::isfinite(cx) && std::isfinite(cy);
+  return width > 0 && height > 0 && width <= kMaxImageSide && height <= kMaxImageSide && std::isfinite(fx) &&
+         std::isfinite(fy) && fx > 0 && fy > 0 && std::isfinite(cx) && std::isfinite(cy);
 }
 
-Camera Camera::fromQuaternion(const Intrinsics& K, const Eigen::Quaterniond& q,
-                              const Eigen::Vector3d& t) {
+Camera Camera::fromQuaternion(const Intrinsics& K, const Eigen::Quaterniond& q, const Eigen::Vector3d& t) {
   Camera c;
   c.K = K;
   c.R = q.normalized().toRotationMatrix();
@@ -49,8 +48,8 @@ Camera Camera::fromQuaternion(const Intrinsics& K, const Eigen::Quaterniond& q,
   return c;
 }
 
-Camera Camera::lookAt(const Intrinsics& K, const Eigen::Vector3d& eye,
-                      const Eigen::Vector3d& target, const Eigen::Vector3d& up) {
+Camera Camera::lookAt(const Intrinsics& K, const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
+                      const Eigen::Vector3d& up) {
   Eigen::Vector3d z = (target - eye).normalized();
   Eigen::Vector3d u = up.normalized();
   if (std::abs(z.dot(u)) > 0.999) {
@@ -88,8 +87,7 @@ Eigen::Matrix<double, 3, 4> Camera::projectionMatrix() const {
   return K.matrix() * rt;
 }
 
-std::optional<Eigen::Vector2d> Camera::project(const Eigen::Vector3d& x_world,
-                                               double min_depth) const {
+std::optional<Eigen::Vector2d> Camera::project(const Eigen::Vector3d& x_world, double min_depth) const {
   const Eigen::Vector3d p = toCamera(x_world);
   if (!(p.z() > min_depth)) return std::nullopt;
   return Eigen::Vector2d(K.fx * p.x() / p.z() + K.cx, K.fy * p.y() / p.z() + K.cy);
@@ -108,8 +106,7 @@ Eigen::Vector3d Camera::rayDirection(const Eigen::Vector2d& uv) const {
 std::array<Plane, 6> Camera::frustumPlanes(double near, double far) const {
   // Build the planes in camera coordinates, then move them to world coordinates.
   // Side planes pass through the centre and the image edges (u = 0, u = W, v = 0, v = H).
-  auto side = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                  const Eigen::Vector3d& inside) {
+  auto side = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& inside) {
     Eigen::Vector3d n = a.cross(b).normalized();
     if (n.dot(inside) < 0) n = -n;
     return n;
@@ -118,9 +115,8 @@ std::array<Plane, 6> Camera::frustumPlanes(double near, double far) const {
   const double tp = (0 - K.cy) / K.fy, bt = (K.height - K.cy) / K.fy;
   const Eigen::Vector3d inside((l + r) / 2, (tp + bt) / 2, 1.0);
   const Eigen::Vector3d tl(l, tp, 1), tr(r, tp, 1), bl(l, bt, 1), br(r, bt, 1);
-  std::array<Eigen::Vector3d, 6> n_cam = {
-      Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(0, 0, -1), side(tl, bl, inside),
-      side(tr, br, inside),     side(tl, tr, inside),      side(bl, br, inside)};
+  std::array<Eigen::Vector3d, 6> n_cam = {Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(0, 0, -1), side(tl, bl, inside),
+                                          side(tr, br, inside),     side(tl, tr, inside),      side(bl, br, inside)};
   std::array<double, 6> d_cam = {-near, far, 0, 0, 0, 0};
   std::array<Plane, 6> planes;
   for (int i = 0; i < 6; ++i) {
@@ -209,12 +205,11 @@ ViewFocus viewFocus(std::span<const Camera> cameras) {
 void validateCamera(const Camera& cam, const std::string& file, const std::string& field) {
   if (!cam.K.valid()) {
     std::ostringstream s;
-    s << "expected positive finite focal lengths and an image size of 1.." << kMaxImageSide << " per side, got fx=" << cam.K.fx
-      << " fy=" << cam.K.fy << " size=" << cam.K.width << "x" << cam.K.height;
+    s << "expected positive finite focal lengths and an image size of 1.." << kMaxImageSide
+      << " per side, got fx=" << cam.K.fx << " fy=" << cam.K.fy << " size=" << cam.K.width << "x" << cam.K.height;
     throw InputError(file, field, s.str());
   }
-  if (!cam.R.allFinite() || !cam.t.allFinite())
-    throw InputError(file, field, "expected a finite pose, got NaN or Inf");
+  if (!cam.R.allFinite() || !cam.t.allFinite()) throw InputError(file, field, "expected a finite pose, got NaN or Inf");
   const double orth = (cam.R * cam.R.transpose() - Eigen::Matrix3d::Identity()).norm();
   if (orth > 1e-6 || std::abs(cam.R.determinant() - 1.0) > 1e-6)
     throw InputError(file, field, "expected a rotation (orthonormal, det +1)");

@@ -42,17 +42,15 @@ struct Camera {
   Eigen::Matrix3d R = Eigen::Matrix3d::Identity();  // world -> camera
   Eigen::Vector3d t = Eigen::Vector3d::Zero();
 
-  static Camera fromQuaternion(const Intrinsics& K, const Eigen::Quaterniond& q_wxyz,
-                               const Eigen::Vector3d& t);
+  static Camera fromQuaternion(const Intrinsics& K, const Eigen::Quaterniond& q_wxyz, const Eigen::Vector3d& t);
   // A camera at `eye` looking at `target`, with image "up" (-y) as close to `up` as
   // possible. Falls back to another up vector when `up` is parallel to the view.
-  static Camera lookAt(const Intrinsics& K, const Eigen::Vector3d& eye,
-                       const Eigen::Vector3d& target,
+  static Camera lookAt(const Intrinsics& K, const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
                        const Eigen::Vector3d& up = Eigen::Vector3d::UnitZ());
 
-  Eigen::Quaterniond quaternion() const;  // world -> camera, normalised, w >= 0
-  Eigen::Vector3d center() const;         // camera centre in world coordinates
-  Eigen::Vector3d viewDirection() const;  // +z axis of the camera in world coordinates
+  Eigen::Quaterniond quaternion() const;                 // world -> camera, normalised, w >= 0
+  Eigen::Vector3d center() const;                        // camera centre in world coordinates
+  Eigen::Vector3d viewDirection() const;                 // +z axis of the camera in world coordinates
   Eigen::Matrix<double, 3, 4> projectionMatrix() const;  // K [R | t]
 
   Eigen::Vector3d toCamera(const Eigen::Vector3d& x_world) const { return R * x_world + t; }
@@ -60,8 +58,7 @@ struct Camera {
 
   // Projects a world point to continuous pixel coordinates. Returns nothing for points
   // at or behind the camera plane (z <= min_depth).
-  std::optional<Eigen::Vector2d> project(const Eigen::Vector3d& x_world,
-                                         double min_depth = 1e-12) const;
+  std::optional<Eigen::Vector2d> project(const Eigen::Vector3d& x_world, double min_depth = 1e-12) const;
   // The world point at pixel coordinates `uv` and depth `z` along the camera's z axis
   // (the convention of COLMAP and of 3DGS depth maps).
   Eigen::Vector3d unproject(const Eigen::Vector2d& uv, double z) const;

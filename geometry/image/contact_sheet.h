@@ -15,7 +15,6 @@ struct ContactSheetItem {
 };
 
 // Lays the items out in rows of `columns`, each scaled to `thumb_width` wide.
-Image8 makeContactSheet(const std::vector<ContactSheetItem>& items, int columns = 8,
-                        int thumb_width = 160);
+Image8 makeContactSheet(const std::vector<ContactSheetItem>& items, int columns = 8, int thumb_width = 160);
 
 }  // namespace saresgs

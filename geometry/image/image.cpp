@@ -96,7 +96,8 @@ bool imageHasAlpha(const std::string& path) {
     for (int chunk = 0; chunk < 64; ++chunk) {
       std::uint8_t h[8];
       if (std::fread(h, 1, 8, file) != 8) break;
-      const std::uint32_t length = (std::uint32_t{h[0]} << 24) | (std::uint32_t{h[1]} << 16) | (std::uint32_t{h[2]} << 8) | h[3];
+      const std::uint32_t length =
+          (std::uint32_t{h[0]} << 24) | (std::uint32_t{h[1]} << 16) | (std::uint32_t{h[2]} << 8) | h[3];
       const std::string type(reinterpret_cast<const char*>(h + 4), 4);
       if (type == "IHDR") {
         std::uint8_t ihdr[13];
@@ -136,9 +137,12 @@ std::vector<std::uint8_t> encodeImage(const Image8& img, const std::string& ext,
   const int type = CV_8UC(img.channels);
   cv::Mat m(img.height, img.width, type, const_cast<std::uint8_t*>(img.data.data()));
   cv::Mat bgr;
-  if (img.channels == 3) cv::cvtColor(m, bgr, cv::COLOR_RGB2BGR);
-  else if (img.channels == 4) cv::cvtColor(m, bgr, cv::COLOR_RGBA2BGRA);
-  else bgr = m;
+  if (img.channels == 3)
+    cv::cvtColor(m, bgr, cv::COLOR_RGB2BGR);
+  else if (img.channels == 4)
+    cv::cvtColor(m, bgr, cv::COLOR_RGBA2BGRA);
+  else
+    bgr = m;
   std::vector<std::uint8_t> bytes;
   bool encoded = false;
   const std::vector<int> params = {cv::IMWRITE_JPEG_QUALITY, std::clamp(jpeg_quality, 0, 100)};

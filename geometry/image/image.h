@@ -18,9 +18,7 @@ struct ImageT {
   ImageT(int w, int h, int c, T fill = T{})
       : width(w), height(h), channels(c), data(static_cast<size_t>(w) * h * c, fill) {}
   bool empty() const { return data.empty(); }
-  size_t index(int x, int y, int ch = 0) const {
-    return (static_cast<size_t>(y) * width + x) * channels + ch;
-  }
+  size_t index(int x, int y, int ch = 0) const { return (static_cast<size_t>(y) * width + x) * channels + ch; }
   T& at(int x, int y, int ch = 0) { return data[index(x, y, ch)]; }
   const T& at(int x, int y, int ch = 0) const { return data[index(x, y, ch)]; }
 };

@@ -12,8 +12,7 @@ namespace saresgs {
 
 namespace fs = std::filesystem;
 
-void writeStreamAtomic(const std::string& path, const std::function<void(std::ostream&)>& write,
-                       bool binary) {
+void writeStreamAtomic(const std::string& path, const std::function<void(std::ostream&)>& write, bool binary) {
   const fs::path target(path);
   if (target.has_parent_path()) fs::create_directories(target.parent_path());
   const fs::path tmp = target.string() + ".tmp." + std::to_string(::getpid());
@@ -33,8 +32,8 @@ void writeStreamAtomic(const std::string& path, const std::function<void(std::os
 }
 
 void writeFileAtomic(const std::string& path, const std::string& bytes) {
-  writeStreamAtomic(path, [&](std::ostream& o) { o.write(bytes.data(), static_cast<std::streamsize>(bytes.size())); },
-                    true);
+  writeStreamAtomic(
+      path, [&](std::ostream& o) { o.write(bytes.data(), static_cast<std::streamsize>(bytes.size())); }, true);
 }
 
 std::string readFile(const std::string& path) {

@@ -34,8 +34,7 @@ T load(const char* p, std::endian order) {
   U u = 0;
   for (std::size_t i = 0; i < sizeof(T); ++i) {
     const std::size_t byte = order == std::endian::little ? i : sizeof(T) - 1 - i;
-    u = static_cast<U>(
-        u | static_cast<U>(static_cast<U>(static_cast<unsigned char>(p[i])) << (8 * byte)));
+    u = static_cast<U>(u | static_cast<U>(static_cast<U>(static_cast<unsigned char>(p[i])) << (8 * byte)));
   }
   return std::bit_cast<T>(u);
 }
@@ -44,8 +43,7 @@ template <typename T>
 void appendLittleEndian(std::string& out, T value) {
   using U = typename UnsignedOfSize<sizeof(T)>::type;
   const U u = std::bit_cast<U>(value);
-  for (std::size_t i = 0; i < sizeof(T); ++i)
-    out.push_back(static_cast<char>((u >> (8 * i)) & 0xffu));
+  for (std::size_t i = 0; i < sizeof(T); ++i) out.push_back(static_cast<char>((u >> (8 * i)) & 0xffu));
 }
 
 }  // namespace saresgs::byte_order

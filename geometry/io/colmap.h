@@ -16,7 +16,7 @@ inline constexpr std::uint64_t kInvalidPoint3DId = std::numeric_limits<std::uint
 
 struct ColmapCamera {
   std::uint32_t id = 0;
-  std::string model;           // e.g. "PINHOLE"
+  std::string model;  // e.g. "PINHOLE"
   std::uint64_t width = 0, height = 0;
   std::vector<double> params;  // model parameters in COLMAP's order
 };
@@ -27,8 +27,8 @@ struct ColmapImage {
   Eigen::Vector3d t = Eigen::Vector3d::Zero();
   std::uint32_t camera_id = 0;
   std::string name;
-  std::vector<Eigen::Vector2d> xys;          // 2D points
-  std::vector<std::uint64_t> point3d_ids;    // kInvalidPoint3DId where unmatched
+  std::vector<Eigen::Vector2d> xys;        // 2D points
+  std::vector<std::uint64_t> point3d_ids;  // kInvalidPoint3DId where unmatched
 };
 
 struct TrackElement {

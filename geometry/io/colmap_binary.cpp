@@ -29,9 +29,7 @@ constexpr size_t kPoint2DBytes = 8 + 8 + 8;             // x, y, point3D_id
 constexpr size_t kPointBytes = 8 + 3 * 8 + 3 + 8 + 8;   // id, xyz, rgb, error, length
 constexpr size_t kTrackElementBytes = 4 + 4;            // image_id, point2D_idx
 
-std::string pathIn(const std::string& dir, const char* name) {
-  return (std::filesystem::path(dir) / name).string();
-}
+std::string pathIn(const std::string& dir, const char* name) { return (std::filesystem::path(dir) / name).string(); }
 
 // Names the record being read: "image 7" once its id is known, "image record 3"
 // (0-based position in the file) while reading the id itself, nothing for the
@@ -41,9 +39,7 @@ struct Where {
   std::uint64_t number = 0;
   bool is_index = false;
 
-  std::string name() const {
-    return std::string(kind) + (is_index ? " record " : " ") + std::to_string(number);
-  }
+  std::string name() const { return std::string(kind) + (is_index ? " record " : " ") + std::to_string(number); }
   std::string field(std::string_view field) const {
     return kind ? name() + ": " + std::string(field) : std::string(field);
   }
@@ -63,8 +59,8 @@ class ByteReader {
   T read(const Where& where, std::string_view field) {
     if (remaining() < sizeof(T))
       fail(where, field,
-           "expected " + std::to_string(sizeof(T)) + " more bytes at offset " +
-               std::to_string(pos_) + ", the file ends (truncated)");
+           "expected " + std::to_string(sizeof(T)) + " more bytes at offset " + std::to_string(pos_) +
+               ", the file ends (truncated)");
     const T value = byte_order::load<T>(data_.data() + pos_, std::endian::little);
     pos_ += sizeof(T);
     return value;
@@ -75,16 +71,14 @@ class ByteReader {
     const auto count = read<std::uint64_t>(where, field);
     if (count > remaining() / min_bytes)
       fail(where, field,
-           "count " + std::to_string(count) + " needs at least " + std::to_string(min_bytes) +
-               " bytes each, only " + std::to_string(remaining()) +
-               " bytes remain (corrupt or truncated)");
+           "count " + std::to_string(count) + " needs at least " + std::to_string(min_bytes) + " bytes each, only " +
+               std::to_string(remaining()) + " bytes remain (corrupt or truncated)");
     return count;
   }
 
   std::string readName(const Where& where, std::string_view field) {
     const size_t end = data_.find('\0', pos_);
-    if (end == std::string::npos)
-      fail(where, field, "expected a name ending in '\\0', the file ends (truncated)");
+    if (end == std::string::npos) fail(where, field, "expected a name ending in '\\0', the file ends (truncated)");
     std::string name = data_.substr(pos_, end - pos_);
     pos_ = end + 1;
     if (name.empty()) fail(where, field, "expected an image name, got an empty one");
@@ -94,13 +88,11 @@ class ByteReader {
   void expectEnd(std::uint64_t records, std::string_view things) const {
     if (remaining() != 0)
       throw InputError(path_, "end of file",
-                       "expected the file to end after " + std::to_string(records) + " " +
-                           std::string(things) + ", found " + std::to_string(remaining()) +
-                           " more bytes");
+                       "expected the file to end after " + std::to_string(records) + " " + std::string(things) +
+                           ", found " + std::to_string(remaining()) + " more bytes");
   }
 
-  [[noreturn]] void fail(const Where& where, std::string_view field,
-                         const std::string& what) const {
+  [[noreturn]] void fail(const Where& where, std::string_view field, const std::string& what) const {
     throw InputError(path_, where.field(field), what);
   }
 
@@ -111,8 +103,7 @@ class ByteReader {
 };
 
 template <typename Map, typename Record>
-void insertUnique(Map& map, Record&& record, const ByteReader& in, const Where& where,
-                  std::string_view field) {
+void insertUnique(Map& map, Record&& record, const ByteReader& in, const Where& where, std::string_view field) {
   const auto id = record.id;
   if (!map.emplace(id, std::forward<Record>(record)).second)
     in.fail(where, field, "expected unique ids, " + std::to_string(id) + " appears twice");
@@ -125,8 +116,7 @@ ColmapCamera readCamera(ByteReader& in, std::uint64_t index) {
   const auto model_id = in.read<std::int32_t>(where, "model_id");
   cam.model = colmapModelName(model_id);
   if (cam.model.empty())
-    in.fail(where, "model_id",
-            "expected a COLMAP camera model id 0..10, got " + std::to_string(model_id));
+    in.fail(where, "model_id", "expected a COLMAP camera model id 0..10, got " + std::to_string(model_id));
   cam.width = in.read<std::uint64_t>(where, "width");
   cam.height = in.read<std::uint64_t>(where, "height");
   cam.params.resize(static_cast<size_t>(colmapModelParamCount(model_id)));
@@ -149,8 +139,7 @@ void readCameras(const std::string& dir, ColmapModel& model) {
 std::uint64_t readPoint3DId(ByteReader& in, const Where& where) {
   const auto id = in.read<std::int64_t>(where, "point3D_id");
   if (id == -1) return kInvalidPoint3DId;
-  if (id < 0)
-    in.fail(where, "point3D_id", "expected -1 or a non-negative id, got " + std::to_string(id));
+  if (id < 0) in.fail(where, "point3D_id", "expected -1 or a non-negative id, got " + std::to_string(id));
   return static_cast<std::uint64_t>(id);
 }
 
@@ -196,8 +185,7 @@ ColmapPoint3D readPoint(ByteReader& in, std::uint64_t index) {
   pt.id = in.read<std::uint64_t>({"point", index, true}, "point3D_id");
   const Where where{"point", pt.id};
   for (int i = 0; i < 3; ++i) pt.xyz[i] = in.read<double>(where, std::string(1, "xyz"[i]));
-  for (int i = 0; i < 3; ++i)
-    pt.rgb[static_cast<size_t>(i)] = in.read<std::uint8_t>(where, std::string(1, "rgb"[i]));
+  for (int i = 0; i < 3; ++i) pt.rgb[static_cast<size_t>(i)] = in.read<std::uint8_t>(where, std::string(1, "rgb"[i]));
   pt.error = in.read<double>(where, "error");
   const std::uint64_t n = in.readCount(where, "track_length", kTrackElementBytes);
   pt.track.reserve(n);
@@ -264,8 +252,7 @@ void writeImages(std::ostream& o, const ColmapModel& model) {
   w.put<std::uint64_t>(model.images.size());
   for (const auto& [id, img] : model.images) {
     w.put<std::uint32_t>(id);
-    for (double v : {img.q.w(), img.q.x(), img.q.y(), img.q.z(), img.t.x(), img.t.y(), img.t.z()})
-      w.put(v);
+    for (double v : {img.q.w(), img.q.x(), img.q.y(), img.q.z(), img.t.x(), img.t.y(), img.t.z()}) w.put(v);
     w.put<std::uint32_t>(img.camera_id);
     w.putName(img.name);
     w.put<std::uint64_t>(img.xys.size());
@@ -308,8 +295,7 @@ void checkWritable(const ColmapModel& model, const std::string& dir) {
                        "expected a COLMAP camera model, got '" + cam.model + "'");
     if (cam.params.size() != static_cast<size_t>(colmapModelParamCount(model_id)))
       throw InputError(pathIn(dir, "cameras.bin"), where + ": params",
-                       "expected " + std::to_string(colmapModelParamCount(model_id)) +
-                           " parameters for " + cam.model);
+                       "expected " + std::to_string(colmapModelParamCount(model_id)) + " parameters for " + cam.model);
   }
   constexpr auto kMaxId = static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max());
   for (const auto& [id, img] : model.images) {
@@ -321,8 +307,7 @@ void checkWritable(const ColmapModel& model, const std::string& dir) {
       throw InputError(path, where + ": points2D", "expected one point3D id per 2D point");
     for (std::uint64_t pid : img.point3d_ids)
       if (pid != kInvalidPoint3DId && pid > kMaxId)
-        throw InputError(path, where + ": point3D_id",
-                         "expected ids below 2^63, got " + std::to_string(pid));
+        throw InputError(path, where + ": point3D_id", "expected ids below 2^63, got " + std::to_string(pid));
   }
 }
 

@@ -31,8 +31,7 @@ constexpr std::array<ModelInfo, 11> kModels{{
 }};
 
 const ModelInfo* find(int id) {
-  return id >= 0 && id < static_cast<int>(kModels.size()) ? &kModels[static_cast<size_t>(id)]
-                                                          : nullptr;
+  return id >= 0 && id < static_cast<int>(kModels.size()) ? &kModels[static_cast<size_t>(id)] : nullptr;
 }
 
 }  // namespace

@@ -27,9 +27,7 @@ using colmap_detail::checkPose;
 
 constexpr std::string_view kSpace = " \t\r\v\f";
 
-std::string pathIn(const std::string& dir, const char* name) {
-  return (std::filesystem::path(dir) / name).string();
-}
+std::string pathIn(const std::string& dir, const char* name) { return (std::filesystem::path(dir) / name).string(); }
 
 std::string_view trim(std::string_view s) {
   const size_t b = s.find_first_not_of(kSpace);
@@ -94,16 +92,14 @@ class Fields {
 
   template <typename T>
   T take(std::string_view column) {
-    if (done())
-      fail(column, std::string("expected ") + describe<T>() + ", got the end of the line");
+    if (done()) fail(column, std::string("expected ") + describe<T>() + ", got the end of the line");
     return parse<T>(tokens_[next_++], column);
   }
 
   template <typename T>
   T parse(std::string_view tok, std::string_view column) const {
     const std::optional<T> v = parseToken<T>(tok);
-    if (!v)
-      fail(column, std::string("expected ") + describe<T>() + ", got '" + std::string(tok) + "'");
+    if (!v) fail(column, std::string("expected ") + describe<T>() + ", got '" + std::string(tok) + "'");
     return *v;
   }
 
@@ -166,9 +162,8 @@ class TextFile {
   void checkCount(size_t records) const {
     if (count_ && *count_ != records)
       throw InputError(path_, lineName(count_line_) + ": " + countField(),
-                       "the header says " + std::to_string(*count_) + " " + things_ +
-                           ", the file has " + std::to_string(records) +
-                           " (truncated or edited file?)");
+                       "the header says " + std::to_string(*count_) + " " + things_ + ", the file has " +
+                           std::to_string(records) + " (truncated or edited file?)");
   }
 
  private:
@@ -266,8 +261,7 @@ void parsePoints2D(Fields& f, ColmapImage& img) {
     const double y = f.take<double>("Y");
     img.xys.emplace_back(x, y);
     const std::string_view id = f.word("POINT3D_ID");
-    img.point3d_ids.push_back(id == "-1" ? kInvalidPoint3DId
-                                         : f.parse<std::uint64_t>(id, "POINT3D_ID"));
+    img.point3d_ids.push_back(id == "-1" ? kInvalidPoint3DId : f.parse<std::uint64_t>(id, "POINT3D_ID"));
   }
 }
 
@@ -289,12 +283,10 @@ ColmapPoint3D parsePoint(Fields& f) {
   ColmapPoint3D pt;
   pt.id = f.take<std::uint64_t>("POINT3D_ID");
   for (int i = 0; i < 3; ++i) pt.xyz[i] = f.take<double>(std::string(1, "XYZ"[i]));
-  for (int i = 0; i < 3; ++i)
-    pt.rgb[static_cast<size_t>(i)] = f.take<std::uint8_t>(std::string(1, "RGB"[i]));
+  for (int i = 0; i < 3; ++i) pt.rgb[static_cast<size_t>(i)] = f.take<std::uint8_t>(std::string(1, "RGB"[i]));
   pt.error = f.take<double>("ERROR");
   if (f.left() % 2 != 0)
-    f.fail("TRACK",
-           "expected IMAGE_ID POINT2D_IDX pairs, got " + std::to_string(f.left()) + " values");
+    f.fail("TRACK", "expected IMAGE_ID POINT2D_IDX pairs, got " + std::to_string(f.left()) + " values");
   pt.track.reserve(f.left() / 2);
   while (!f.done()) {
     TrackElement e;
@@ -343,8 +335,7 @@ void writeImages(std::ostream& o, const ColmapModel& model) {
   size_t observations = 0;
   for (const auto& [id, img] : model.images)
     for (std::uint64_t pid : img.point3d_ids) observations += pid != kInvalidPoint3DId;
-  const double mean =
-      model.images.empty() ? 0.0 : double(observations) / double(model.images.size());
+  const double mean = model.images.empty() ? 0.0 : double(observations) / double(model.images.size());
   o << "# Image list with two lines of data per image:\n"
        "#   IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\n"
        "#   POINTS2D[] as (X, Y, POINT3D_ID)\n"
@@ -393,8 +384,7 @@ void writePoints(std::ostream& o, const ColmapModel& model) {
 void checkWritable(const ColmapModel& model, const std::string& path) {
   for (const auto& [id, img] : model.images) {
     const std::string where = "image " + std::to_string(id);
-    if (img.name.empty() || img.name.find_first_of("\r\n") != std::string::npos ||
-        trim(img.name) != img.name)
+    if (img.name.empty() || img.name.find_first_of("\r\n") != std::string::npos || trim(img.name) != img.name)
       throw InputError(path, where + ": name",
                        "expected a non-empty name on one line without leading or trailing blanks, "
                        "got '" +

@@ -45,8 +45,7 @@ void checkCamera(const ColmapCamera& cam, const std::string& file, const std::st
   for (size_t i = 0; i < count; ++i)
     if (!std::isfinite(cam.params[i]))
       fail(file, where, "params",
-           "expected finite parameters, parameter " + std::to_string(i) + " is " +
-               str(cam.params[i]));
+           "expected finite parameters, parameter " + std::to_string(i) + " is " + str(cam.params[i]));
   for (int i = 0; i < focalLengthCount(id); ++i)
     if (!(cam.params[static_cast<size_t>(i)] > 0))
       fail(file, where, "focal length",
@@ -55,37 +54,34 @@ void checkCamera(const ColmapCamera& cam, const std::string& file, const std::st
   for (const auto& [name, v] : {std::pair<const char*, std::uint64_t>{"width", cam.width}, {"height", cam.height}})
     if (v == 0 || v > static_cast<std::uint64_t>(kMaxImageSide))
       fail(file, where, name,
-           "expected an image " + std::string(name) + " in 1.." + std::to_string(kMaxImageSide) + ", got " + std::to_string(v));
+           "expected an image " + std::string(name) + " in 1.." + std::to_string(kMaxImageSide) + ", got " +
+               std::to_string(v));
 }
 
 void checkPose(const Eigen::Quaterniond& q, const Eigen::Vector3d& t, const std::string& file,
                const std::string& where) {
-  if (!q.coeffs().allFinite())
-    fail(file, where, "quaternion", "expected finite QW QX QY QZ, got NaN or Inf");
+  if (!q.coeffs().allFinite()) fail(file, where, "quaternion", "expected finite QW QX QY QZ, got NaN or Inf");
   if (!t.allFinite()) fail(file, where, "translation", "expected finite TX TY TZ, got NaN or Inf");
   // COLMAP writes normalised quaternions; a clearly non-unit one means a corrupt or
   // mis-ordered file, and silently normalising it would hide that.
   const double norm = q.norm();
   if (std::abs(norm - 1.0) > 1e-3)
-    fail(file, where, "quaternion",
-         "expected a unit quaternion (|norm - 1| <= 1e-3), got norm " + str(norm));
+    fail(file, where, "quaternion", "expected a unit quaternion (|norm - 1| <= 1e-3), got norm " + str(norm));
 }
 
 void checkImagePoints(const ColmapImage& img, const std::string& file, const std::string& where) {
   if (img.xys.size() != img.point3d_ids.size())
     fail(file, where, "points2D",
-         "expected one point3D id per 2D point, got " + std::to_string(img.xys.size()) +
-             " points and " + std::to_string(img.point3d_ids.size()) + " ids");
+         "expected one point3D id per 2D point, got " + std::to_string(img.xys.size()) + " points and " +
+             std::to_string(img.point3d_ids.size()) + " ids");
   for (size_t i = 0; i < img.xys.size(); ++i)
     if (!img.xys[i].allFinite())
-      fail(file, where, "points2D",
-           "expected finite X Y, 2D point " + std::to_string(i) + " has NaN or Inf");
+      fail(file, where, "points2D", "expected finite X Y, 2D point " + std::to_string(i) + " has NaN or Inf");
 }
 
 void checkPoint(const ColmapPoint3D& pt, const std::string& file, const std::string& where) {
   if (!pt.xyz.allFinite()) fail(file, where, "xyz", "expected finite X Y Z, got NaN or Inf");
-  if (!std::isfinite(pt.error))
-    fail(file, where, "error", "expected a finite error, got " + str(pt.error));
+  if (!std::isfinite(pt.error)) fail(file, where, "error", "expected a finite error, got " + str(pt.error));
 }
 
 }  // namespace colmap_detail
@@ -103,19 +99,17 @@ void checkKeys(const Map& map, const std::string& dir, const char* kind, const c
            "expected the id to equal its map key, got " + std::to_string(value.id));
 }
 
-void checkImageReferences(const ColmapModel& model, const ColmapImage& img,
-                          const std::string& dir) {
+void checkImageReferences(const ColmapModel& model, const ColmapImage& img, const std::string& dir) {
   const std::string where = "image " + std::to_string(img.id);
   if (!model.cameras.count(img.camera_id))
     fail(dir, where, "camera_id",
-         "expected an existing camera, camera " + std::to_string(img.camera_id) +
-             " is not in cameras");
+         "expected an existing camera, camera " + std::to_string(img.camera_id) + " is not in cameras");
   for (size_t i = 0; i < img.point3d_ids.size(); ++i) {
     const std::uint64_t pid = img.point3d_ids[i];
     if (pid != kInvalidPoint3DId && !model.points.count(pid))
       fail(dir, where, "point3D_id",
-           "expected an existing point, 2D point " + std::to_string(i) + " references point " +
-               std::to_string(pid) + ", which is not in points3D");
+           "expected an existing point, 2D point " + std::to_string(i) + " references point " + std::to_string(pid) +
+               ", which is not in points3D");
   }
 }
 
@@ -130,9 +124,9 @@ void checkTrack(const ColmapModel& model, const ColmapPoint3D& pt, const std::st
                std::to_string(e.image_id) + ", which is not in images");
     if (e.point2d_idx >= it->second.xys.size())
       fail(dir, where, "track",
-           "expected a 2D point index below " + std::to_string(it->second.xys.size()) +
-               " (the 2D points of image " + std::to_string(e.image_id) + "), element " +
-               std::to_string(k) + " has " + std::to_string(e.point2d_idx));
+           "expected a 2D point index below " + std::to_string(it->second.xys.size()) + " (the 2D points of image " +
+               std::to_string(e.image_id) + "), element " + std::to_string(k) + " has " +
+               std::to_string(e.point2d_idx));
   }
 }
 
@@ -142,8 +136,7 @@ void validateColmapModel(const ColmapModel& model, const std::string& dir) {
   checkKeys(model.cameras, dir, "camera", "camera_id");
   checkKeys(model.images, dir, "image", "image_id");
   checkKeys(model.points, dir, "point", "point3D_id");
-  for (const auto& [id, cam] : model.cameras)
-    colmap_detail::checkCamera(cam, dir, "camera " + std::to_string(id));
+  for (const auto& [id, cam] : model.cameras) colmap_detail::checkCamera(cam, dir, "camera " + std::to_string(id));
   for (const auto& [id, img] : model.images) {
     const std::string where = "image " + std::to_string(id);
     colmap_detail::checkPose(img.q, img.t, dir, where);

@@ -35,8 +35,12 @@ nlohmann::json readJsonFile(const std::string& path) {
   }
 }
 
-std::string jsonPath(const std::string& parent, const std::string& key) { return parent.empty() ? key : parent + "." + key; }
-std::string jsonPath(const std::string& parent, std::size_t index) { return parent + "[" + std::to_string(index) + "]"; }
+std::string jsonPath(const std::string& parent, const std::string& key) {
+  return parent.empty() ? key : parent + "." + key;
+}
+std::string jsonPath(const std::string& parent, std::size_t index) {
+  return parent + "[" + std::to_string(index) + "]";
+}
 
 const json& jsonObject(const json& v, const std::string& file, const std::string& field) {
   if (!v.is_object()) expected(v, file, field.empty() ? "json" : field, "an object");
@@ -46,7 +50,8 @@ const json& jsonObject(const json& v, const std::string& file, const std::string
 const json& jsonArray(const json& v, const std::string& file, const std::string& field, std::size_t max_size) {
   if (!v.is_array()) expected(v, file, field, "an array");
   if (v.size() > max_size)
-    throw InputError(file, field, "holds " + std::to_string(v.size()) + " items, at most " + std::to_string(max_size) + " allowed");
+    throw InputError(file, field,
+                     "holds " + std::to_string(v.size()) + " items, at most " + std::to_string(max_size) + " allowed");
   return v;
 }
 
@@ -115,13 +120,15 @@ std::string jsonString(const json& v, const std::string& file, const std::string
 
 std::vector<std::string> jsonStrings(const json& v, const std::string& file, const std::string& field) {
   std::vector<std::string> out;
-  for (std::size_t i = 0; i < jsonArray(v, file, field).size(); ++i) out.push_back(jsonString(v[i], file, jsonPath(field, i)));
+  for (std::size_t i = 0; i < jsonArray(v, file, field).size(); ++i)
+    out.push_back(jsonString(v[i], file, jsonPath(field, i)));
   return out;
 }
 
 std::vector<double> jsonNumbers(const json& v, const std::string& file, const std::string& field) {
   std::vector<double> out;
-  for (std::size_t i = 0; i < jsonArray(v, file, field).size(); ++i) out.push_back(jsonNumber(v[i], file, jsonPath(field, i)));
+  for (std::size_t i = 0; i < jsonArray(v, file, field).size(); ++i)
+    out.push_back(jsonNumber(v[i], file, jsonPath(field, i)));
   return out;
 }
 

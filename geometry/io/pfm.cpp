@@ -51,8 +51,7 @@ class HeaderReader {
     double v = 0;
     const auto [p, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), v);
     if (ec != std::errc() || p != tok.data() + tok.size() || !std::isfinite(v) || v == 0)
-      fail("header: scale",
-           "expected a non-zero number (negative: little-endian), got '" + std::string(tok) + "'");
+      fail("header: scale", "expected a non-zero number (negative: little-endian), got '" + std::string(tok) + "'");
     // Exactly one whitespace character ends the header: the data may start with a
     // byte that looks like whitespace.
     if (pos_ >= data_.size() || !isSpace(data_[pos_]))
@@ -63,9 +62,7 @@ class HeaderReader {
 
   size_t position() const { return pos_; }
 
-  [[noreturn]] void fail(const char* field, const std::string& what) const {
-    throw InputError(path_, field, what);
-  }
+  [[noreturn]] void fail(const char* field, const std::string& what) const { throw InputError(path_, field, what); }
 
  private:
   // Whitespace (at least one character), then a token of at most 32 characters.
@@ -97,32 +94,28 @@ ImageF readPfm(const std::string& path) {
 
   // Compare before allocating (a corrupt size must not allocate gigabytes); by
   // division, since height * row_bytes can overflow.
-  const size_t row_bytes =
-      static_cast<size_t>(width) * static_cast<size_t>(channels) * sizeof(float);
+  const size_t row_bytes = static_cast<size_t>(width) * static_cast<size_t>(channels) * sizeof(float);
   const size_t remaining = data.size() - header.position();
   if (remaining % row_bytes != 0 || remaining / row_bytes != static_cast<size_t>(height))
     throw InputError(path, "data",
-                     "expected " + std::to_string(height) + " rows of " +
-                         std::to_string(row_bytes) + " bytes, found " + std::to_string(remaining) +
-                         " bytes");
+                     "expected " + std::to_string(height) + " rows of " + std::to_string(row_bytes) + " bytes, found " +
+                         std::to_string(remaining) + " bytes");
 
   ImageF img(width, height, channels);
   const char* p = data.data() + header.position();
   // The first stored row is the bottom one.
   for (int y = height - 1; y >= 0; --y)
     for (int x = 0; x < width; ++x)
-      for (int c = 0; c < channels; ++c, p += sizeof(float))
-        img.at(x, y, c) = byte_order::load<float>(p, order);
+      for (int c = 0; c < channels; ++c, p += sizeof(float)) img.at(x, y, c) = byte_order::load<float>(p, order);
   return img;
 }
 
 void writePfm(const std::string& path, const ImageF& img) {
   if (img.channels != 1 && img.channels != 3)
-    throw InputError(path, "channels",
-                     "expected 1 or 3 channels, got " + std::to_string(img.channels));
+    throw InputError(path, "channels", "expected 1 or 3 channels, got " + std::to_string(img.channels));
   if (img.width <= 0 || img.height <= 0 ||
-      img.data.size() != static_cast<size_t>(img.width) * static_cast<size_t>(img.height) *
-                             static_cast<size_t>(img.channels))
+      img.data.size() !=
+          static_cast<size_t>(img.width) * static_cast<size_t>(img.height) * static_cast<size_t>(img.channels))
     throw InputError(path, "image", "expected a non-empty image whose data matches its size");
   std::string bytes = (img.channels == 3 ? "PF\n" : "Pf\n") + std::to_string(img.width) + " " +
                       std::to_string(img.height) + "\n-1.0\n";  // negative scale: little-endian

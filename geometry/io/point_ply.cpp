@@ -32,13 +32,17 @@ std::optional<Scalar> scalarType(const std::string& t) {
 std::size_t sizeOf(Scalar s) {
   switch (s) {
     case Scalar::kInt8:
-    case Scalar::kUInt8: return 1;
+    case Scalar::kUInt8:
+      return 1;
     case Scalar::kInt16:
-    case Scalar::kUInt16: return 2;
+    case Scalar::kUInt16:
+      return 2;
     case Scalar::kInt32:
     case Scalar::kUInt32:
-    case Scalar::kFloat32: return 4;
-    case Scalar::kFloat64: return 8;
+    case Scalar::kFloat32:
+      return 4;
+    case Scalar::kFloat64:
+      return 8;
   }
   return 0;
 }
@@ -47,14 +51,22 @@ double loadScalar(const char* p, Scalar s) {
   using byte_order::load;
   constexpr auto le = std::endian::little;
   switch (s) {
-    case Scalar::kInt8: return load<std::int8_t>(p, le);
-    case Scalar::kUInt8: return load<std::uint8_t>(p, le);
-    case Scalar::kInt16: return load<std::int16_t>(p, le);
-    case Scalar::kUInt16: return load<std::uint16_t>(p, le);
-    case Scalar::kInt32: return load<std::int32_t>(p, le);
-    case Scalar::kUInt32: return load<std::uint32_t>(p, le);
-    case Scalar::kFloat32: return load<float>(p, le);
-    case Scalar::kFloat64: return load<double>(p, le);
+    case Scalar::kInt8:
+      return load<std::int8_t>(p, le);
+    case Scalar::kUInt8:
+      return load<std::uint8_t>(p, le);
+    case Scalar::kInt16:
+      return load<std::int16_t>(p, le);
+    case Scalar::kUInt16:
+      return load<std::uint16_t>(p, le);
+    case Scalar::kInt32:
+      return load<std::int32_t>(p, le);
+    case Scalar::kUInt32:
+      return load<std::uint32_t>(p, le);
+    case Scalar::kFloat32:
+      return load<float>(p, le);
+    case Scalar::kFloat64:
+      return load<double>(p, le);
   }
   return 0;
 }
@@ -117,7 +129,8 @@ VertexLayout parseHeader(const std::string& bytes, const std::string& path) {
       std::string type, name;
       ls >> type >> name;
       const auto t = scalarType(type);
-      if (type == "list") throw InputError(path, "property " + name, "a list property in the vertex element is not supported");
+      if (type == "list")
+        throw InputError(path, "property " + name, "a list property in the vertex element is not supported");
       if (!t || name.empty()) throw InputError(path, "header", "bad property line '" + *line + "'");
       const int index = static_cast<int>(L.types.size());
       for (int k = 0; k < 3; ++k) {
@@ -164,8 +177,9 @@ std::vector<PlyPoint> readPointsPly(const std::string& path) {
   // Each vertex needs its bytes (binary) or one character and a separator per value (ascii).
   const std::uint64_t least = L.ascii ? 2 * n_props : L.stride;
   if (least == 0 || L.count > left / least)
-    throw InputError(path, "element vertex",
-                     std::to_string(L.count) + " vertices cannot fit in the " + std::to_string(left) + " bytes after the header");
+    throw InputError(
+        path, "element vertex",
+        std::to_string(L.count) + " vertices cannot fit in the " + std::to_string(left) + " bytes after the header");
   std::vector<PlyPoint> out(L.count);
   std::vector<double> values(n_props);
   std::size_t pos = L.data_offset;
@@ -178,7 +192,9 @@ std::vector<PlyPoint> readPointsPly(const std::string& path) {
         while (end < bytes.size() && !std::isspace(static_cast<unsigned char>(bytes[end]))) ++end;
         const auto [p, ec] = std::from_chars(bytes.data() + pos, bytes.data() + end, values[k]);
         if (pos == end || ec != std::errc() || p != bytes.data() + end)
-          throw InputError(path, where, "expected " + std::to_string(n_props) + " numbers, got '" + bytes.substr(pos, std::min<std::size_t>(end - pos, 20)) + "'");
+          throw InputError(path, where,
+                           "expected " + std::to_string(n_props) + " numbers, got '" +
+                               bytes.substr(pos, std::min<std::size_t>(end - pos, 20)) + "'");
         pos = end;
       }
     } else {

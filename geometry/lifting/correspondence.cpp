@@ -73,20 +73,17 @@ std::vector<Correspondence> readMatches(const std::string& path, const MatchesFi
     if (first == line.size() || line[first] == '#') continue;
     const std::string field = "line " + std::to_string(line_no);
     if (!have_header) {
-      if (!splitFields(line, fields) || fields.size() != 4 || fields[0] != "x0" ||
-          fields[1] != "y0" || fields[2] != "x1" || fields[3] != "y1")
+      if (!splitFields(line, fields) || fields.size() != 4 || fields[0] != "x0" || fields[1] != "y0" ||
+          fields[2] != "x1" || fields[3] != "y1")
         throw InputError(path, field, "expected the header 'x0,y0,x1,y1', got " + quoted(line));
       have_header = true;
       continue;
     }
     double v[4];
     if (!splitFields(line, fields) || fields.size() != 4 || !parseFinite(fields[0], v[0]) ||
-        !parseFinite(fields[1], v[1]) || !parseFinite(fields[2], v[2]) ||
-        !parseFinite(fields[3], v[3]))
-      throw InputError(path, field,
-                       "expected four finite numbers x0,y0,x1,y1, got " + quoted(line));
-    out.push_back({Eigen::Vector2d(v[0] + shift, v[1] + shift),
-                   Eigen::Vector2d(v[2] + shift, v[3] + shift)});
+        !parseFinite(fields[1], v[1]) || !parseFinite(fields[2], v[2]) || !parseFinite(fields[3], v[3]))
+      throw InputError(path, field, "expected four finite numbers x0,y0,x1,y1, got " + quoted(line));
+    out.push_back({Eigen::Vector2d(v[0] + shift, v[1] + shift), Eigen::Vector2d(v[2] + shift, v[3] + shift)});
   }
   if (!have_header) throw InputError(path, "header", "expected the header line 'x0,y0,x1,y1'");
   return out;
@@ -98,23 +95,20 @@ void writeMatches(const std::string& path, std::span<const Correspondence> match
     os.precision(std::numeric_limits<double>::max_digits10);
     os << "# saresgs matches: view 0 (real) -> view 1 (extrapolated), pixel centres at +0.5\n"
        << "x0,y0,x1,y1\n";
-    for (const auto& m : matches)
-      os << m.x0.x() << ',' << m.x0.y() << ',' << m.x1.x() << ',' << m.x1.y() << '\n';
+    for (const auto& m : matches) os << m.x0.x() << ',' << m.x0.y() << ',' << m.x1.x() << ',' << m.x1.y() << '\n';
   });
 }
 
-std::vector<Correspondence> subsampleByStride(std::span<const Correspondence> matches,
-                                              int stride, int width, int height) {
-  if (stride < 1)
-    throw InputError("lifting options", "stride", "expected >= 1, got " + std::to_string(stride));
+std::vector<Correspondence> subsampleByStride(std::span<const Correspondence> matches, int stride, int width,
+                                              int height) {
+  if (stride < 1) throw InputError("lifting options", "stride", "expected >= 1, got " + std::to_string(stride));
   if (width <= 0 || height <= 0) return {};
   const int nx = (width + stride - 1) / stride, ny = (height + stride - 1) / stride;
   std::vector<std::ptrdiff_t> best(static_cast<std::size_t>(nx) * ny, -1);
   std::vector<double> best_d2(best.size(), 0.0);
   for (std::size_t i = 0; i < matches.size(); ++i) {
     const Eigen::Vector2d& x = matches[i].x0;
-    if (!x.allFinite() || !(x.x() >= 0 && x.x() < width && x.y() >= 0 && x.y() < height))
-      continue;
+    if (!x.allFinite() || !(x.x() >= 0 && x.x() < width && x.y() >= 0 && x.y() < height)) continue;
     const int cx = std::min(static_cast<int>(x.x()) / stride, nx - 1);
     const int cy = std::min(static_cast<int>(x.y()) / stride, ny - 1);
     const Eigen::Vector2d anchor(cx * stride + 0.5, cy * stride + 0.5);

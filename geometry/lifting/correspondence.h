@@ -33,8 +33,7 @@ struct MatchesFileOptions {
   double pixel_center = 0.5;
 };
 
-std::vector<Correspondence> readMatches(const std::string& path,
-                                        const MatchesFileOptions& opts = {});
+std::vector<Correspondence> readMatches(const std::string& path, const MatchesFileOptions& opts = {});
 // Writes the format above (pixel_center 0.5) with 17 significant digits, so that reading
 // the file back gives the same doubles; written to a temporary name, then renamed.
 void writeMatches(const std::string& path, std::span<const Correspondence> matches);
@@ -45,7 +44,7 @@ void writeMatches(const std::string& path, std::span<const Correspondence> match
 // as in the paper (5 px in x and y); for sparse input it thins without moving points.
 // Correspondences whose x0 is not finite or lies outside [0, width) x [0, height) are
 // dropped. The output is in the order of the cells (row-major), so it is deterministic.
-std::vector<Correspondence> subsampleByStride(std::span<const Correspondence> matches,
-                                              int stride, int width, int height);
+std::vector<Correspondence> subsampleByStride(std::span<const Correspondence> matches, int stride, int width,
+                                              int height);
 
 }  // namespace saresgs

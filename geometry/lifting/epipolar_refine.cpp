@@ -18,12 +18,13 @@ struct Luma {
   int width = 0, height = 0;
   std::vector<float> v;
 
-  explicit Luma(const ImageF& img) : width(img.width), height(img.height), v(img.data.size() / std::max(img.channels, 1)) {
+  explicit Luma(const ImageF& img)
+      : width(img.width), height(img.height), v(img.data.size() / std::max(img.channels, 1)) {
     for (int y = 0; y < height; ++y)
       for (int x = 0; x < width; ++x) {
-        const float l = img.channels >= 3 ? 0.299f * img.at(x, y, 0) + 0.587f * img.at(x, y, 1) +
-                                                0.114f * img.at(x, y, 2)
-                                          : img.at(x, y, 0);
+        const float l = img.channels >= 3
+                            ? 0.299f * img.at(x, y, 0) + 0.587f * img.at(x, y, 1) + 0.114f * img.at(x, y, 2)
+                            : img.at(x, y, 0);
         v[static_cast<std::size_t>(y) * width + x] = std::isfinite(l) ? l : 0.0f;
       }
   }
@@ -63,8 +64,7 @@ std::optional<Eigen::Vector2d> dehom(const Eigen::Vector3d& h) {
   return p;
 }
 
-std::optional<Correspondence> refineOne(const PairGeometry& g, const Luma& l0, const Luma& l1,
-                                        const Correspondence& m,
+std::optional<Correspondence> refineOne(const PairGeometry& g, const Luma& l0, const Luma& l1, const Correspondence& m,
                                         const EpipolarRefineOptions& o) {
   if (!m.x0.allFinite() || !m.x1.allFinite()) return std::nullopt;
   const Eigen::Vector3d h0 = g.M * Eigen::Vector3d(m.x0.x(), m.x0.y(), 1.0);
@@ -124,7 +124,8 @@ std::optional<Correspondence> refineOne(const PairGeometry& g, const Luma& l0, c
     for (int i = 0; i < n && inside; ++i) {
       const auto q = dehom(base[i] + rho * g.hb);
       const auto val = q ? l1.sample(q->x(), q->y()) : std::nullopt;
-      if (!val) inside = false;
+      if (!val)
+        inside = false;
       else {
         cur[i] = *val;
         mean1 += *val;
@@ -160,12 +161,11 @@ std::optional<Correspondence> refineOne(const PairGeometry& g, const Luma& l0, c
 
 }  // namespace
 
-std::vector<Correspondence> refineOnEpipolarLines(const Camera& cam0, const ImageF& image0,
-                                                  const Camera& cam1, const ImageF& image1,
-                                                  std::span<const Correspondence> matches,
+std::vector<Correspondence> refineOnEpipolarLines(const Camera& cam0, const ImageF& image0, const Camera& cam1,
+                                                  const ImageF& image1, std::span<const Correspondence> matches,
                                                   const EpipolarRefineOptions& opts) {
-  if (image0.empty() || image1.empty() || image0.width < 2 || image0.height < 2 ||
-      image1.width < 2 || image1.height < 2)
+  if (image0.empty() || image1.empty() || image0.width < 2 || image0.height < 2 || image1.width < 2 ||
+      image1.height < 2)
     return {};
   const PairGeometry g = pairGeometry(cam0, cam1);
   if (!g.M.allFinite() || !g.hb.allFinite()) return {};

@@ -32,19 +32,18 @@ struct EpipolarRefineOptions {
   // The initial x1 must be this close to x0's epipolar line. Only a guard against refining
   // junk: the paper's 1 px reprojection test decides later (it sees the same distance).
   double max_epipolar_px = 3.0;
-  double search_px = 3.0;        // half-length of the search along the line, pixels
-  double step_px = 0.25;         // search step along the line, pixels
-  int patch_radius = 3;          // 7x7 patches
+  double search_px = 3.0;  // half-length of the search along the line, pixels
+  double step_px = 0.25;   // search step along the line, pixels
+  int patch_radius = 3;    // 7x7 patches
   double min_zncc = 0.9;
-  double min_patch_std = 0.01;   // luma standard deviation of the patch around x0 (in [0,1])
+  double min_patch_std = 0.01;  // luma standard deviation of the patch around x0 (in [0,1])
 };
 
 // Returns the refined correspondences that pass (x0 unchanged, x1 moved along the line),
 // in input order. Images are RGB (or grey) float in [0,1] of the cameras' sizes.
 // TBB-parallel with one slot per input, so the result does not depend on the threads.
-std::vector<Correspondence> refineOnEpipolarLines(const Camera& cam0, const ImageF& image0,
-                                                  const Camera& cam1, const ImageF& image1,
-                                                  std::span<const Correspondence> matches,
+std::vector<Correspondence> refineOnEpipolarLines(const Camera& cam0, const ImageF& image0, const Camera& cam1,
+                                                  const ImageF& image1, std::span<const Correspondence> matches,
                                                   const EpipolarRefineOptions& opts = {});
 
 }  // namespace saresgs

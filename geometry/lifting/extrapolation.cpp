@@ -4,15 +4,14 @@ namespace saresgs {
 
 Camera extrapolatedCamera(const Camera& cam, double sx, double sy, double back) {
   // The rows of R are the camera axes in world coordinates; t = -R c.
-  const Eigen::Vector3d c = cam.center() + sx * cam.R.row(0).transpose() +
-                            sy * cam.R.row(1).transpose() - back * cam.R.row(2).transpose();
+  const Eigen::Vector3d c =
+      cam.center() + sx * cam.R.row(0).transpose() + sy * cam.R.row(1).transpose() - back * cam.R.row(2).transpose();
   Camera e = cam;
   e.t = -cam.R * c;
   return e;
 }
 
-std::vector<Camera> extrapolatedCameras(const Camera& cam, double extent,
-                                        const ExtrapolationOptions& opts) {
+std::vector<Camera> extrapolatedCameras(const Camera& cam, double extent, const ExtrapolationOptions& opts) {
   const double dx = opts.dx_fraction * extent;
   const double dy = opts.dy_fraction * extent;
   const double dz = opts.dz_fraction * extent;

@@ -33,7 +33,6 @@ Camera extrapolatedCamera(const Camera& cam, double sx, double sy, double back);
 // The extrapolated views of `cam` for a scene of the given extent (see the options), in a
 // fixed order: with all_combinations, sy = -1, 0, +1 (outer) then sx = -1, 0, +1 (inner),
 // skipping (0, 0), except that the default view (+1, +1) comes first.
-std::vector<Camera> extrapolatedCameras(const Camera& cam, double extent,
-                                        const ExtrapolationOptions& opts = {});
+std::vector<Camera> extrapolatedCameras(const Camera& cam, double extent, const ExtrapolationOptions& opts = {});
 
 }  // namespace saresgs

@@ -20,9 +20,8 @@ cv::Mat toGrey8(const ImageF& img) {
   for (int y = 0; y < img.height; ++y) {
     auto* row = g.ptr<std::uint8_t>(y);
     for (int x = 0; x < img.width; ++x) {
-      float v = img.channels >= 3
-                    ? 0.299f * img.at(x, y, 0) + 0.587f * img.at(x, y, 1) + 0.114f * img.at(x, y, 2)
-                    : img.at(x, y, 0);
+      float v = img.channels >= 3 ? 0.299f * img.at(x, y, 0) + 0.587f * img.at(x, y, 1) + 0.114f * img.at(x, y, 2)
+                                  : img.at(x, y, 0);
       if (!(v > 0.0f)) v = 0.0f;  // also catches NaN
       row[x] = static_cast<std::uint8_t>(std::lround(std::min(v, 1.0f) * 255.0f));
     }
@@ -32,9 +31,12 @@ cv::Mat toGrey8(const ImageF& img) {
 
 int disPreset(FlowPreset p) {
   switch (p) {
-    case FlowPreset::kUltrafast: return cv::DISOpticalFlow::PRESET_ULTRAFAST;
-    case FlowPreset::kFast: return cv::DISOpticalFlow::PRESET_FAST;
-    case FlowPreset::kMedium: return cv::DISOpticalFlow::PRESET_MEDIUM;
+    case FlowPreset::kUltrafast:
+      return cv::DISOpticalFlow::PRESET_ULTRAFAST;
+    case FlowPreset::kFast:
+      return cv::DISOpticalFlow::PRESET_FAST;
+    case FlowPreset::kMedium:
+      return cv::DISOpticalFlow::PRESET_MEDIUM;
   }
   return cv::DISOpticalFlow::PRESET_MEDIUM;
 }
@@ -60,20 +62,22 @@ FlowPreset parseFlowPreset(const std::string& name) {
 
 const char* flowPresetName(FlowPreset p) {
   switch (p) {
-    case FlowPreset::kUltrafast: return "ultrafast";
-    case FlowPreset::kFast: return "fast";
-    case FlowPreset::kMedium: return "medium";
+    case FlowPreset::kUltrafast:
+      return "ultrafast";
+    case FlowPreset::kFast:
+      return "fast";
+    case FlowPreset::kMedium:
+      return "medium";
   }
   return "medium";
 }
 
-CorrespondenceSet flowCorrespondences(const ImageF& image0, const ImageF& image1,
-                                      const FlowOptions& opts) {
+CorrespondenceSet flowCorrespondences(const ImageF& image0, const ImageF& image1, const FlowOptions& opts) {
   if (image0.width != image1.width || image0.height != image1.height)
     throw InputError("flow", "image size",
-                     "expected two images of the same size, got " + std::to_string(image0.width) +
-                         "x" + std::to_string(image0.height) + " and " +
-                         std::to_string(image1.width) + "x" + std::to_string(image1.height));
+                     "expected two images of the same size, got " + std::to_string(image0.width) + "x" +
+                         std::to_string(image0.height) + " and " + std::to_string(image1.width) + "x" +
+                         std::to_string(image1.height));
   CorrespondenceSet out;
   const int W = image0.width, H = image0.height;
   out.candidates = static_cast<std::size_t>(W) * H;
@@ -96,8 +100,7 @@ CorrespondenceSet flowCorrespondences(const ImageF& image0, const ImageF& image1
       const cv::Vec2f b01 = bwd.at<cv::Vec2f>(y0 + 1, x0), b11 = bwd.at<cv::Vec2f>(y0 + 1, x0 + 1);
       double bx = 0, by = 0;
       for (int c = 0; c < 2; ++c) {
-        const double v = (1 - ay) * ((1 - ax) * b00[c] + ax * b10[c]) +
-                         ay * ((1 - ax) * b01[c] + ax * b11[c]);
+        const double v = (1 - ay) * ((1 - ax) * b00[c] + ax * b10[c]) + ay * ((1 - ax) * b01[c] + ax * b11[c]);
         (c == 0 ? bx : by) = v;
       }
       const double ex = f[0] + bx, ey = f[1] + by;
@@ -116,10 +119,9 @@ LiftingModule flowModule(const FlowOptions& opts) {
     CorrespondenceSet set = flowCorrespondences(pair.real_image, pair.extrapolated_image, opts);
     if (!opts.epipolar_refine) return set;
     // Thin first: refinement costs a patch search per match.
-    const auto thin = subsampleByStride(set.matches, pair.stride, pair.real.K.width,
-                                        pair.real.K.height);
-    set.matches = refineOnEpipolarLines(pair.real, pair.real_image, pair.extrapolated,
-                                        pair.extrapolated_image, thin, opts.refine);
+    const auto thin = subsampleByStride(set.matches, pair.stride, pair.real.K.width, pair.real.K.height);
+    set.matches = refineOnEpipolarLines(pair.real, pair.real_image, pair.extrapolated, pair.extrapolated_image, thin,
+                                        opts.refine);
     return set;
   };
   return m;

@@ -13,16 +13,13 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double secondsSince(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
+double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 void checkImage(const ImageF& img, const Camera& cam, const std::string& what) {
   if (img.width != cam.K.width || img.height != cam.K.height || img.channels < 1 ||
       img.data.size() != static_cast<std::size_t>(img.width) * img.height * img.channels)
     throw InputError("lifting", what,
-                     "expected a " + std::to_string(cam.K.width) + "x" +
-                         std::to_string(cam.K.height) + " image, got " +
+                     "expected a " + std::to_string(cam.K.width) + "x" + std::to_string(cam.K.height) + " image, got " +
                          std::to_string(img.width) + "x" + std::to_string(img.height) + "x" +
                          std::to_string(img.channels));
 }
@@ -73,8 +70,7 @@ LiftingModule matchesModule(std::string path_pattern, const MatchesFileOptions& 
   return m;
 }
 
-CorrespondenceSet depthCorrespondences(const Camera& real, const ImageF& depth,
-                                       const Camera& other) {
+CorrespondenceSet depthCorrespondences(const Camera& real, const ImageF& depth, const Camera& other) {
   checkImage(depth, real, "depth map");
   CorrespondenceSet out;
   out.candidates = static_cast<std::size_t>(depth.width) * depth.height;
@@ -113,8 +109,7 @@ void LiftingReport::add(const LiftingReport& o) {
 
 nlohmann::json LiftingReport::toJson() const {
   nlohmann::json rej = nlohmann::json::object();
-  for (int r = 1; r < kRejectionCount; ++r)
-    rej[rejectionName(static_cast<Rejection>(r))] = rejected[r];
+  for (int r = 1; r < kRejectionCount; ++r) rej[rejectionName(static_cast<Rejection>(r))] = rejected[r];
   return {{"module", module},
           {"view", view},
           {"extrapolated_views", extrapolated_views},
@@ -124,22 +119,19 @@ nlohmann::json LiftingReport::toJson() const {
           {"kept", kept},
           {"rejected", rej},
           {"median_reprojection_px", median_reprojection_px},
-          {"seconds", {{"render", seconds_render},
-                       {"correspondence", seconds_correspondence},
-                       {"triangulation", seconds_triangulation}}}};
+          {"seconds",
+           {{"render", seconds_render},
+            {"correspondence", seconds_correspondence},
+            {"triangulation", seconds_triangulation}}}};
 }
 
-LiftingResult liftView(const Camera& real, const ImageF& real_image, double extent,
-                       const ViewRenderer& render, const LiftingModule& module,
-                       const LiftingOptions& opts, int view) {
+LiftingResult liftView(const Camera& real, const ImageF& real_image, double extent, const ViewRenderer& render,
+                       const LiftingModule& module, const LiftingOptions& opts, int view) {
   if (!(extent > 0) || !std::isfinite(extent))
-    throw InputError("lifting", "extent", "expected a positive finite scene extent, got " +
-                                              std::to_string(extent));
+    throw InputError("lifting", "extent", "expected a positive finite scene extent, got " + std::to_string(extent));
   if (opts.stride < 1)
-    throw InputError("lifting options", "stride",
-                     "expected >= 1, got " + std::to_string(opts.stride));
-  if (!module.correspond)
-    throw InputError("lifting", "module", "module '" + module.name + "' has no function");
+    throw InputError("lifting options", "stride", "expected >= 1, got " + std::to_string(opts.stride));
+  if (!module.correspond) throw InputError("lifting", "module", "module '" + module.name + "' has no function");
   if (module.needs_render && !render)
     throw InputError("lifting", "renderer", "module '" + module.name + "' needs a renderer");
   checkImage(real_image, real, "real image");
@@ -169,8 +161,7 @@ LiftingResult liftView(const Camera& real, const ImageF& real_image, double exte
     auto t0 = Clock::now();
     const LiftingPair pair{real, real_image, cam, rendered, view, static_cast<int>(k), opts.stride};
     const CorrespondenceSet set = module.correspond(pair);
-    const std::vector<Correspondence> sub =
-        subsampleByStride(set.matches, opts.stride, real.K.width, real.K.height);
+    const std::vector<Correspondence> sub = subsampleByStride(set.matches, opts.stride, real.K.width, real.K.height);
     rep.seconds_correspondence += secondsSince(t0);
 
     t0 = Clock::now();
@@ -180,8 +171,8 @@ LiftingResult liftView(const Camera& real, const ImageF& real_image, double exte
         ++rep.rejected[static_cast<int>(tp[i].rejection)];
         continue;
       }
-      result.points.push_back({tp[i].X, colourAt(real_image, sub[i].x0), sub[i].x0,
-                               static_cast<float>(tp[i].reprojection_px)});
+      result.points.push_back(
+          {tp[i].X, colourAt(real_image, sub[i].x0), sub[i].x0, static_cast<float>(tp[i].reprojection_px)});
       errors.push_back(tp[i].reprojection_px);
     }
     rep.seconds_triangulation += secondsSince(t0);

@@ -53,14 +53,14 @@ struct LiftingPair {
   const ImageF& extrapolated_image;  // empty when the module does not need renders
   int view = -1;                     // the caller's index of the real view
   int extrapolation = 0;             // index into extrapolatedCameras(real, ...)
-  int stride = 1;  // the pipeline's stride: a module may thin to it early (subsampleByStride
-                   // is idempotent, so the pipeline's own thinning then changes nothing)
+  int stride = 1;                    // the pipeline's stride: a module may thin to it early (subsampleByStride
+                                     // is idempotent, so the pipeline's own thinning then changes nothing)
 };
 
 struct CorrespondenceSet {
   std::vector<Correspondence> matches;  // x0 in the real view, x1 in the extrapolated view
-  std::size_t candidates = 0;  // what the module started from, before its own checks
-                               // (pixels for flow and depth, lines read for matches)
+  std::size_t candidates = 0;           // what the module started from, before its own checks
+                                        // (pixels for flow and depth, lines read for matches)
 };
 
 struct LiftingModule {
@@ -94,8 +94,7 @@ struct FlowOptions {
 // Flow from image0 to image1 (same size, RGB or grey float in [0,1], converted to 8-bit
 // luma for DIS) at every pixel centre that passes the check and whose target lies inside
 // image1's pixel-centre range. candidates = width * height.
-CorrespondenceSet flowCorrespondences(const ImageF& image0, const ImageF& image1,
-                                      const FlowOptions& opts = {});
+CorrespondenceSet flowCorrespondences(const ImageF& image0, const ImageF& image1, const FlowOptions& opts = {});
 // The module: flowCorrespondences, thinned to the pair's stride, then (by default)
 // refineOnEpipolarLines with the pair's cameras.
 LiftingModule flowModule(const FlowOptions& opts = {});
@@ -110,8 +109,7 @@ LiftingModule matchesModule(std::string path_pattern, const MatchesFileOptions& 
 // ---------------------------------------------------------------------------- depth
 // Every pixel centre of `real` with a positive finite depth, unprojected and projected into
 // `other` (dropped when behind it). candidates = width * height.
-CorrespondenceSet depthCorrespondences(const Camera& real, const ImageF& depth,
-                                       const Camera& other);
+CorrespondenceSet depthCorrespondences(const Camera& real, const ImageF& depth, const Camera& other);
 LiftingModule depthModule(DepthRenderer depth_of);
 
 // --------------------------------------------------------------------------- lifting
@@ -143,8 +141,8 @@ struct LiftingReport {
   std::size_t subsampled = 0;       // after the stride
   std::size_t kept = 0;
   std::array<std::size_t, kRejectionCount> rejected{};  // indexed by Rejection; [0] unused
-  double median_reprojection_px = 0;  // over the kept points; 0 when none
-  double seconds_render = 0;          // wall-clock per stage, summed over extrapolated views
+  double median_reprojection_px = 0;                    // over the kept points; 0 when none
+  double seconds_render = 0;                            // wall-clock per stage, summed over extrapolated views
   double seconds_correspondence = 0;
   double seconds_triangulation = 0;
 
@@ -162,9 +160,8 @@ struct LiftingResult {
 // `extent` the scene scale that the options' fractions refer to; `view` is passed to the
 // module (matches file names) and the report. Throws InputError on a non-positive extent,
 // a bad stride, a missing renderer or images of the wrong size.
-LiftingResult liftView(const Camera& real, const ImageF& real_image, double extent,
-                       const ViewRenderer& render, const LiftingModule& module,
-                       const LiftingOptions& opts = {}, int view = -1);
+LiftingResult liftView(const Camera& real, const ImageF& real_image, double extent, const ViewRenderer& render,
+                       const LiftingModule& module, const LiftingOptions& opts = {}, int view = -1);
 
 std::vector<Eigen::Vector3d> positions(std::span<const SAPoint> points);
 

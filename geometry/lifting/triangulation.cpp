@@ -15,14 +15,22 @@ using Matrix34d = Eigen::Matrix<double, 3, 4>;
 
 const char* rejectionName(Rejection r) {
   switch (r) {
-    case Rejection::kNone: return "kept";
-    case Rejection::kBorder: return "border";
-    case Rejection::kZeroBaseline: return "zero_baseline";
-    case Rejection::kDegenerate: return "degenerate";
-    case Rejection::kAtInfinity: return "at_infinity";
-    case Rejection::kBehindCamera: return "behind_camera";
-    case Rejection::kParallelRays: return "parallel_rays";
-    case Rejection::kReprojection: return "reprojection";
+    case Rejection::kNone:
+      return "kept";
+    case Rejection::kBorder:
+      return "border";
+    case Rejection::kZeroBaseline:
+      return "zero_baseline";
+    case Rejection::kDegenerate:
+      return "degenerate";
+    case Rejection::kAtInfinity:
+      return "at_infinity";
+    case Rejection::kBehindCamera:
+      return "behind_camera";
+    case Rejection::kParallelRays:
+      return "parallel_rays";
+    case Rejection::kReprojection:
+      return "reprojection";
   }
   return "unknown";
 }
@@ -38,8 +46,7 @@ bool cameraCentre(const Matrix34d& P, Eigen::Vector3d& c) {
 }
 
 bool insideImage(const Eigen::Vector2d& x, const Intrinsics& K, double border) {
-  return x.allFinite() && x.x() >= border && x.y() >= border && x.x() <= K.width - border &&
-         x.y() <= K.height - border;
+  return x.allFinite() && x.x() >= border && x.y() >= border && x.x() <= K.width - border && x.y() <= K.height - border;
 }
 
 struct PairGeometry {
@@ -90,8 +97,8 @@ DltSolution triangulateDLT(const Matrix34d& P0, const Matrix34d& P1, const Eigen
                            const Eigen::Vector2d& x1) {
   DltSolution out;
   Eigen::Vector3d c0, c1;
-  if (!P0.allFinite() || !P1.allFinite() || !x0.allFinite() || !x1.allFinite() ||
-      !cameraCentre(P0, c0) || !cameraCentre(P1, c1)) {
+  if (!P0.allFinite() || !P1.allFinite() || !x0.allFinite() || !x1.allFinite() || !cameraCentre(P0, c0) ||
+      !cameraCentre(P1, c1)) {
     out.status = Rejection::kDegenerate;
     return out;
   }

@@ -35,13 +35,13 @@ struct TriangulationOptions {
   // (1/128 of the scene box) of the surface; the extra points are far walls seen near the
   // epipole.
   double min_ray_angle_deg = 2.0;
-  double near = 1e-6;                // minimum depth along each camera's z axis, world units
-  double border_px = 1.0;            // both points must lie in [b, W - b] x [b, H - b]
+  double near = 1e-6;      // minimum depth along each camera's z axis, world units
+  double border_px = 1.0;  // both points must lie in [b, W - b] x [b, H - b]
 };
 
 struct TriangulatedPoint {
   Eigen::Vector3d X = Eigen::Vector3d::Zero();  // finite; zero when no point was solved
-  double reprojection_px = -1;  // mean of the two pixel errors; -1 when no point was solved
+  double reprojection_px = -1;                  // mean of the two pixel errors; -1 when no point was solved
   Rejection rejection = Rejection::kNone;
   bool kept() const { return rejection == Rejection::kNone; }
 };
@@ -53,9 +53,8 @@ struct DltSolution {
   Eigen::Vector3d X = Eigen::Vector3d::Zero();
   Rejection status = Rejection::kNone;
 };
-DltSolution triangulateDLT(const Eigen::Matrix<double, 3, 4>& P0,
-                           const Eigen::Matrix<double, 3, 4>& P1, const Eigen::Vector2d& x0,
-                           const Eigen::Vector2d& x1);
+DltSolution triangulateDLT(const Eigen::Matrix<double, 3, 4>& P0, const Eigen::Matrix<double, 3, 4>& P1,
+                           const Eigen::Vector2d& x0, const Eigen::Vector2d& x1);
 
 // One correspondence between cam0 and cam1: DLT from their projection matrices, then the
 // checks of Rejection in order.

@@ -71,13 +71,11 @@ VoxelSet frustumSet(const OccupancyGrids& grids, const Camera& cam, const DepthR
   const std::vector<std::size_t> starts = blockStarts(keys);
   const std::size_t nblocks = starts.size() - 1;
   std::vector<std::uint8_t> inside(keys.size(), 0);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nblocks, 16),
-                    [&](const tbb::blocked_range<std::size_t>& br) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nblocks, 16), [&](const tbb::blocked_range<std::size_t>& br) {
     const FloatEnvGuard fenv;  // geometry/float_env.h
     for (std::size_t b = br.begin(); b != br.end(); ++b) {
       const Voxel base = unpackVoxel(keys[starts[b]] & ~VoxelKey{511});  // block corner
-      const Eigen::Vector3d lo =
-          origin + h * Eigen::Vector3d(base[0] + 0.5, base[1] + 0.5, base[2] + 0.5);
+      const Eigen::Vector3d lo = origin + h * Eigen::Vector3d(base[0] + 0.5, base[1] + 0.5, base[2] + 0.5);
       const Eigen::Vector3d hi = lo + Eigen::Vector3d::Constant(7.0 * h);
       bool culled = false;
       for (const Plane& p : planes) {
@@ -102,15 +100,12 @@ VoxelSet frustumSet(const OccupancyGrids& grids, const Camera& cam, const DepthR
 }
 
 std::vector<Eigen::Vector2d> samplePixels(const Intrinsics& K, int stride) {
-  if (stride < 1)
-    throw InputError("candidate camera", "pixel_stride",
-                     "expected >= 1, got " + std::to_string(stride));
+  if (stride < 1) throw InputError("candidate camera", "pixel_stride", "expected >= 1, got " + std::to_string(stride));
   std::vector<Eigen::Vector2d> uv;
   if (K.width <= 0 || K.height <= 0) return uv;
   auto centres = [stride](int n) {
     std::vector<double> c;
-    for (int i = 0; i * stride < n; ++i)
-      c.push_back(0.5 * (i * stride + std::min((i + 1) * stride, n)));
+    for (int i = 0; i * stride < n; ++i) c.push_back(0.5 * (i * stride + std::min((i + 1) * stride, n)));
     return c;
   };
   const auto us = centres(K.width), vs = centres(K.height);
@@ -143,8 +138,7 @@ void boxBounds(const RTCBoundsFunctionArguments* args) {
 // Slab test in double (the float ray is widened, the box corners are exact). Returns
 // the entry parameter clamped to tnear (a ray starting inside a box hits it at tnear),
 // or NaN on a miss.
-double slabEntry(const double o[3], const double d[3], const std::array<float, 3>& lower,
-                 double tnear, double tfar) {
+double slabEntry(const double o[3], const double d[3], const std::array<float, 3>& lower, double tnear, double tfar) {
   double t0 = tnear, t1 = tfar;
   for (int a = 0; a < 3; ++a) {
     const double lo = lower[a], hi = lower[a] + 1.0;
@@ -171,10 +165,8 @@ void boxIntersect(const RTCIntersectFunctionNArguments* args) {
   RTCHitN* hit = RTCRayHitN_HitN(args->rayhit, N);
   for (unsigned i = 0; i < N; ++i) {
     if (args->valid[i] != -1) continue;
-    const double o[3] = {RTCRayN_org_x(ray, N, i), RTCRayN_org_y(ray, N, i),
-                         RTCRayN_org_z(ray, N, i)};
-    const double d[3] = {RTCRayN_dir_x(ray, N, i), RTCRayN_dir_y(ray, N, i),
-                         RTCRayN_dir_z(ray, N, i)};
+    const double o[3] = {RTCRayN_org_x(ray, N, i), RTCRayN_org_y(ray, N, i), RTCRayN_org_z(ray, N, i)};
+    const double d[3] = {RTCRayN_dir_x(ray, N, i), RTCRayN_dir_y(ray, N, i), RTCRayN_dir_z(ray, N, i)};
     float& tfar = RTCRayN_tfar(ray, N, i);
     const double t = slabEntry(o, d, boxes->lower[prim], RTCRayN_tnear(ray, N, i), tfar);
     if (std::isnan(t)) continue;
@@ -251,16 +243,14 @@ VisibilityTracer::VisibilityTracer(const OccupancyGrids& grids) : impl_(std::mak
   rtcCommitScene(m.scene);
   const RTCError err = rtcGetDeviceError(m.device);
   if (err != RTC_ERROR_NONE)
-    throw std::runtime_error("Embree: voxel scene build failed with error " +
-                             std::to_string(static_cast<int>(err)));
+    throw std::runtime_error("Embree: voxel scene build failed with error " + std::to_string(static_cast<int>(err)));
 }
 
 VisibilityTracer::~VisibilityTracer() = default;
 
 std::size_t VisibilityTracer::voxelCount() const { return impl_->keys.size(); }
 
-std::int64_t VisibilityTracer::firstHit(const Eigen::Vector3d& origin,
-                                        const Eigen::Vector3d& dir) const {
+std::int64_t VisibilityTracer::firstHit(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir) const {
   const Impl& m = *impl_;
   if (!m.scene || !origin.allFinite() || !dir.allFinite() || dir.isZero()) return -1;
   const Eigen::Vector3f o = m.local(origin).cast<float>();
@@ -294,8 +284,7 @@ std::vector<std::int64_t> VisibilityTracer::tracePixels(const Camera& cam, int s
   std::vector<std::int64_t> hits(uv.size(), -1);
   if (!impl_->scene) return hits;
   const Eigen::Vector3d c = cam.center();
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, uv.size(), 256),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, uv.size(), 256), [&](const tbb::blocked_range<std::size_t>& r) {
     const FloatEnvGuard fenv;  // geometry/float_env.h
     for (std::size_t i = r.begin(); i != r.end(); ++i) hits[i] = firstHit(c, cam.rayDirection(uv[i]));
   });

@@ -47,8 +47,7 @@ std::size_t HashedBits::count() const {
 CoverageScore scoreHashed(const HashedBits& observed, const HashedBits& candidate) {
   if (observed.size() != candidate.size())
     throw InputError("hash encoding", "table_size",
-                     "observed and candidate bits differ in size (" +
-                         std::to_string(observed.size()) + " vs " +
+                     "observed and candidate bits differ in size (" + std::to_string(observed.size()) + " vs " +
                          std::to_string(candidate.size()) + ")");
   CoverageScore s;
   const auto& a = observed.words();
@@ -61,8 +60,7 @@ CoverageScore scoreHashed(const HashedBits& observed, const HashedBits& candidat
   return s;
 }
 
-CoverageScore scoreExact(const VoxelSet& observed, const VoxelSet& candidate,
-                         std::size_t universe) {
+CoverageScore scoreExact(const VoxelSet& observed, const VoxelSet& candidate, std::size_t universe) {
   CoverageScore s;
   const std::size_t common = intersectionSize(observed, candidate);
   s.differing = observed.size() + candidate.size() - 2 * common;
@@ -71,8 +69,7 @@ CoverageScore scoreExact(const VoxelSet& observed, const VoxelSet& candidate,
   return s;
 }
 
-std::vector<CoverageScore> scoreCandidates(const VoxelSet& observed,
-                                           std::span<const VoxelSet> candidates,
+std::vector<CoverageScore> scoreCandidates(const VoxelSet& observed, std::span<const VoxelSet> candidates,
                                            std::size_t universe, const CoverageScoring& opts) {
   std::vector<CoverageScore> out(candidates.size());
   if (opts.encoding == CoverageEncoding::Exact) {

@@ -42,7 +42,7 @@ class HashedBits {
   void reset(std::uint32_t bit) { words_[bit >> 6] &= ~(std::uint64_t{1} << (bit & 63)); }
   bool test(std::uint32_t bit) const { return (words_[bit >> 6] >> (bit & 63)) & 1u; }
   std::size_t size() const { return size_; }  // T
-  std::size_t count() const;                   // set bits
+  std::size_t count() const;                  // set bits
   const std::vector<std::uint64_t>& words() const { return words_; }
 
  private:
@@ -51,16 +51,15 @@ class HashedBits {
 };
 
 struct CoverageScore {
-  double hamming = 0.0;         // differing / K, in [0, 1] when K covers both sets
-  std::size_t differing = 0;    // |obs XOR cand| (bits or voxels)
-  std::size_t new_count = 0;    // |cand \ obs| (bits or voxels)
+  double hamming = 0.0;       // differing / K, in [0, 1] when K covers both sets
+  std::size_t differing = 0;  // |obs XOR cand| (bits or voxels)
+  std::size_t new_count = 0;  // |cand \ obs| (bits or voxels)
 };
 
 // Throws InputError("hash encoding", "table_size", ...) when the sizes differ.
 CoverageScore scoreHashed(const HashedBits& observed, const HashedBits& candidate);
 // `universe` = K; 0 gives hamming = 0 (an empty grid has nothing to differ on).
-CoverageScore scoreExact(const VoxelSet& observed, const VoxelSet& candidate,
-                         std::size_t universe);
+CoverageScore scoreExact(const VoxelSet& observed, const VoxelSet& candidate, std::size_t universe);
 
 enum class CoverageEncoding { Hashed, Exact };
 enum class CoverageCriterion { Hamming, NewCount };
@@ -75,8 +74,7 @@ struct CoverageScoring {
 // Scores every candidate set against the observed set with the chosen encoding
 // (`universe` = K for the exact Hamming distance). Candidates are scored in parallel
 // into fixed slots; the result does not depend on the thread count.
-std::vector<CoverageScore> scoreCandidates(const VoxelSet& observed,
-                                           std::span<const VoxelSet> candidates,
+std::vector<CoverageScore> scoreCandidates(const VoxelSet& observed, std::span<const VoxelSet> candidates,
                                            std::size_t universe, const CoverageScoring& opts);
 // The value ranked by the prefilter: hamming or new_count.
 double criterionValue(const CoverageScore& s, CoverageCriterion c);

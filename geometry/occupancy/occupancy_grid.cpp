@@ -52,9 +52,12 @@ VoxelSet keysOf(const MaskTree& tree) {
 
 openvdb::tools::NearestNeighbors neighbours(DilationShape s) {
   switch (s) {
-    case DilationShape::Cube: return openvdb::tools::NN_FACE_EDGE_VERTEX;
-    case DilationShape::FaceEdge: return openvdb::tools::NN_FACE_EDGE;
-    case DilationShape::Octahedron: return openvdb::tools::NN_FACE;
+    case DilationShape::Cube:
+      return openvdb::tools::NN_FACE_EDGE_VERTEX;
+    case DilationShape::FaceEdge:
+      return openvdb::tools::NN_FACE_EDGE;
+    case DilationShape::Octahedron:
+      return openvdb::tools::NN_FACE;
   }
   return openvdb::tools::NN_FACE_EDGE_VERTEX;
 }
@@ -64,17 +67,15 @@ void dilate(MaskTree& tree, int radius, DilationShape shape) {
   // EXPAND_TILES keeps the result voxelized (no pruning into tiles); the enumeration
   // above handles tiles anyway. OpenVDB threads this with TBB; topology union is
   // order independent, so the result is deterministic.
-  openvdb::tools::dilateActiveValues(tree, radius, neighbours(shape),
-                                     openvdb::tools::EXPAND_TILES);
+  openvdb::tools::dilateActiveValues(tree, radius, neighbours(shape), openvdb::tools::EXPAND_TILES);
 }
 
 void checkOptions(const OccupancyOptions& o) {
   const std::string file = "SfM points";
   if (o.resolution < 1 || o.resolution > 16384)
-    throw InputError(file, "resolution", "expected 1..16384 voxels along the longest side, got " +
-                                             std::to_string(o.resolution));
-  if (o.min_points < 1)
-    throw InputError(file, "min_points", "expected >= 1, got " + std::to_string(o.min_points));
+    throw InputError(file, "resolution",
+                     "expected 1..16384 voxels along the longest side, got " + std::to_string(o.resolution));
+  if (o.min_points < 1) throw InputError(file, "min_points", "expected >= 1, got " + std::to_string(o.min_points));
   if (o.upsample < 1 || o.upsample > 64)
     throw InputError(file, "upsample", "expected 1..64, got " + std::to_string(o.upsample));
   // Fine coordinates must stay far inside the key range.
@@ -83,8 +84,7 @@ void checkOptions(const OccupancyOptions& o) {
   if (!(o.trim_percent >= 0.0 && o.trim_percent < 50.0))
     throw InputError(file, "trim_percent", "expected a percentile in [0, 50)");
   if (o.dilation_radius < 0 || o.dilation_radius > 64)
-    throw InputError(file, "dilation_radius",
-                     "expected 0..64, got " + std::to_string(o.dilation_radius));
+    throw InputError(file, "dilation_radius", "expected 0..64, got " + std::to_string(o.dilation_radius));
 }
 
 // The [p, 100-p] percentile range of one coordinate (nearest rank, no interpolation, so
@@ -124,14 +124,12 @@ OccupancyGrids::OccupancyGrids(OccupancyGrids&&) noexcept = default;
 OccupancyGrids& OccupancyGrids::operator=(OccupancyGrids&&) noexcept = default;
 OccupancyGrids::~OccupancyGrids() = default;
 
-OccupancyGrids OccupancyGrids::fromSfm(std::span<const Eigen::Vector3d> points,
-                                       const OccupancyOptions& opts) {
+OccupancyGrids OccupancyGrids::fromSfm(std::span<const Eigen::Vector3d> points, const OccupancyOptions& opts) {
   checkOptions(opts);
   const std::string file = "SfM points";
   if (points.empty()) throw InputError(file, "points", "expected at least one point to span the grid");
   for (std::size_t i = 0; i < points.size(); ++i)
-    if (!points[i].allFinite())
-      throw InputError(file, "point " + std::to_string(i), "expected finite coordinates");
+    if (!points[i].allFinite()) throw InputError(file, "point " + std::to_string(i), "expected finite coordinates");
 
   auto impl = std::make_unique<Impl>();
   impl->opts = opts;
@@ -214,15 +212,12 @@ Voxel OccupancyGrids::voxelOf(const Eigen::Vector3d& p) const {
 }
 
 Eigen::Vector3d OccupancyGrids::voxelCenter(const Voxel& v) const {
-  return impl_->origin +
-         impl_->h * Eigen::Vector3d(v[0] + 0.5, v[1] + 0.5, v[2] + 0.5);
+  return impl_->origin + impl_->h * Eigen::Vector3d(v[0] + 0.5, v[1] + 0.5, v[2] + 0.5);
 }
 
 std::size_t OccupancyGrids::sceneCount() const { return impl_->scene_keys.size(); }
 const VoxelSet& OccupancyGrids::sceneVoxels() const { return impl_->scene_keys; }
-bool OccupancyGrids::isSceneOccupied(const Voxel& v) const {
-  return impl_->scene.isValueOn(toCoord(v));
-}
+bool OccupancyGrids::isSceneOccupied(const Voxel& v) const { return impl_->scene.isValueOn(toCoord(v)); }
 std::size_t OccupancyGrids::coarseCount() const { return impl_->coarse_count; }
 
 AABB OccupancyGrids::sceneVoxelBounds() const {
@@ -263,9 +258,7 @@ std::size_t OccupancyGrids::addObserved(std::span<const Eigen::Vector3d> points)
 
 void OccupancyGrids::clearObserved() { impl_->observed.clear(); }
 std::size_t OccupancyGrids::observedCount() const { return impl_->observed.activeVoxelCount(); }
-bool OccupancyGrids::isObserved(const Voxel& v) const {
-  return impl_->observed.isValueOn(toCoord(v));
-}
+bool OccupancyGrids::isObserved(const Voxel& v) const { return impl_->observed.isValueOn(toCoord(v)); }
 VoxelSet OccupancyGrids::observedVoxels() const { return keysOf(impl_->observed); }
 
 VoxelSet OccupancyGrids::observedSceneVoxels() const {
@@ -280,8 +273,7 @@ VoxelSet OccupancyGrids::observedSceneVoxels() const {
 
 double OccupancyGrids::observedFraction() const {
   if (impl_->scene_keys.empty()) return 0.0;
-  return static_cast<double>(observedSceneVoxels().size()) /
-         static_cast<double>(impl_->scene_keys.size());
+  return static_cast<double>(observedSceneVoxels().size()) / static_cast<double>(impl_->scene_keys.size());
 }
 
 GridMemory OccupancyGrids::memory() const {
@@ -293,8 +285,7 @@ GridMemory OccupancyGrids::memory() const {
 }
 
 VoxelSet dilateVoxels(const VoxelSet& voxels, int radius, DilationShape shape) {
-  if (radius < 0)
-    throw InputError("dilation", "radius", "expected >= 0, got " + std::to_string(radius));
+  if (radius < 0) throw InputError("dilation", "radius", "expected >= 0, got " + std::to_string(radius));
   if (radius == 0) return voxels;
   MaskTree tree;
   {

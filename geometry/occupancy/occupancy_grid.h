@@ -33,13 +33,13 @@ namespace saresgs {
 enum class DilationShape { Cube, FaceEdge, Octahedron };
 
 struct OccupancyOptions {
-  int resolution = 128;          // coarse voxels along the longest side of the box
-  int min_points = 2;            // m: a coarse voxel is occupied with >= m SfM points
-  int upsample = 2;              // N: each occupied coarse voxel -> N^3 fine voxels
-  double trim_percent = 0.0;     // per axis, the box spans the [p, 100-p] percentiles of
-                                 // the points (outlier trimming); points outside it are
-                                 // dropped. 0: the plain AABB. In [0, 50).
-  int dilation_radius = 2;       // r of the observed-voxel dilation, in fine voxels
+  int resolution = 128;       // coarse voxels along the longest side of the box
+  int min_points = 2;         // m: a coarse voxel is occupied with >= m SfM points
+  int upsample = 2;           // N: each occupied coarse voxel -> N^3 fine voxels
+  double trim_percent = 0.0;  // per axis, the box spans the [p, 100-p] percentiles of
+                              // the points (outlier trimming); points outside it are
+                              // dropped. 0: the plain AABB. In [0, 50).
+  int dilation_radius = 2;    // r of the observed-voxel dilation, in fine voxels
   DilationShape dilation_shape = DilationShape::Cube;
 };
 
@@ -58,8 +58,7 @@ class OccupancyGrids {
   // options are out of range, a point is not finite, there are no points, or the box has
   // zero size (no voxel size can be derived). A grid with no occupied voxel (no voxel
   // reaches m points) is valid and empty.
-  static OccupancyGrids fromSfm(std::span<const Eigen::Vector3d> points,
-                                const OccupancyOptions& opts = {});
+  static OccupancyGrids fromSfm(std::span<const Eigen::Vector3d> points, const OccupancyOptions& opts = {});
 
   OccupancyGrids(const OccupancyGrids&);
   OccupancyGrids& operator=(const OccupancyGrids&);
@@ -68,9 +67,9 @@ class OccupancyGrids {
   ~OccupancyGrids();
 
   const OccupancyOptions& options() const;
-  const AABB& box() const;               // the (trimmed) SfM box the grid was built on
-  const Eigen::Vector3d& origin() const; // world position of fine voxel (0,0,0)'s corner
-  double voxelSize() const;              // fine voxel edge length h
+  const AABB& box() const;                // the (trimmed) SfM box the grid was built on
+  const Eigen::Vector3d& origin() const;  // world position of fine voxel (0,0,0)'s corner
+  double voxelSize() const;               // fine voxel edge length h
   double coarseVoxelSize() const;
   Voxel voxelOf(const Eigen::Vector3d& p) const;  // floor((p - origin) / h), saturated
   Eigen::Vector3d voxelCenter(const Voxel& v) const;
@@ -79,7 +78,7 @@ class OccupancyGrids {
   std::size_t sceneCount() const;
   const VoxelSet& sceneVoxels() const;  // sorted keys, computed once at construction
   bool isSceneOccupied(const Voxel& v) const;
-  std::size_t coarseCount() const;      // occupied coarse voxels (before upsampling)
+  std::size_t coarseCount() const;  // occupied coarse voxels (before upsampling)
   // World box covered by the scene-occupied voxels (empty when there are none). The
   // frustum near/far come from it: it contains every voxel centre.
   AABB sceneVoxelBounds() const;
@@ -93,8 +92,8 @@ class OccupancyGrids {
   void clearObserved();
   std::size_t observedCount() const;
   bool isObserved(const Voxel& v) const;
-  VoxelSet observedVoxels() const;          // all observed voxels
-  VoxelSet observedSceneVoxels() const;     // observed AND scene-occupied
+  VoxelSet observedVoxels() const;       // all observed voxels
+  VoxelSet observedSceneVoxels() const;  // observed AND scene-occupied
   // |observed AND scene| / |scene|; 0 for an empty scene grid.
   double observedFraction() const;
 
@@ -109,7 +108,6 @@ class OccupancyGrids {
 // Dilates a voxel set with OpenVDB's topological dilation (`radius` steps of `shape`);
 // radius 0 returns the set unchanged. Used by addObserved; exposed for tests and tools.
 // Throws InputError("dilation", "radius", ...) for a negative radius.
-VoxelSet dilateVoxels(const VoxelSet& voxels, int radius,
-                      DilationShape shape = DilationShape::Cube);
+VoxelSet dilateVoxels(const VoxelSet& voxels, int radius, DilationShape shape = DilationShape::Cube);
 
 }  // namespace saresgs

@@ -48,8 +48,7 @@ inline Voxel unpackVoxel(VoxelKey key) {
     const int shift = 2 - a;  // x is the most significant of each group
     const std::uint64_t local = (key >> (3 * shift)) & 7u;
     const std::uint64_t block = (key >> (9 + 18 * shift)) & ((std::uint64_t{1} << 18) - 1);
-    v[a] = static_cast<std::int32_t>(static_cast<std::int64_t>((block << 3) | local) -
-                                     kVoxelCoordLimit);
+    v[a] = static_cast<std::int32_t>(static_cast<std::int64_t>((block << 3) | local) - kVoxelCoordLimit);
   }
   return v;
 }
@@ -81,7 +80,7 @@ VoxelSet setIntersection(const VoxelSet& a, const VoxelSet& b);
 VoxelSet setDifference(const VoxelSet& a, const VoxelSet& b);  // a \ b
 // Counts without building the sets.
 std::size_t intersectionSize(const VoxelSet& a, const VoxelSet& b);
-std::size_t differenceSize(const VoxelSet& a, const VoxelSet& b);            // |a \ b|
+std::size_t differenceSize(const VoxelSet& a, const VoxelSet& b);           // |a \ b|
 std::size_t symmetricDifferenceSize(const VoxelSet& a, const VoxelSet& b);  // |a xor b|
 
 }  // namespace saresgs

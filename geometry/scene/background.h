@@ -10,13 +10,14 @@
 namespace saresgs {
 
 struct BackgroundChoice {
-  bool random = false;                   // a fresh colour per training step
-  std::array<float, 3> color{1, 1, 1};   // the colour; with `random`, the one evaluation uses
+  bool random = false;                  // a fresh colour per training step
+  std::array<float, 3> color{1, 1, 1};  // the colour; with `random`, the one evaluation uses
   bool operator==(const BackgroundChoice&) const = default;
 };
 
 // The forms parseBackground takes, for messages and --help.
-inline constexpr const char* kBackgroundForms = "white, black, random, or R,G,B with three numbers in 0..1 (e.g. 0.5,0.5,0.5)";
+inline constexpr const char* kBackgroundForms =
+    "white, black, random, or R,G,B with three numbers in 0..1 (e.g. 0.5,0.5,0.5)";
 
 // "white", "black", "R,G,B" (three numbers in 0..1) or "random" (evaluated on white).
 // Throws InputError(where, "value", ...) naming the accepted forms for anything else;

@@ -62,14 +62,16 @@ void readSplit(const fs::path& root, const std::string& name, const json& j, Sty
     const std::string where = jsonPath("frames", k);
     jsonObject(fr, file, where);
     SceneView v;
-    const std::string file_path = jsonString(jsonMember(fr, "file_path", file, where), file, jsonPath(where, "file_path"));
+    const std::string file_path =
+        jsonString(jsonMember(fr, "file_path", file, where), file, jsonPath(where, "file_path"));
     v.image_path = resolveImage(root, file_path);
     v.name = fs::path(v.image_path).filename().string();
     if (!fs::exists(v.image_path))
       throw InputError(v.image_path, jsonPath(where, "file_path"), "image file is missing");
     const std::string here = name + " " + where;
     if (const auto [it, fresh] = seen.emplace(v.image_path, here); !fresh)
-      throw InputError(file, jsonPath(where, "file_path"), "'" + file_path + "' is listed twice (also as " + it->second + ")");
+      throw InputError(file, jsonPath(where, "file_path"),
+                       "'" + file_path + "' is listed twice (also as " + it->second + ")");
 
     // Intrinsics: camera_angle_x (NeRF) or fl_x/fl_y/cx/cy/w/h (Instant-NGP style),
     // per frame or per file. Size comes from w/h or from the image itself.
@@ -121,15 +123,17 @@ void readSplit(const fs::path& root, const std::string& name, const json& j, Sty
       }
       if (!pinholeWhenUndistorted(model))
         throw InputError(file, model_field,
-                         "camera model '" + model + "' is not a pinhole camera: saresgs trains pinhole images (PINHOLE, "
-                         "SIMPLE_PINHOLE, or OPENCV / SIMPLE_RADIAL / RADIAL with zero distortion); undistort the "
-                         "images first (colmap image_undistorter)");
+                         "camera model '" + model +
+                             "' is not a pinhole camera: saresgs trains pinhole images (PINHOLE, "
+                             "SIMPLE_PINHOLE, or OPENCV / SIMPLE_RADIAL / RADIAL with zero distortion); undistort the "
+                             "images first (colmap image_undistorter)");
       for (const char* key : kDistortionKeys)
         if (const auto [x, field] = pick(key); x) {
           const double d = jsonNumber(*x, file, field);
           if (d != 0)
             throw InputError(file, field,
-                             "distortion " + std::string(key) + " = " + std::to_string(d) + " of camera model " + model +
+                             "distortion " + std::string(key) + " = " + std::to_string(d) + " of camera model " +
+                                 model +
                                  " is not zero: saresgs trains pinhole images and does not undistort; undistort them "
                                  "first (colmap image_undistorter), or write 0 if they already are");
         }
@@ -168,11 +172,11 @@ Scene loadBlenderDataset(const std::string& path, const DatasetOptions& opts) {
   scene.load = opts.load;
   std::vector<Intrinsics> full_size;
   std::map<std::string, std::string> seen;
-  readSplit(root, "transforms_train.json", readJsonFile((root / "transforms_train.json").string()), Style::kBlender, opts,
-            scene, scene.train, full_size, seen);
+  readSplit(root, "transforms_train.json", readJsonFile((root / "transforms_train.json").string()), Style::kBlender,
+            opts, scene, scene.train, full_size, seen);
   if (fs::exists(root / "transforms_test.json"))
-    readSplit(root, "transforms_test.json", readJsonFile((root / "transforms_test.json").string()), Style::kBlender, opts,
-              scene, scene.test, full_size, seen);
+    readSplit(root, "transforms_test.json", readJsonFile((root / "transforms_test.json").string()), Style::kBlender,
+              opts, scene, scene.test, full_size, seen);
   if (scene.train.empty())
     throw InputError((root / "transforms_train.json").string(), "frames", "expected at least one frame");
   // The format implies white (NeRF-synthetic's images are composited on it). A folder
@@ -238,14 +242,18 @@ Scene loadNerfstudioDataset(const std::string& path, const DatasetOptions& opts)
   if (const json* tr = jsonFind(j, "train_filenames", file, "")) {
     const char* test_key = jsonFind(j, "test_filenames", file, "") ? "test_filenames" : "val_filenames";
     const json* te = jsonFind(j, test_key, file, "");
-    if (!te) throw InputError(file, "test_filenames", "train_filenames is given, so test_filenames (or val_filenames) must be");
-    for (const auto& [list, key, out] : {std::tuple{tr, "train_filenames", &scene.train}, std::tuple{te, test_key, &scene.test}}) {
+    if (!te)
+      throw InputError(file, "test_filenames",
+                       "train_filenames is given, so test_filenames (or val_filenames) must be");
+    for (const auto& [list, key, out] :
+         {std::tuple{tr, "train_filenames", &scene.train}, std::tuple{te, test_key, &scene.test}}) {
       const json& names = jsonArray(*list, file, key, kMaxFrames);
       for (std::size_t k = 0; k < names.size(); ++k) {
         const std::string n = jsonString(names[k], file, jsonPath(key, k));
         auto it = by_path.find(n);
         if (it == by_path.end()) it = by_path.find((root / n).lexically_normal().string());
-        if (it == by_path.end()) throw InputError(file, jsonPath(key, k), "'" + n + "' is not the file_path of any frame");
+        if (it == by_path.end())
+          throw InputError(file, jsonPath(key, k), "'" + n + "' is not the file_path of any frame");
         out->push_back(it->second);
       }
       std::sort(out->begin(), out->end());
@@ -255,7 +263,8 @@ Scene loadNerfstudioDataset(const std::string& path, const DatasetOptions& opts)
     std::vector<int> order = all;
     std::sort(order.begin(), order.end(), [&](int a, int b) { return scene.views[a].name < scene.views[b].name; });
     for (std::size_t k = 0; k < order.size(); ++k)
-      (opts.test_every > 0 && k % static_cast<std::size_t>(opts.test_every) == 0 ? scene.test : scene.train).push_back(order[k]);
+      (opts.test_every > 0 && k % static_cast<std::size_t>(opts.test_every) == 0 ? scene.test : scene.train)
+          .push_back(order[k]);
     std::sort(scene.train.begin(), scene.train.end());
     std::sort(scene.test.begin(), scene.test.end());
   }

@@ -57,7 +57,8 @@ bool applyManifest(const fs::path& manifest, const std::vector<Intrinsics>& full
     for (const std::string& n : list) {
       const auto it = index.find(n);
       if (it == index.end())
-        throw InputError(manifest.string(), train ? "split.train" : "split.test", "names '" + n + "', which is not an image of the model");
+        throw InputError(manifest.string(), train ? "split.train" : "split.test",
+                         "names '" + n + "', which is not an image of the model");
       out.push_back(it->second);
     }
   }
@@ -72,8 +73,9 @@ bool applyManifest(const fs::path& manifest, const std::vector<Intrinsics>& full
 Intrinsics intrinsicsFromColmap(const ColmapCamera& c, const std::string& file) {
   const std::string field = "camera " + std::to_string(c.id);
   if (c.width == 0 || c.height == 0 || c.width > kMaxImageSide || c.height > kMaxImageSide)
-    throw InputError(file, field, "expected an image size of 1.." + std::to_string(kMaxImageSide) + " per side, got " +
-                                      std::to_string(c.width) + "x" + std::to_string(c.height));
+    throw InputError(file, field,
+                     "expected an image size of 1.." + std::to_string(kMaxImageSide) + " per side, got " +
+                         std::to_string(c.width) + "x" + std::to_string(c.height));
   Intrinsics K;
   K.width = static_cast<int>(c.width);
   K.height = static_cast<int>(c.height);
@@ -93,8 +95,7 @@ Intrinsics intrinsicsFromColmap(const ColmapCamera& c, const std::string& file) 
                          "Undistort first: colmap image_undistorter --image_path IMAGES "
                          "--input_path SPARSE --output_path OUT");
   }
-  if (!K.valid())
-    throw InputError(file, field, "expected positive focal length and image size");
+  if (!K.valid()) throw InputError(file, field, "expected positive focal length and image size");
   return K;
 }
 
@@ -125,20 +126,19 @@ Scene loadColmapDataset(const std::string& path, const DatasetOptions& opts) {
   // A pre-downscaled folder (images_2, _4, _8 as 3DGS tools write) is used when it exists;
   // otherwise images/ is resized on load.
   fs::path image_dir = root / "images";
-  if (f > 1 && fs::exists(root / ("images_" + std::to_string(f))))
-    image_dir = root / ("images_" + std::to_string(f));
+  if (f > 1 && fs::exists(root / ("images_" + std::to_string(f)))) image_dir = root / ("images_" + std::to_string(f));
 
   Scene scene;
   scene.source = path;
   scene.load = opts.load;
   std::vector<const ColmapImage*> sorted;
   for (const auto& [id, im] : model.images) sorted.push_back(&im);
-  std::sort(sorted.begin(), sorted.end(),
-            [](const ColmapImage* a, const ColmapImage* b) { return a->name < b->name; });
+  std::sort(sorted.begin(), sorted.end(), [](const ColmapImage* a, const ColmapImage* b) { return a->name < b->name; });
   std::vector<Intrinsics> full_size;
   for (const ColmapImage* im : sorted) {
     if (!scene.views.empty() && scene.views.back().name == im->name)
-      throw InputError(img_file, "image " + std::to_string(im->id) + " (" + im->name + ")", "the image name appears twice");
+      throw InputError(img_file, "image " + std::to_string(im->id) + " (" + im->name + ")",
+                       "the image name appears twice");
     SceneView v;
     v.name = im->name;
     const Intrinsics K = intrinsicsFromColmap(model.cameras.at(im->camera_id), cam_file);

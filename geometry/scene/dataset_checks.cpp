@@ -44,8 +44,9 @@ std::vector<DatasetWarning> checkDataset(const Scene& scene, double near_plane) 
       const double fov = 2 * std::atan(0.5 * side / f) * 180 / std::numbers::pi;
       if (!(fov >= kMinFovDeg && fov <= kMaxFovDeg))
         out.push_back({v.name, field,
-                       std::string(field) + " = " + num(f) + " px for " + std::to_string(side) + " px gives a field of view of " +
-                           num(fov) + " degrees, outside the " + num(kMinFovDeg) + ".." + num(kMaxFovDeg) +
+                       std::string(field) + " = " + num(f) + " px for " + std::to_string(side) +
+                           " px gives a field of view of " + num(fov) + " degrees, outside the " + num(kMinFovDeg) +
+                           ".." + num(kMaxFovDeg) +
                            " that lenses give: is the focal length in pixels of this image size?"});
     }
     for (const auto& [field, c, side] : {std::tuple{"cx", K.cx, K.width}, std::tuple{"cy", K.cy, K.height}})
@@ -82,16 +83,18 @@ std::vector<DatasetWarning> checkDataset(const Scene& scene, double near_plane) 
     if (r > 0 && r < 50 * near_plane)
       out.push_back({"(scene)", "scale",
                      "the train cameras spread over " + num(r) + ", under 50 times the renderer's near plane (" +
-                         num(near_plane) + "): Gaussians nearer than that to a camera are not drawn; scale the model up "
+                         num(near_plane) +
+                         "): Gaussians nearer than that to a camera are not drawn; scale the model up "
                          "before training (COLMAP: model_transformer)"});
   }
   if (!scene.points.empty() && !scene.train.empty() && blind_train == scene.train.size())
-    throw InputError(scene.source, "intrinsics or poses",
-                     "none of the " + std::to_string(scene.points.size()) + " sparse points projects into any of the " +
-                         std::to_string(scene.train.size()) +
-                         " train views, so nothing can be trained; check the cameras' intrinsics (focal length, "
-                         "principal point) and poses" +
-                         (out.empty() ? std::string() : " (first: " + out.front().view + ": " + out.front().message + ")"));
+    throw InputError(
+        scene.source, "intrinsics or poses",
+        "none of the " + std::to_string(scene.points.size()) + " sparse points projects into any of the " +
+            std::to_string(scene.train.size()) +
+            " train views, so nothing can be trained; check the cameras' intrinsics (focal length, "
+            "principal point) and poses" +
+            (out.empty() ? std::string() : " (first: " + out.front().view + ": " + out.front().message + ")"));
   return out;
 }
 

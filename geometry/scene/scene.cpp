@@ -12,7 +12,6 @@
 
 namespace saresgs {
 
-
 // Images are read on first use and kept as 8-bit; the mutex guards the slots, and a
 // slot once filled is never replaced, so returned references stay valid.
 struct CachedImage {
@@ -54,15 +53,13 @@ std::unique_ptr<CachedImage> loadViewImage(const SceneView& v, const ImageLoadOp
   img = std::move(out->rgb);
   throw InputError(v.image_path, "image size",
                    "expected " + std::to_string(w * f) + "x" + std::to_string(h * f) +
-                       " (the camera's size) but the file is " + std::to_string(img.width) +
-                       "x" + std::to_string(img.height));
+                       " (the camera's size) but the file is " + std::to_string(img.width) + "x" +
+                       std::to_string(img.height));
 }
 
 }  // namespace
 
-const Image8& Scene::image(int i) const {
-  return cachedImage(i).rgb;
-}
+const Image8& Scene::image(int i) const { return cachedImage(i).rgb; }
 
 const Image8* Scene::alpha(int i) const {
   const CachedImage& c = cachedImage(i);
@@ -128,8 +125,7 @@ ImageF Scene::depth(int i) const {
   if (d.width == w && d.height == h) return d;
   // Downscaled view: sample the depth at the new pixel centres (nearest). Averaging
   // depths would invent surfaces across occlusion edges.
-  if (d.width < w || d.height < h)
-    throw InputError(v.depth_path, "size", "depth map is smaller than the view");
+  if (d.width < w || d.height < h) throw InputError(v.depth_path, "size", "depth map is smaller than the view");
   ImageF out(w, h, 1);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
@@ -159,7 +155,7 @@ namespace {
 constexpr const char* kAlphaNoneSaid = "alpha in the images, none said (white)";
 // Images with an alpha channel decoded to find one that is not opaque, at most.
 constexpr int kAlphaImagesDecoded = 8;
-}
+}  // namespace
 
 void settleBackground(Scene& scene, const BackgroundRule& rule) {
   scene.random_background = false;
@@ -207,8 +203,9 @@ void setBackground(Scene& scene, const BackgroundChoice& choice, const std::stri
 
 std::string backgroundWarning(const Scene& scene) {
   if (scene.background_from != kAlphaNoneSaid) return {};
-  return scene.source + ": background: the images have alpha but nothing says what stands behind them; they are "
-                        "composited on white and trained against white (say --background white|black|R,G,B|random)\n";
+  return scene.source +
+         ": background: the images have alpha but nothing says what stands behind them; they are "
+         "composited on white and trained against white (say --background white|black|R,G,B|random)\n";
 }
 
 void moveToOwnFrame(Scene& scene) {

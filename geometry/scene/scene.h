@@ -62,8 +62,8 @@ class Scene {
   std::vector<int> train;  // indices into views
   std::vector<int> test;
   std::vector<SparsePoint> points;
-  AABB aabb;             // of the sparse points (of the cameras when there are none)
-  double extent = 0.0;   // 3DGS scene scale from the train cameras
+  AABB aabb;            // of the sparse points (of the cameras when there are none)
+  double extent = 0.0;  // 3DGS scene scale from the train cameras
   // Cameras, points, aabb, extent and depth maps are in this frame's internal coordinates
   // (scene_frame.h): world = frame.toWorld(internal). The loaders choose it; a Scene built
   // in memory is in world coordinates (the identity frame) until moveToOwnFrame.

@@ -38,12 +38,14 @@ nlohmann::json toJson(const SceneFrame& f) {
 SceneFrame sceneFrameFromJson(const nlohmann::json& j, const std::string& file, const std::string& field) {
   const nlohmann::json& o = jsonObject(j, file, field);
   const std::vector<double> c = jsonNumbers(jsonMember(o, "center", file, field), file, jsonPath(field, "center"));
-  if (c.size() != 3) throw InputError(file, jsonPath(field, "center"), "expected 3 numbers, got " + std::to_string(c.size()));
+  if (c.size() != 3)
+    throw InputError(file, jsonPath(field, "center"), "expected 3 numbers, got " + std::to_string(c.size()));
   SceneFrame f;
   f.center = Eigen::Vector3d(c[0], c[1], c[2]);
   f.scale = jsonNumber(jsonMember(o, "scale", file, field), file, jsonPath(field, "scale"));
   if (!f.center.allFinite()) throw InputError(file, jsonPath(field, "center"), "expected finite numbers");
-  if (!(f.scale > 0) || !std::isfinite(f.scale)) throw InputError(file, jsonPath(field, "scale"), "expected a positive finite number");
+  if (!(f.scale > 0) || !std::isfinite(f.scale))
+    throw InputError(file, jsonPath(field, "scale"), "expected a positive finite number");
   return f;
 }
 

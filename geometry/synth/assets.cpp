@@ -49,15 +49,16 @@ std::string resolveAsset(const std::string& spec) {
       const fs::path p = dir / "data" / "meshes" / (name + ext);
       if (fs::exists(p)) return p.string();
     }
-    throw InputError(spec, "mesh", std::string("no mesh of that name in ") + kCgalData +
-                                       " (list them: tar tzf " + kCgalData + " | grep meshes/)");
+    throw InputError(
+        spec, "mesh",
+        std::string("no mesh of that name in ") + kCgalData + " (list them: tar tzf " + kCgalData + " | grep meshes/)");
   }
   if (spec.rfind("opencv:", 0) == 0) {
     const std::string name = spec.substr(7);
     const fs::path p = fs::path(kOpencvData) / name;
     if (!safeName(name) || !fs::exists(p))
-      throw InputError(spec, "texture", std::string("no such photograph in ") + kOpencvData +
-                                            " (Debian package opencv-doc)");
+      throw InputError(spec, "texture",
+                       std::string("no such photograph in ") + kOpencvData + " (Debian package opencv-doc)");
     return p.string();
   }
   return spec;

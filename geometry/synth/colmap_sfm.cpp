@@ -19,8 +19,10 @@ std::string quote(const std::string& s) {
   // POSIX shell single quotes; an embedded quote becomes '\''.
   std::string q = "'";
   for (char c : s) {
-    if (c == '\'') q.append("'\\''");
-    else q.push_back(c);
+    if (c == '\'')
+      q.append("'\\''");
+    else
+      q.push_back(c);
   }
   q.push_back('\'');
   return q;
@@ -62,8 +64,7 @@ ColmapModel triangulateWithColmap(const SyntheticScene& scene, const std::string
                                   const ColmapModel& known) {
   if (std::system("colmap help > /dev/null 2>&1") != 0)
     throw std::runtime_error("--sfm colmap needs the colmap binary (bash scripts/install_deps.sh)");
-  if (known.cameras.size() != 1)
-    throw std::runtime_error("--sfm colmap: expected one shared camera");
+  if (known.cameras.size() != 1) throw std::runtime_error("--sfm colmap: expected one shared camera");
   const fs::path root(dataset_dir), work = root / "colmap";
   fs::create_directories(work / "known");
   fs::create_directories(work / "triangulated");

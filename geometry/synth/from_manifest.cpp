@@ -38,10 +38,12 @@ std::optional<SyntheticOptions> syntheticOptionsFromManifest(const std::string& 
   // two billion cameras.
   SyntheticOptions s;
   s.layout = jsonString(jsonMember(m, "layout", path, ""), path, "layout");
-  s.seed = static_cast<std::uint64_t>(jsonInteger(jsonMember(m, "seed", path, ""), path, "seed", 0, std::numeric_limits<long long>::max()));
+  s.seed = static_cast<std::uint64_t>(
+      jsonInteger(jsonMember(m, "seed", path, ""), path, "seed", 0, std::numeric_limits<long long>::max()));
   s.width = static_cast<int>(jsonInteger(jsonMember(m, "width", path, ""), path, "width", 1, kMaxImageSide));
   s.height = static_cast<int>(jsonInteger(jsonMember(m, "height", path, ""), path, "height", 1, kMaxImageSide));
-  s.num_views = static_cast<int>(jsonInteger(jsonMember(m, "num_views", path, ""), path, "num_views", 1, kMaxSyntheticViews));
+  s.num_views =
+      static_cast<int>(jsonInteger(jsonMember(m, "num_views", path, ""), path, "num_views", 1, kMaxSyntheticViews));
   if (const auto* v = jsonFind(m, "up_axis", path, "")) s.up_axis = jsonString(*v, path, "up_axis");
   if (const auto* v = jsonFind(m, "projection", path, "")) s.projection = jsonString(*v, path, "projection");
   return s;
@@ -51,8 +53,9 @@ std::optional<SyntheticScene> rebuildSyntheticScene(const std::string& folder, c
   const auto opts = syntheticOptionsFromManifest(folder);
   if (!opts) return std::nullopt;
   if (static_cast<std::size_t>(opts->num_views) != dataset.views.size())
-    throw InputError((std::filesystem::path(folder) / "manifest.json").string(), "num_views",
-                     std::to_string(opts->num_views) + ", but the dataset has " + std::to_string(dataset.views.size()) + " views");
+    throw InputError(
+        (std::filesystem::path(folder) / "manifest.json").string(), "num_views",
+        std::to_string(opts->num_views) + ", but the dataset has " + std::to_string(dataset.views.size()) + " views");
   // The rebuilt meshes are in the manifest's frame, which is the dataset's only when the
   // loader kept it (every scene `saresgs scene` writes: metres, about the origin). A dataset
   // moved out of it has no rebuilt ground truth.
@@ -63,7 +66,8 @@ std::optional<SyntheticScene> rebuildSyntheticScene(const std::string& folder, c
   for (std::size_t i = 0; i < s.cameras.size(); ++i) {
     // Views are matched by name: the dataset may order them differently.
     const std::string& name = s.names[i];
-    const auto it = std::find_if(dataset.views.begin(), dataset.views.end(), [&](const SceneView& v) { return v.name == name; });
+    const auto it =
+        std::find_if(dataset.views.begin(), dataset.views.end(), [&](const SceneView& v) { return v.name == name; });
     if (it == dataset.views.end() || (it->camera.center() - s.cameras[i].center()).norm() > tol) return std::nullopt;
   }
   return s;

@@ -54,15 +54,14 @@ void resolveContent(const Assets& assets, int slot, ContentSpec& spec, std::stri
   }
   if (!assets.photos.empty()) {
     const std::size_t k = static_cast<std::size_t>(slot) % assets.photos.size();
-    spec.texture = makeImageTexture(assets.photos[k], assets.projection, 1.0f,
-                                    assets.photo_paths[k]);
+    spec.texture = makeImageTexture(assets.photos[k], assets.projection, 1.0f, assets.photo_paths[k]);
   }
 }
 
 // Places a content object on the floor: scaled to radius `size`, turned by `yaw` about
 // z, its lowest point on z = floor_z, its bounding-sphere centre above (x, y).
-SceneObject placeOnFloor(const Assets& assets, int slot, ContentSpec spec, const Vector2f& xy,
-                         float floor_z, float size, float yaw) {
+SceneObject placeOnFloor(const Assets& assets, int slot, ContentSpec spec, const Vector2f& xy, float floor_z,
+                         float size, float yaw) {
   std::string source;
   resolveContent(assets, slot, spec, source);
   const float min_z = boundingBox(spec.mesh).min().z();
@@ -80,8 +79,8 @@ SceneObject placeOnFloor(const Assets& assets, int slot, ContentSpec spec, const
 }
 
 // An object given directly in world coordinates (room faces, pillars): local = world.
-SceneObject fixedObject(std::string name, std::string kind, TriangleMesh mesh,
-                        std::shared_ptr<const Texture> texture, bool casts_shadow) {
+SceneObject fixedObject(std::string name, std::string kind, TriangleMesh mesh, std::shared_ptr<const Texture> texture,
+                        bool casts_shadow) {
   SceneObject o;
   o.name = std::move(name);
   o.mesh_source = "procedural:" + kind;
@@ -98,8 +97,7 @@ struct RoomTextures {
 void addRoom(LayoutResult& out, const Vector3f& lo, const Vector3f& hi, const RoomTextures& t) {
   RoomFaces r = makeRoom(lo, hi, 1);
   out.objects.push_back(fixedObject("room_floor", "room_floor", std::move(r.floor), t.floor, false));
-  out.objects.push_back(
-      fixedObject("room_ceiling", "room_ceiling", std::move(r.ceiling), t.ceiling, false));
+  out.objects.push_back(fixedObject("room_ceiling", "room_ceiling", std::move(r.ceiling), t.ceiling, false));
   out.objects.push_back(fixedObject("room_wall_xlo", "room_wall", std::move(r.wall_xlo), t.xlo, false));
   out.objects.push_back(fixedObject("room_wall_xhi", "room_wall", std::move(r.wall_xhi), t.xhi, false));
   out.objects.push_back(fixedObject("room_wall_ylo", "room_wall", std::move(r.wall_ylo), t.ylo, false));
@@ -127,20 +125,19 @@ ContentSpec contentSpec(const std::string& kind, std::uint64_t seed) {
     const TriangleMesh t = makeTorus(0.7f, 0.3f, 96, 48);
     Eigen::Affine3f R(Eigen::AngleAxisf(static_cast<float>(kPi / 2), Vector3f::UnitX()));
     s.mesh = transformed(t, R);
-    s.texture = makeStripes(Vector3f(1, 0.2f, 0), 0.14f, rgb(240, 150, 170), rgb(250, 240, 230),
-                            rgb(150, 90, 60), seed + 4);
+    s.texture =
+        makeStripes(Vector3f(1, 0.2f, 0), 0.14f, rgb(240, 150, 170), rgb(250, 240, 230), rgb(150, 90, 60), seed + 4);
   } else if (kind == "column") {
     s.mesh = makeCylinder(0.3f, 1.4f, 96);
-    s.texture = makeWood(Vector3f(0.05f, 0.0f, 1.0f), Vector3f(0.9f, 0.4f, 0.0f), 0.07f,
-                         rgb(215, 170, 110), rgb(120, 70, 35), seed + 5);
+    s.texture = makeWood(Vector3f(0.05f, 0.0f, 1.0f), Vector3f(0.9f, 0.4f, 0.0f), 0.07f, rgb(215, 170, 110),
+                         rgb(120, 70, 35), seed + 5);
   } else if (kind == "cone") {
     s.mesh = makeCone(0.5f, 1.0f, 96);
-    s.texture = makeStripes(Vector3f(0, 0, 1), 0.16f, rgb(60, 160, 210), rgb(245, 245, 240),
-                            rgb(250, 170, 40), seed + 6);
+    s.texture =
+        makeStripes(Vector3f(0, 0, 1), 0.16f, rgb(60, 160, 210), rgb(245, 245, 240), rgb(250, 170, 40), seed + 6);
   } else {  // "superquadric"
     s.mesh = makeSuperquadric(Vector3f(1.0f, 0.8f, 0.6f), 0.45f, 0.45f, 96, 48);
-    s.texture = makeTiles(0.3f, 0.03f, rgb(200, 90, 200), rgb(250, 230, 250), rgb(60, 50, 60),
-                          seed + 7);
+    s.texture = makeTiles(0.3f, 0.03f, rgb(200, 90, 200), rgb(250, 230, 250), rgb(60, 50, 60), seed + 7);
   }
   return s;
 }
@@ -186,8 +183,7 @@ Intrinsics layoutIntrinsics(int width, int height, double fov_deg) {
   return K;
 }
 
-LayoutResult makeObjectLayout(const Assets& assets, int width, int height, std::uint64_t seed,
-                              int num_views) {
+LayoutResult makeObjectLayout(const Assets& assets, int width, int height, std::uint64_t seed, int num_views) {
   LayoutResult out;
   if (!assets.meshes.empty()) {
     ContentSpec spec;
@@ -213,8 +209,8 @@ LayoutResult makeObjectLayout(const Assets& assets, int width, int height, std::
     appendMesh(all, ball);
     TriangleMesh probe = all;
     const Eigen::Affine3f N = normaliseMesh(probe, 1.0f);
-    auto part = [&](const char* name, const char* kind, const TriangleMesh& m,
-                    std::shared_ptr<const Texture> tex, const Eigen::Affine3f& local_to_design) {
+    auto part = [&](const char* name, const char* kind, const TriangleMesh& m, std::shared_ptr<const Texture> tex,
+                    const Eigen::Affine3f& local_to_design) {
       SceneObject o = fixedObject(name, kind, transformed(m, N), std::move(tex), true);
       // The texture frame is the part's own frame before it was moved into the compound.
       o.to_world = N * local_to_design;
@@ -223,15 +219,12 @@ LayoutResult makeObjectLayout(const Assets& assets, int width, int height, std::
     part("blob", "bumpy_blob", blob, makeMarble(1.6f, rgb(240, 200, 140), rgb(150, 50, 30), s + 1),
          Eigen::Affine3f::Identity());
     part("ring", "torus", ring,
-         makeStripes(Vector3f(1, 0.1f, 0.2f), 0.09f, rgb(40, 90, 200), rgb(245, 245, 245),
-                     rgb(220, 60, 50), s + 2),
+         makeStripes(Vector3f(1, 0.1f, 0.2f), 0.09f, rgb(40, 90, 200), rgb(245, 245, 245), rgb(220, 60, 50), s + 2),
          ring_T);
-    part("cap", "sphere", ball, makeDots(0.11f, 0.035f, rgb(60, 170, 90), rgb(250, 240, 120), s + 3),
-         ball_T);
+    part("cap", "sphere", ball, makeDots(0.11f, 0.035f, rgb(60, 170, 90), rgb(250, 240, 120), s + 3), ball_T);
     for (std::size_t k = 0; k < out.objects.size() && !assets.photos.empty(); ++k) {
       const std::size_t p = k % assets.photos.size();
-      out.objects[k].texture =
-          makeImageTexture(assets.photos[p], assets.projection, 1.0f, assets.photo_paths[p]);
+      out.objects[k].texture = makeImageTexture(assets.photos[p], assets.projection, 1.0f, assets.photo_paths[p]);
     }
   }
   const int n = num_views > 0 ? num_views : 150;
@@ -242,24 +235,21 @@ LayoutResult makeObjectLayout(const Assets& assets, int width, int height, std::
   for (int i = 0; i < n; ++i) {
     const double az = rng.uniform(0, 2 * kPi);
     const double el = std::asin(rng.uniform(s_lo, s_hi));  // area-uniform in the band
-    const Vector3d eye = 4.0 * Vector3d(std::cos(el) * std::cos(az),
-                                        std::cos(el) * std::sin(az), std::sin(el));
+    const Vector3d eye = 4.0 * Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
     out.cameras.push_back(lookAtf(K, eye, Vector3d::Zero()));
     (i < n_train ? out.train : out.test).push_back(i);
   }
   return out;
 }
 
-LayoutResult makeRoom360Layout(const Assets& assets, int width, int height, std::uint64_t seed,
-                               int num_views) {
+LayoutResult makeRoom360Layout(const Assets& assets, int width, int height, std::uint64_t seed, int num_views) {
   LayoutResult out;
   const std::uint64_t s = mix64(seed + 360);
   RoomTextures rt;
   rt.floor = makePlanks(0.22f, 1.3f, rgb(205, 155, 100), rgb(120, 72, 38), s + 10);
   rt.ceiling = makeSpeckle(1.5f, rgb(235, 232, 222), rgb(150, 150, 140), s + 11);
   rt.xlo = makeBricks(0.26f, 0.11f, 0.018f, rgb(165, 72, 48), rgb(205, 200, 190), s + 12);
-  rt.xhi = makeStripes(Vector3f(0, 1, 0), 0.18f, rgb(110, 160, 100), rgb(238, 232, 200),
-                       rgb(70, 110, 70), s + 13);
+  rt.xhi = makeStripes(Vector3f(0, 1, 0), 0.18f, rgb(110, 160, 100), rgb(238, 232, 200), rgb(70, 110, 70), s + 13);
   rt.ylo = makeTiles(0.4f, 0.025f, rgb(70, 120, 190), rgb(235, 240, 245), rgb(90, 90, 95), s + 14);
   rt.yhi = makeMarble(0.8f, rgb(228, 230, 238), rgb(70, 75, 105), s + 15);
   addRoom(out, Vector3f(-4, -4, 0), Vector3f(4, 4, 4), rt);
@@ -267,16 +257,15 @@ LayoutResult makeRoom360Layout(const Assets& assets, int width, int height, std:
   Rng rng(seed ^ 0x360360ull);
   // One object in the middle, five on a ring of radius 1.35 (sizes are bounding radii,
   // so neighbours cannot touch: the smallest gap is kept positive by construction).
-  out.objects.push_back(placeOnFloor(assets, 0, contentSpec("blob", s), Vector2f(0, 0), 0.0f,
-                                     0.5f, static_cast<float>(rng.uniform(0, 2 * kPi))));
+  out.objects.push_back(placeOnFloor(assets, 0, contentSpec("blob", s), Vector2f(0, 0), 0.0f, 0.5f,
+                                     static_cast<float>(rng.uniform(0, 2 * kPi))));
   const char* kinds[5] = {"crate", "ball", "donut", "column", "cone"};
   const float sizes[5] = {0.55f, 0.45f, 0.55f, 0.7f, 0.6f};
   const double phase = rng.uniform(0, 2 * kPi);
   for (int k = 0; k < 5; ++k) {
     const double a = phase + 2 * kPi * k / 5 + rng.uniform(-1, 1) * 5 * kPi / 180;
     const Vector2f xy(static_cast<float>(1.35 * std::cos(a)), static_cast<float>(1.35 * std::sin(a)));
-    out.objects.push_back(placeOnFloor(assets, k + 1, contentSpec(kinds[k], s + 100 * (k + 1)),
-                                       xy, 0.0f, sizes[k],
+    out.objects.push_back(placeOnFloor(assets, k + 1, contentSpec(kinds[k], s + 100 * (k + 1)), xy, 0.0f, sizes[k],
                                        static_cast<float>(rng.uniform(0, 2 * kPi))));
   }
 
@@ -296,15 +285,13 @@ LayoutResult makeRoom360Layout(const Assets& assets, int width, int height, std:
   return out;
 }
 
-LayoutResult makeUnbalancedLayout(const Assets& assets, int width, int height,
-                                  std::uint64_t seed, int num_views) {
+LayoutResult makeUnbalancedLayout(const Assets& assets, int width, int height, std::uint64_t seed, int num_views) {
   LayoutResult out;
   const std::uint64_t s = mix64(seed + 777);
   RoomTextures rt;
   rt.floor = makeTiles(0.5f, 0.03f, rgb(200, 195, 185), rgb(110, 105, 100), rgb(60, 55, 50), s + 10);
   rt.ceiling = makeSpeckle(1.2f, rgb(240, 238, 230), rgb(170, 165, 155), s + 11);
-  rt.xlo = makeStripes(Vector3f(0, 1, 0.15f), 0.25f, rgb(210, 120, 80), rgb(245, 225, 190),
-                       rgb(160, 70, 60), s + 12);
+  rt.xlo = makeStripes(Vector3f(0, 1, 0.15f), 0.25f, rgb(210, 120, 80), rgb(245, 225, 190), rgb(160, 70, 60), s + 12);
   rt.xhi = makePlanks(0.18f, 1.6f, rgb(190, 150, 105), rgb(100, 65, 40), s + 13);
   rt.ylo = makeBricks(0.3f, 0.12f, 0.02f, rgb(200, 170, 100), rgb(90, 85, 80), s + 14);
   rt.yhi = makeMarble(0.9f, rgb(190, 215, 210), rgb(40, 80, 80), s + 15);
@@ -323,23 +310,21 @@ LayoutResult makeUnbalancedLayout(const Assets& assets, int width, int height,
                          {"superquadric", {3.3f, -2.2f}, 0.55f}};
   std::vector<Vector3d> centres;  // look-at points of the objects
   for (int k = 0; k < 5; ++k) {
-    out.objects.push_back(placeOnFloor(assets, k, contentSpec(slots[k].kind, s + 100 * (k + 1)),
-                                       slots[k].xy, 0.0f, slots[k].size,
-                                       static_cast<float>(rng.uniform(0, 2 * kPi))));
+    out.objects.push_back(placeOnFloor(assets, k, contentSpec(slots[k].kind, s + 100 * (k + 1)), slots[k].xy, 0.0f,
+                                       slots[k].size, static_cast<float>(rng.uniform(0, 2 * kPi))));
     centres.push_back(boundingBox(out.objects.back().mesh).center().cast<double>());
   }
   // Occluders: two floor-to-ceiling pillars and a partition wall.
   {
     Eigen::Affine3f T(Eigen::Translation3f(-1.3f, 0.3f, 0.0f));
-    out.objects.push_back(fixedObject("pillar_round", "cylinder",
-                                      transformed(makeCylinder(0.3f, 3.2f, 64), T),
+    out.objects.push_back(fixedObject("pillar_round", "cylinder", transformed(makeCylinder(0.3f, 3.2f, 64), T),
                                       makeSpeckle(3.0f, rgb(175, 175, 170), rgb(90, 90, 95), s + 20), true));
-    out.objects.push_back(fixedObject(
-        "pillar_square", "box", makeBox(Vector3f(1.45f, 0.15f, 0.0f), Vector3f(1.95f, 0.65f, 3.2f), 1),
-        makeBricks(0.22f, 0.09f, 0.015f, rgb(150, 60, 45), rgb(215, 210, 200), s + 21), true));
-    out.objects.push_back(fixedObject(
-        "partition", "box", makeBox(Vector3f(-0.9f, -0.375f, 0.0f), Vector3f(0.5f, -0.225f, 1.8f), 1),
-        makeChecker(0.2f, rgb(240, 240, 235), rgb(50, 50, 55), s + 22), true));
+    out.objects.push_back(
+        fixedObject("pillar_square", "box", makeBox(Vector3f(1.45f, 0.15f, 0.0f), Vector3f(1.95f, 0.65f, 3.2f), 1),
+                    makeBricks(0.22f, 0.09f, 0.015f, rgb(150, 60, 45), rgb(215, 210, 200), s + 21), true));
+    out.objects.push_back(fixedObject("partition", "box",
+                                      makeBox(Vector3f(-0.9f, -0.375f, 0.0f), Vector3f(0.5f, -0.225f, 1.8f), 1),
+                                      makeChecker(0.2f, rgb(240, 240, 235), rgb(50, 50, 55), s + 22), true));
   }
 
   // The walk: four clusters (dense, nearly similar views of one object each) joined by
@@ -349,17 +334,14 @@ LayoutResult makeUnbalancedLayout(const Assets& assets, int width, int height,
     int target;  // index into `centres`
     double weight;
   };
-  const Cluster clusters[4] = {{{-1.2, -1.4, 1.5}, 0, 36},
-                               {{1.2, -1.5, 1.4}, 4, 26},
-                               {{2.6, 2.0, 1.6}, 2, 34},
-                               {{-1.5, 2.2, 1.5}, 1, 30}};
+  const Cluster clusters[4] = {
+      {{-1.2, -1.4, 1.5}, 0, 36}, {{1.2, -1.5, 1.4}, 4, 26}, {{2.6, 2.0, 1.6}, 2, 34}, {{-1.5, 2.2, 1.5}, 1, 30}};
   // Stretch k runs from cluster k to cluster k+1 (the last one back towards the first)
   // through the given via points, which keep it clear of the pillars.
-  const std::vector<std::vector<Vector3d>> stretches = {
-      {clusters[0].centre, clusters[1].centre},
-      {clusters[1].centre, {3.3, 0.0, 1.5}, clusters[2].centre},
-      {clusters[2].centre, clusters[3].centre},
-      {clusters[3].centre, {-2.4, 0.3, 1.5}, {-1.9, -0.7, 1.5}}};
+  const std::vector<std::vector<Vector3d>> stretches = {{clusters[0].centre, clusters[1].centre},
+                                                        {clusters[1].centre, {3.3, 0.0, 1.5}, clusters[2].centre},
+                                                        {clusters[2].centre, clusters[3].centre},
+                                                        {clusters[3].centre, {-2.4, 0.3, 1.5}, {-1.9, -0.7, 1.5}}};
   const int n = num_views > 0 ? num_views : 150;
   std::vector<double> weights;
   for (int k = 0; k < 4; ++k) {
@@ -380,8 +362,7 @@ LayoutResult makeUnbalancedLayout(const Assets& assets, int width, int height,
     // The stretch: evenly spaced by arc length along its polyline, ends excluded.
     const auto& poly = stretches[k];
     std::vector<double> cum{0};
-    for (std::size_t j = 1; j < poly.size(); ++j)
-      cum.push_back(cum.back() + (poly[j] - poly[j - 1]).norm());
+    for (std::size_t j = 1; j < poly.size(); ++j) cum.push_back(cum.back() + (poly[j] - poly[j - 1]).norm());
     const int m = counts[2 * k + 1];
     for (int i = 0; i < m; ++i) {
       const double len = cum.back() * (i + 1) / (m + 1);
@@ -401,13 +382,12 @@ LayoutResult makeUnbalancedLayout(const Assets& assets, int width, int height,
 }
 
 const std::vector<std::string>& twoRoomsDefaultMeshes() {
-  static const std::vector<std::string> kMeshes = {"cgal:cow",  "cgal:elephant",   "cgal:camel",
+  static const std::vector<std::string> kMeshes = {"cgal:cow",   "cgal:elephant",    "cgal:camel",
                                                    "cgal:homer", "cgal:triceratops", "cgal:pig"};
   return kMeshes;
 }
 
-LayoutResult makeTwoRoomsLayout(const Assets& assets, int width, int height, std::uint64_t seed,
-                                int num_views) {
+LayoutResult makeTwoRoomsLayout(const Assets& assets, int width, int height, std::uint64_t seed, int num_views) {
   LayoutResult out;
   const std::uint64_t s = mix64(seed + 2222);
   RoomTextures rt;
@@ -415,8 +395,7 @@ LayoutResult makeTwoRoomsLayout(const Assets& assets, int width, int height, std
   rt.ceiling = makeSpeckle(1.4f, rgb(238, 236, 228), rgb(160, 158, 150), s + 11);
   rt.xlo = makeBricks(0.28f, 0.11f, 0.018f, rgb(170, 80, 55), rgb(210, 205, 195), s + 12);
   rt.xhi = makeMarble(0.8f, rgb(215, 225, 235), rgb(60, 70, 110), s + 13);
-  rt.ylo = makeStripes(Vector3f(0, 0, 1), 0.2f, rgb(120, 170, 110), rgb(240, 236, 205),
-                       rgb(80, 120, 80), s + 14);
+  rt.ylo = makeStripes(Vector3f(0, 0, 1), 0.2f, rgb(120, 170, 110), rgb(240, 236, 205), rgb(80, 120, 80), s + 14);
   rt.yhi = makeTiles(0.45f, 0.03f, rgb(210, 170, 80), rgb(245, 240, 225), rgb(90, 80, 70), s + 15);
   const float half_w = 3.0f, top = 3.0f;
   addRoom(out, Vector3f(-6, -half_w, 0), Vector3f(6, half_w, top), rt);
@@ -424,18 +403,15 @@ LayoutResult makeTwoRoomsLayout(const Assets& assets, int width, int height, std
   // The dividing wall at x = 0 (16 cm thick) with a doorway |y| <= 0.55, z <= 2.1: two
   // wall pieces and a lintel. Named room_* like the room's faces (structure, not content).
   const float t = 0.08f, door = 0.55f, door_top = 2.1f;
-  auto wallTexture = [&](std::uint64_t k) {
-    return makeChecker(0.25f, rgb(235, 230, 220), rgb(70, 90, 120), s + k);
-  };
+  auto wallTexture = [&](std::uint64_t k) { return makeChecker(0.25f, rgb(235, 230, 220), rgb(70, 90, 120), s + k); };
   out.objects.push_back(fixedObject("room_divider_south", "box",
-                                    makeBox(Vector3f(-t, -half_w, 0), Vector3f(t, -door, top), 1),
-                                    wallTexture(20), true));
-  out.objects.push_back(fixedObject("room_divider_north", "box",
-                                    makeBox(Vector3f(-t, door, 0), Vector3f(t, half_w, top), 1),
-                                    wallTexture(20), true));
+                                    makeBox(Vector3f(-t, -half_w, 0), Vector3f(t, -door, top), 1), wallTexture(20),
+                                    true));
+  out.objects.push_back(fixedObject(
+      "room_divider_north", "box", makeBox(Vector3f(-t, door, 0), Vector3f(t, half_w, top), 1), wallTexture(20), true));
   out.objects.push_back(fixedObject("room_divider_lintel", "box",
-                                    makeBox(Vector3f(-t, -door, door_top), Vector3f(t, door, top), 1),
-                                    wallTexture(20), true));
+                                    makeBox(Vector3f(-t, -door, door_top), Vector3f(t, door, top), 1), wallTexture(20),
+                                    true));
 
   Rng rng(seed ^ 0x2D002D00ull);
   struct Slot {
@@ -444,13 +420,12 @@ LayoutResult makeTwoRoomsLayout(const Assets& assets, int width, int height, std
     float size;
   };
   // Three objects per room around its centre (x = -3 and x = 3), apart by construction.
-  const Slot slots[6] = {{"blob", {-3.0f, 0.0f}, 0.55f},  {"crate", {-3.8f, -0.8f}, 0.45f},
-                         {"cone", {-2.3f, 0.9f}, 0.45f},  {"superquadric", {3.0f, 0.0f}, 0.55f},
-                         {"ball", {3.7f, 0.9f}, 0.45f},   {"donut", {2.4f, -0.9f}, 0.45f}};
+  const Slot slots[6] = {{"blob", {-3.0f, 0.0f}, 0.55f}, {"crate", {-3.8f, -0.8f}, 0.45f},
+                         {"cone", {-2.3f, 0.9f}, 0.45f}, {"superquadric", {3.0f, 0.0f}, 0.55f},
+                         {"ball", {3.7f, 0.9f}, 0.45f},  {"donut", {2.4f, -0.9f}, 0.45f}};
   for (int k = 0; k < 6; ++k) {
-    out.objects.push_back(placeOnFloor(assets, k, contentSpec(slots[k].kind, s + 100 * (k + 1)),
-                                       slots[k].xy, 0.0f, slots[k].size,
-                                       static_cast<float>(rng.uniform(0, 2 * kPi))));
+    out.objects.push_back(placeOnFloor(assets, k, contentSpec(slots[k].kind, s + 100 * (k + 1)), slots[k].xy, 0.0f,
+                                       slots[k].size, static_cast<float>(rng.uniform(0, 2 * kPi))));
     // A built-in mesh names its object ("cow"); a file keeps the slot's name.
     SceneObject& o = out.objects.back();
     if (o.mesh_source.rfind("cgal:", 0) == 0) o.name = o.mesh_source.substr(5);
@@ -491,8 +466,7 @@ LayoutResult makeTwoRoomsLayout(const Assets& assets, int width, int height, std
   return out;
 }
 
-LayoutResult makeCorridorLayout(const Assets& assets, int width, int height, std::uint64_t seed,
-                                int num_views) {
+LayoutResult makeCorridorLayout(const Assets& assets, int width, int height, std::uint64_t seed, int num_views) {
   LayoutResult out;
   const std::uint64_t s = mix64(seed + 3333);
   RoomTextures rt;
@@ -501,8 +475,7 @@ LayoutResult makeCorridorLayout(const Assets& assets, int width, int height, std
   rt.xlo = makeMarble(0.8f, rgb(225, 210, 190), rgb(110, 70, 50), s + 12);
   rt.xhi = makeBricks(0.26f, 0.1f, 0.016f, rgb(150, 90, 70), rgb(215, 210, 200), s + 13);
   rt.ylo = makePlanks(0.2f, 1.5f, rgb(200, 160, 110), rgb(105, 70, 45), s + 14);
-  rt.yhi = makeStripes(Vector3f(0, 0, 1), 0.22f, rgb(90, 140, 190), rgb(240, 238, 225),
-                       rgb(60, 90, 130), s + 15);
+  rt.yhi = makeStripes(Vector3f(0, 0, 1), 0.22f, rgb(90, 140, 190), rgb(240, 238, 225), rgb(60, 90, 130), s + 15);
   const float half_w = 3.0f, top = 3.0f;
   addRoom(out, Vector3f(-9, -half_w, 0), Vector3f(9, half_w, top), rt);
 
@@ -511,12 +484,13 @@ LayoutResult makeCorridorLayout(const Assets& assets, int width, int height, std
   const float t = 0.08f, door_top = 2.1f;
   auto divider = [&](const std::string& name, float x, float door_lo, float door_hi, std::uint64_t k) {
     auto tex = [&] { return makeChecker(0.25f, rgb(230, 228, 220), rgb(120, 70, 90), s + k); };
-    out.objects.push_back(fixedObject(name + "_south", "box",
-                                      makeBox(Vector3f(x - t, -half_w, 0), Vector3f(x + t, door_lo, top), 1), tex(), true));
-    out.objects.push_back(fixedObject(name + "_north", "box",
-                                      makeBox(Vector3f(x - t, door_hi, 0), Vector3f(x + t, half_w, top), 1), tex(), true));
+    out.objects.push_back(fixedObject(
+        name + "_south", "box", makeBox(Vector3f(x - t, -half_w, 0), Vector3f(x + t, door_lo, top), 1), tex(), true));
+    out.objects.push_back(fixedObject(
+        name + "_north", "box", makeBox(Vector3f(x - t, door_hi, 0), Vector3f(x + t, half_w, top), 1), tex(), true));
     out.objects.push_back(fixedObject(name + "_lintel", "box",
-                                      makeBox(Vector3f(x - t, door_lo, door_top), Vector3f(x + t, door_hi, top), 1), tex(), true));
+                                      makeBox(Vector3f(x - t, door_lo, door_top), Vector3f(x + t, door_hi, top), 1),
+                                      tex(), true));
   };
   divider("room_divider_ab", -3.0f, 0.9f, 2.0f, 20);
   divider("room_divider_bc", 3.0f, -2.0f, -0.9f, 21);
@@ -529,14 +503,13 @@ LayoutResult makeCorridorLayout(const Assets& assets, int width, int height, std
   };
   // Two objects in each of the first two rooms, three in the last.
   const Slot slots[7] = {{"blob", {-6.0f, 0.0f}, 0.55f},        {"crate", {-7.1f, -1.0f}, 0.4f},
-                         {"cone", {0.8f, 1.6f}, 0.45f},          {"donut", {-0.8f, -1.6f}, 0.45f},
-                         {"superquadric", {6.9f, -0.9f}, 0.5f},  {"ball", {5.4f, 0.8f}, 0.4f},
+                         {"cone", {0.8f, 1.6f}, 0.45f},         {"donut", {-0.8f, -1.6f}, 0.45f},
+                         {"superquadric", {6.9f, -0.9f}, 0.5f}, {"ball", {5.4f, 0.8f}, 0.4f},
                          {"column", {6.7f, 0.9f}, 0.4f}};
   std::vector<Vector3d> centres;
   for (int k = 0; k < 7; ++k) {
-    out.objects.push_back(placeOnFloor(assets, k, contentSpec(slots[k].kind, s + 100 * (k + 1)),
-                                       slots[k].xy, 0.0f, slots[k].size,
-                                       static_cast<float>(rng.uniform(0, 2 * kPi))));
+    out.objects.push_back(placeOnFloor(assets, k, contentSpec(slots[k].kind, s + 100 * (k + 1)), slots[k].xy, 0.0f,
+                                       slots[k].size, static_cast<float>(rng.uniform(0, 2 * kPi))));
     centres.push_back(boundingBox(out.objects.back().mesh).center().cast<double>());
   }
 
@@ -569,8 +542,8 @@ LayoutResult makeCorridorLayout(const Assets& assets, int width, int height, std
       const double f = (len - cum[j - 1]) / (cum[j] - cum[j - 1]);
       Vector3d eye = poly[j - 1] + f * (poly[j] - poly[j - 1]);
       eye.z() += rng.uniform(-0.05, 0.05);
-      const Vector3d ahead = Eigen::AngleAxisd(rng.uniform(-0.35, 0.35), Vector3d::UnitZ()) *
-                             (poly[j] - poly[j - 1]).normalized();
+      const Vector3d ahead =
+          Eigen::AngleAxisd(rng.uniform(-0.35, 0.35), Vector3d::UnitZ()) * (poly[j] - poly[j - 1]).normalized();
       out.cameras.push_back(lookAtf(K, eye, eye + 2.5 * ahead + Vector3d(0, 0, -0.8)));
     }
   };

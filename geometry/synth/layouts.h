@@ -62,16 +62,11 @@ struct LayoutResult {
 Intrinsics layoutIntrinsics(int width, int height, double fov_deg);
 
 // num_views <= 0 selects the layout's default count.
-LayoutResult makeObjectLayout(const Assets& assets, int width, int height, std::uint64_t seed,
-                              int num_views);
-LayoutResult makeRoom360Layout(const Assets& assets, int width, int height, std::uint64_t seed,
-                               int num_views);
-LayoutResult makeUnbalancedLayout(const Assets& assets, int width, int height,
-                                  std::uint64_t seed, int num_views);
-LayoutResult makeTwoRoomsLayout(const Assets& assets, int width, int height, std::uint64_t seed,
-                                int num_views);
-LayoutResult makeCorridorLayout(const Assets& assets, int width, int height, std::uint64_t seed,
-                                int num_views);
+LayoutResult makeObjectLayout(const Assets& assets, int width, int height, std::uint64_t seed, int num_views);
+LayoutResult makeRoom360Layout(const Assets& assets, int width, int height, std::uint64_t seed, int num_views);
+LayoutResult makeUnbalancedLayout(const Assets& assets, int width, int height, std::uint64_t seed, int num_views);
+LayoutResult makeTwoRoomsLayout(const Assets& assets, int width, int height, std::uint64_t seed, int num_views);
+LayoutResult makeCorridorLayout(const Assets& assets, int width, int height, std::uint64_t seed, int num_views);
 
 // The real meshes the tworooms layout uses when no mesh file is given (cgal:NAME specs
 // for resolveAsset; their up axis is +y).

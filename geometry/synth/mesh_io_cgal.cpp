@@ -20,16 +20,13 @@ TriangleMesh readMeshFile(const std::string& path) {
   TriangleMesh mesh;
   mesh.vertices.reserve(points.size());
   for (const auto& p : points)
-    mesh.vertices.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()),
-                               static_cast<float>(p.z()));
+    mesh.vertices.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
   for (std::size_t f = 0; f < polygons.size(); ++f) {
     const auto& poly = polygons[f];
     for (std::size_t v : poly)
-      if (v >= points.size())
-        throw InputError(path, "face " + std::to_string(f), "vertex index out of range");
+      if (v >= points.size()) throw InputError(path, "face " + std::to_string(f), "vertex index out of range");
     for (std::size_t k = 1; k + 1 < poly.size(); ++k)
-      mesh.faces.emplace_back(static_cast<int>(poly[0]), static_cast<int>(poly[k]),
-                              static_cast<int>(poly[k + 1]));
+      mesh.faces.emplace_back(static_cast<int>(poly[0]), static_cast<int>(poly[k]), static_cast<int>(poly[k + 1]));
   }
   for (const auto& v : mesh.vertices)
     if (!v.allFinite()) throw InputError(path, "vertices", "expected finite coordinates");

@@ -28,18 +28,30 @@ inline float fade(float t) { return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f)
 // One of the 12 cube-edge directions, picked by the lattice hash, dotted with the offset.
 inline float grad(std::uint64_t h, float x, float y, float z) {
   switch (h % 12) {
-    case 0: return x + y;
-    case 1: return -x + y;
-    case 2: return x - y;
-    case 3: return -x - y;
-    case 4: return x + z;
-    case 5: return -x + z;
-    case 6: return x - z;
-    case 7: return -x - z;
-    case 8: return y + z;
-    case 9: return -y + z;
-    case 10: return y - z;
-    default: return -y - z;
+    case 0:
+      return x + y;
+    case 1:
+      return -x + y;
+    case 2:
+      return x - y;
+    case 3:
+      return -x - y;
+    case 4:
+      return x + z;
+    case 5:
+      return -x + z;
+    case 6:
+      return x - z;
+    case 7:
+      return -x - z;
+    case 8:
+      return y + z;
+    case 9:
+      return -y + z;
+    case 10:
+      return y - z;
+    default:
+      return -y - z;
   }
 }
 
@@ -47,8 +59,7 @@ inline float grad(std::uint64_t h, float x, float y, float z) {
 
 float gradientNoise(const Eigen::Vector3f& p, std::uint64_t seed) {
   const float fx = std::floor(p.x()), fy = std::floor(p.y()), fz = std::floor(p.z());
-  const auto ix = static_cast<std::int64_t>(fx), iy = static_cast<std::int64_t>(fy),
-             iz = static_cast<std::int64_t>(fz);
+  const auto ix = static_cast<std::int64_t>(fx), iy = static_cast<std::int64_t>(fy), iz = static_cast<std::int64_t>(fz);
   const float x = p.x() - fx, y = p.y() - fy, z = p.z() - fz;
   float c[8];
   for (int k = 0; k < 8; ++k) {

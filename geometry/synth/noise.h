@@ -9,8 +9,7 @@ namespace saresgs::synth {
 // A 64-bit mixing function (SplitMix64 finaliser).
 std::uint64_t mix64(std::uint64_t x);
 // Hash of up to four integers.
-std::uint64_t hashInts(std::int64_t a, std::int64_t b = 0, std::int64_t c = 0,
-                       std::uint64_t seed = 0);
+std::uint64_t hashInts(std::int64_t a, std::int64_t b = 0, std::int64_t c = 0, std::uint64_t seed = 0);
 // The top 24 bits of a hash as a float in [0, 1).
 float unitFloat(std::uint64_t h);
 

@@ -17,8 +17,7 @@ constexpr float kPi = std::numbers::pi_v<float>;
 // Adds triangle (a, b, c), reversed if needed so that its normal has a positive
 // component along `outward`.
 void addOriented(TriangleMesh& m, int a, int b, int c, const Eigen::Vector3f& outward) {
-  const Eigen::Vector3f n =
-      (m.vertices[b] - m.vertices[a]).cross(m.vertices[c] - m.vertices[a]);
+  const Eigen::Vector3f n = (m.vertices[b] - m.vertices[a]).cross(m.vertices[c] - m.vertices[a]);
   if (n.dot(outward) < 0) std::swap(b, c);
   m.faces.emplace_back(a, b, c);
 }
@@ -29,8 +28,7 @@ Eigen::Vector3f centroid(const TriangleMesh& m, int a, int b, int c) {
 
 // A closed surface over (u, v) in [0,1) x [0,1], periodic in u, with the v = 0 and
 // v = 1 rows collapsed to single pole vertices. `outward(p)` orients the faces.
-TriangleMesh polarSurface(int slices, int stacks,
-                          const std::function<Eigen::Vector3f(float, float)>& f,
+TriangleMesh polarSurface(int slices, int stacks, const std::function<Eigen::Vector3f(float, float)>& f,
                           const std::function<Eigen::Vector3f(const Eigen::Vector3f&)>& outward) {
   slices = std::max(slices, 3);
   stacks = std::max(stacks, 2);
@@ -56,9 +54,7 @@ TriangleMesh polarSurface(int slices, int stacks,
 
 Eigen::Vector3f fromOrigin(const Eigen::Vector3f& p) { return p; }
 
-float signedPow(float x, float e) {
-  return std::copysign(std::pow(std::abs(x), e), x);
-}
+float signedPow(float x, float e) { return std::copysign(std::pow(std::abs(x), e), x); }
 
 }  // namespace
 
@@ -67,14 +63,13 @@ TriangleMesh makeSphere(float radius, int slices, int stacks) {
       slices, stacks,
       [&](float u, float v) {
         const float th = kPi * v, ph = 2 * kPi * u;
-        return Eigen::Vector3f(radius * std::sin(th) * std::cos(ph),
-                               radius * std::sin(th) * std::sin(ph), radius * std::cos(th));
+        return Eigen::Vector3f(radius * std::sin(th) * std::cos(ph), radius * std::sin(th) * std::sin(ph),
+                               radius * std::cos(th));
       },
       fromOrigin);
 }
 
-TriangleMesh makeSuperquadric(const Eigen::Vector3f& radii, float e1, float e2, int slices,
-                              int stacks) {
+TriangleMesh makeSuperquadric(const Eigen::Vector3f& radii, float e1, float e2, int slices, int stacks) {
   return polarSurface(
       slices, stacks,
       [&](float u, float v) {
@@ -86,14 +81,12 @@ TriangleMesh makeSuperquadric(const Eigen::Vector3f& radii, float e1, float e2, 
       fromOrigin);
 }
 
-TriangleMesh makeBumpyBlob(float radius, float amplitude, float frequency, std::uint64_t seed,
-                           int slices, int stacks) {
+TriangleMesh makeBumpyBlob(float radius, float amplitude, float frequency, std::uint64_t seed, int slices, int stacks) {
   return polarSurface(
       slices, stacks,
       [&](float u, float v) {
         const float th = kPi * v, ph = 2 * kPi * u;
-        const Eigen::Vector3f d(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph),
-                                std::cos(th));
+        const Eigen::Vector3f d(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th));
         // Noise sampled on the unit sphere, so the seam and the poles match up.
         const float n = fbm(d * frequency, 3, seed);
         return Eigen::Vector3f(d * radius * (1.0f + amplitude * n));
@@ -129,14 +122,13 @@ namespace {
 
 // A planar grid patch: origin + s * du + t * dv for s, t in [0,1], n x n quads, with
 // its own vertices, oriented along `normal`.
-void addPatch(TriangleMesh& m, const Eigen::Vector3f& origin, const Eigen::Vector3f& du,
-              const Eigen::Vector3f& dv, int n, const Eigen::Vector3f& normal) {
+void addPatch(TriangleMesh& m, const Eigen::Vector3f& origin, const Eigen::Vector3f& du, const Eigen::Vector3f& dv,
+              int n, const Eigen::Vector3f& normal) {
   n = std::max(n, 1);
   const int base = static_cast<int>(m.vertices.size());
   for (int j = 0; j <= n; ++j)
     for (int i = 0; i <= n; ++i)
-      m.vertices.push_back(origin + du * (static_cast<float>(i) / n) +
-                           dv * (static_cast<float>(j) / n));
+      m.vertices.push_back(origin + du * (static_cast<float>(i) / n) + dv * (static_cast<float>(j) / n));
   auto idx = [&](int i, int j) { return base + j * (n + 1) + i; };
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i) {
@@ -145,8 +137,7 @@ void addPatch(TriangleMesh& m, const Eigen::Vector3f& origin, const Eigen::Vecto
     }
 }
 
-void addBoxFaces(TriangleMesh& m, const Eigen::Vector3f& lo, const Eigen::Vector3f& hi, int n,
-                 float sign) {
+void addBoxFaces(TriangleMesh& m, const Eigen::Vector3f& lo, const Eigen::Vector3f& hi, int n, float sign) {
   const Eigen::Vector3f e = hi - lo;
   const Eigen::Vector3f X(e.x(), 0, 0), Y(0, e.y(), 0), Z(0, 0, e.z());
   addPatch(m, lo, X, Y, n, sign * -Eigen::Vector3f::UnitZ());
@@ -166,8 +157,7 @@ void addDisc(TriangleMesh& m, float radius, float z, int segments, float up) {
     m.vertices.emplace_back(radius * std::cos(ph), radius * std::sin(ph), z);
   }
   for (int i = 0; i < segments; ++i)
-    addOriented(m, centre, centre + 1 + i, centre + 1 + (i + 1) % segments,
-                Eigen::Vector3f(0, 0, up));
+    addOriented(m, centre, centre + 1 + i, centre + 1 + (i + 1) % segments, Eigen::Vector3f(0, 0, up));
 }
 
 }  // namespace
@@ -224,8 +214,7 @@ TriangleMesh makeCone(float radius, float height, int segments) {
     const float s = static_cast<float>(k) / rings;
     for (int i = 0; i < segments; ++i) {
       const float ph = 2 * kPi * i / segments;
-      m.vertices.emplace_back((1 - s) * radius * std::cos(ph), (1 - s) * radius * std::sin(ph),
-                              s * height);
+      m.vertices.emplace_back((1 - s) * radius * std::cos(ph), (1 - s) * radius * std::sin(ph), s * height);
     }
   }
   const int apex = static_cast<int>(m.vertices.size());
@@ -289,9 +278,7 @@ double surfaceArea(const TriangleMesh& mesh) {
   double area = 0;
   for (const auto& f : mesh.faces) {
     const Eigen::Vector3d a = mesh.vertices[f[0]].cast<double>();
-    area += 0.5 * (mesh.vertices[f[1]].cast<double>() - a)
-                      .cross(mesh.vertices[f[2]].cast<double>() - a)
-                      .norm();
+    area += 0.5 * (mesh.vertices[f[1]].cast<double>() - a).cross(mesh.vertices[f[2]].cast<double>() - a).norm();
   }
   return area;
 }

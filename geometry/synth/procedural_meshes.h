@@ -25,11 +25,10 @@ TriangleMesh makeCylinder(float radius, float height, int segments = 64);
 TriangleMesh makeCone(float radius, float height, int segments = 64);
 // Superquadric |x/a|^(2/e2) ... with exponents e1 (latitude) and e2 (longitude):
 // e = 1 is an ellipsoid, e < 1 boxier, e > 1 pinched.
-TriangleMesh makeSuperquadric(const Eigen::Vector3f& radii, float e1, float e2, int slices = 64,
-                              int stacks = 32);
+TriangleMesh makeSuperquadric(const Eigen::Vector3f& radii, float e1, float e2, int slices = 64, int stacks = 32);
 // A sphere whose radius is modulated by smooth noise: radius * (1 + amplitude * noise).
-TriangleMesh makeBumpyBlob(float radius, float amplitude, float frequency, std::uint64_t seed,
-                           int slices = 96, int stacks = 48);
+TriangleMesh makeBumpyBlob(float radius, float amplitude, float frequency, std::uint64_t seed, int slices = 96,
+                           int stacks = 48);
 
 // The inside of an axis-aligned box as six separate quads, oriented inward, each split
 // into n x n quads: floor (z = lo), ceiling (z = hi), walls x = lo, x = hi, y = lo, y = hi.

@@ -27,8 +27,7 @@ void throwOnError(RTCDevice device, const char* what) {
                              std::to_string(static_cast<int>(err)));
 }
 
-void setRay(RTCRay& ray, const Eigen::Vector3f& o, const Eigen::Vector3f& d, float tmin,
-            float tmax) {
+void setRay(RTCRay& ray, const Eigen::Vector3f& o, const Eigen::Vector3f& d, float tmin, float tmax) {
   ray.org_x = o.x();
   ray.org_y = o.y();
   ray.org_z = o.z();
@@ -49,8 +48,7 @@ RayTracer::RayTracer(const std::vector<const TriangleMesh*>& meshes, std::vector
     : impl_(std::make_unique<Impl>()) {
   if (object_ids.empty())
     for (std::size_t k = 0; k < meshes.size(); ++k) object_ids.push_back(static_cast<int>(k));
-  if (object_ids.size() != meshes.size())
-    throw std::invalid_argument("RayTracer: one object id per mesh expected");
+  if (object_ids.size() != meshes.size()) throw std::invalid_argument("RayTracer: one object id per mesh expected");
   impl_->device = rtcNewDevice(nullptr);
   if (!impl_->device) throw std::runtime_error("Embree: rtcNewDevice failed");
   impl_->scene = rtcNewScene(impl_->device);
@@ -61,17 +59,16 @@ RayTracer::RayTracer(const std::vector<const TriangleMesh*>& meshes, std::vector
     const TriangleMesh& m = *meshes[k];
     if (m.faces.empty()) continue;
     RTCGeometry g = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
-        g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), m.vertices.size()));
-    auto* f = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
-        g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), m.faces.size()));
+    auto* v = static_cast<float*>(
+        rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), m.vertices.size()));
+    auto* f = static_cast<unsigned*>(
+        rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), m.faces.size()));
     if (!v || !f) {
       rtcReleaseGeometry(g);
       throwOnError(impl_->device, "buffer allocation");
       throw std::runtime_error("Embree: buffer allocation failed");
     }
-    for (std::size_t i = 0; i < m.vertices.size(); ++i)
-      std::memcpy(v + 3 * i, m.vertices[i].data(), 3 * sizeof(float));
+    for (std::size_t i = 0; i < m.vertices.size(); ++i) std::memcpy(v + 3 * i, m.vertices[i].data(), 3 * sizeof(float));
     for (std::size_t i = 0; i < m.faces.size(); ++i)
       for (int c = 0; c < 3; ++c) f[3 * i + c] = static_cast<unsigned>(m.faces[i][c]);
     rtcCommitGeometry(g);
@@ -86,8 +83,7 @@ RayTracer::RayTracer(const std::vector<const TriangleMesh*>& meshes, std::vector
 
 RayTracer::~RayTracer() = default;
 
-TraceHit RayTracer::intersect(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir,
-                              float tmin, float tmax) const {
+TraceHit RayTracer::intersect(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir, float tmin, float tmax) const {
   TraceHit out;
   if (geom_to_object_.empty() || !(tmax > std::max(tmin, 0.0f))) return out;
   RTCIntersectContext ctx;
@@ -108,8 +104,7 @@ TraceHit RayTracer::intersect(const Eigen::Vector3f& origin, const Eigen::Vector
   return out;
 }
 
-bool RayTracer::occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir, float tmin,
-                         float tmax) const {
+bool RayTracer::occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir, float tmin, float tmax) const {
   if (geom_to_object_.empty() || !(tmax > std::max(tmin, 0.0f))) return false;
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);

@@ -12,8 +12,8 @@ namespace saresgs::synth {
 // With `alpha`, the image has a fourth channel, the fraction of samples that hit a
 // surface, and its colour is the mean of the hits alone (straight alpha; black where
 // nothing is hit): composited on the background it is the RGB render.
-ImageF renderGrid(const SyntheticScene& scene, const Camera& cam, int grid, bool jitter,
-                  bool specular, bool alpha = false);
+ImageF renderGrid(const SyntheticScene& scene, const Camera& cam, int grid, bool jitter, bool specular,
+                  bool alpha = false);
 
 // The grid size that the public render uses for a requested sample count.
 int gridForSamples(int samples_per_pixel);

@@ -47,11 +47,10 @@ void simulateSfm(const SyntheticScene& scene, ColmapModel& model, const Simulate
   // Visibility is the expensive part (one shadow ray per camera and sample); it is
   // computed in parallel into fixed slots, so the result does not depend on threads.
   std::vector<std::vector<Observation>> seen(samples.size());
-  tbb::parallel_for(std::size_t(0), samples.size(),
-                    [&](std::size_t k) {
-                      const FloatEnvGuard fenv;  // geometry/float_env.h
-                      seen[k] = observe(scene, samples[k]);
-                    });
+  tbb::parallel_for(std::size_t(0), samples.size(), [&](std::size_t k) {
+    const FloatEnvGuard fenv;  // geometry/float_env.h
+    seen[k] = observe(scene, samples[k]);
+  });
 
   AABB box;
   for (const auto& s : samples) box.extend(s.point.cast<double>());
@@ -100,8 +99,7 @@ void simulateSfm(const SyntheticScene& scene, ColmapModel& model, const Simulate
     hit.point = samples[k].point;
     hit.normal = samples[k].normal;
     hit.object = samples[k].object;
-    const Eigen::Vector3f rgb =
-        scene.shade(hit, scene.cameras[obs.front().image_index].center().cast<float>());
+    const Eigen::Vector3f rgb = scene.shade(hit, scene.cameras[obs.front().image_index].center().cast<float>());
     for (int c = 0; c < 3; ++c)
       p.rgb[c] = static_cast<std::uint8_t>(std::lround(std::clamp(rgb[c], 0.0f, 1.0f) * 255.0f));
 

@@ -17,7 +17,7 @@ struct SimulatedSfmOptions {
   std::size_t candidates = 40000;  // surface samples tried
   std::size_t max_points = 12000;  // points kept at most
   int min_views = 2;
-  double pixel_noise = 0.5;        // target mean reprojection error, px
+  double pixel_noise = 0.5;  // target mean reprojection error, px
   double outlier_fraction = 0.03;
   std::uint64_t seed = 0;
 };
@@ -25,7 +25,6 @@ struct SimulatedSfmOptions {
 // Fills model.points and each image's 2D points. `model` must already hold the
 // cameras and images (image id i+1 belongs to scene.cameras[i]); only the images of
 // scene.train observe points, as in a reconstruction from the train views.
-void simulateSfm(const SyntheticScene& scene, ColmapModel& model,
-                 const SimulatedSfmOptions& opts = {});
+void simulateSfm(const SyntheticScene& scene, ColmapModel& model, const SimulatedSfmOptions& opts = {});
 
 }  // namespace saresgs

@@ -22,16 +22,15 @@ using Eigen::Vector3f;
 
 // ---------------------------------------------------------------------------- world
 
-std::vector<const TriangleMesh*> SyntheticWorld::meshPointers(
-    const std::vector<synth::SceneObject>& o, bool casters_only) {
+std::vector<const TriangleMesh*> SyntheticWorld::meshPointers(const std::vector<synth::SceneObject>& o,
+                                                              bool casters_only) {
   std::vector<const TriangleMesh*> out;
   for (const auto& x : o)
     if (!casters_only || x.casts_shadow) out.push_back(&x.mesh);
   return out;
 }
 
-std::vector<int> SyntheticWorld::objectIds(const std::vector<synth::SceneObject>& o,
-                                           bool casters_only) {
+std::vector<int> SyntheticWorld::objectIds(const std::vector<synth::SceneObject>& o, bool casters_only) {
   std::vector<int> out;
   for (std::size_t k = 0; k < o.size(); ++k)
     if (!casters_only || o[k].casts_shadow) out.push_back(static_cast<int>(k));
@@ -53,9 +52,8 @@ SyntheticWorld::SyntheticWorld(std::vector<synth::SceneObject> objects, synth::L
     for (std::size_t f = 0; f < o.mesh.faces.size(); ++f) {
       const auto& F = o.mesh.faces[f];
       const Eigen::Vector3d a = o.mesh.vertices[F[0]].cast<double>();
-      const double area = 0.5 * (o.mesh.vertices[F[1]].cast<double>() - a)
-                                    .cross(o.mesh.vertices[F[2]].cast<double>() - a)
-                                    .norm();
+      const double area =
+          0.5 * (o.mesh.vertices[F[1]].cast<double>() - a).cross(o.mesh.vertices[F[2]].cast<double>() - a).norm();
       if (!(area > 0)) continue;
       total += area;
       area_cdf_.push_back(total);
@@ -66,8 +64,7 @@ SyntheticWorld::SyntheticWorld(std::vector<synth::SceneObject> objects, synth::L
 
 // ----------------------------------------------------------------------- queries
 
-SurfaceHit SyntheticScene::intersect(const Vector3f& origin, const Vector3f& dir, float tmin,
-                                     float tmax) const {
+SurfaceHit SyntheticScene::intersect(const Vector3f& origin, const Vector3f& dir, float tmin, float tmax) const {
   SurfaceHit out;
   const synth::TraceHit h = world_->tracer().intersect(origin, dir, tmin, tmax);
   if (!h.hit) return out;
@@ -93,8 +90,7 @@ SurfaceHit SyntheticScene::intersect(const Vector3f& origin, const Vector3f& dir
   return out;
 }
 
-bool SyntheticScene::occluded(const Vector3f& origin, const Vector3f& dir, float tmin,
-                              float tmax) const {
+bool SyntheticScene::occluded(const Vector3f& origin, const Vector3f& dir, float tmin, float tmax) const {
   return world_->tracer().occluded(origin, dir, tmin, tmax);
 }
 
@@ -113,8 +109,8 @@ Vector3f SyntheticScene::shade(const SurfaceHit& hit, const Vector3f& eye, bool 
   Vector3f highlight = Vector3f::Zero();
   if (ndl > 0) {
     const Vector3f start = hit.point + L.shadow_epsilon * n;
-    const bool shadowed = world_->casters().occluded(start, L.to_light, L.shadow_epsilon,
-                                                     std::numeric_limits<float>::infinity());
+    const bool shadowed =
+        world_->casters().occluded(start, L.to_light, L.shadow_epsilon, std::numeric_limits<float>::infinity());
     if (!shadowed) {
       light += L.diffuse * ndl;
       if (specular && to_eye.squaredNorm() > 0) {
@@ -127,13 +123,11 @@ Vector3f SyntheticScene::shade(const SurfaceHit& hit, const Vector3f& eye, bool 
 }
 
 ImageF SyntheticScene::render(const Camera& cam, const RenderOptions& opts) const {
-  return synth::renderGrid(*this, cam, synth::gridForSamples(opts.samples_per_pixel), true,
-                           opts.specular);
+  return synth::renderGrid(*this, cam, synth::gridForSamples(opts.samples_per_pixel), true, opts.specular);
 }
 
 ImageF SyntheticScene::renderRgba(const Camera& cam, const RenderOptions& opts) const {
-  return synth::renderGrid(*this, cam, synth::gridForSamples(opts.samples_per_pixel), true,
-                           opts.specular, true);
+  return synth::renderGrid(*this, cam, synth::gridForSamples(opts.samples_per_pixel), true, opts.specular, true);
 }
 
 ImageF SyntheticScene::renderDepth(const Camera& cam) const {
@@ -153,8 +147,7 @@ ImageF SyntheticScene::renderDepth(const Camera& cam) const {
   return depth;
 }
 
-std::vector<SurfaceSample> SyntheticScene::sampleSurface(std::size_t count,
-                                                         std::mt19937_64& rng) const {
+std::vector<SurfaceSample> SyntheticScene::sampleSurface(std::size_t count, std::mt19937_64& rng) const {
   std::vector<SurfaceSample> out;
   const auto& cdf = world_->areaCdf();
   if (cdf.empty()) return out;
@@ -162,8 +155,7 @@ std::vector<SurfaceSample> SyntheticScene::sampleSurface(std::size_t count,
   auto uniform = [&] { return static_cast<double>(rng() >> 11) * 0x1.0p-53; };
   for (std::size_t s = 0; s < count; ++s) {
     const double pick = uniform() * cdf.back();
-    std::size_t idx = static_cast<std::size_t>(std::upper_bound(cdf.begin(), cdf.end(), pick) -
-                                               cdf.begin());
+    std::size_t idx = static_cast<std::size_t>(std::upper_bound(cdf.begin(), cdf.end(), pick) - cdf.begin());
     idx = std::min(idx, cdf.size() - 1);
     const auto [k, f] = world_->areaFaces()[idx];
     const auto& obj = world_->objects()[k];
@@ -171,13 +163,12 @@ std::vector<SurfaceSample> SyntheticScene::sampleSurface(std::size_t count,
     const auto& N = world_->normals(k);
     // Uniform barycentrics over the triangle.
     const double r1 = std::sqrt(uniform()), r2 = uniform();
-    const float a = static_cast<float>(1 - r1), b = static_cast<float>(r1 * (1 - r2)),
-                c = static_cast<float>(r1 * r2);
+    const float a = static_cast<float>(1 - r1), b = static_cast<float>(r1 * (1 - r2)), c = static_cast<float>(r1 * r2);
     SurfaceSample smp;
     smp.point = a * obj.mesh.vertices[F[0]] + b * obj.mesh.vertices[F[1]] + c * obj.mesh.vertices[F[2]];
     Vector3f n = a * N[F[0]] + b * N[F[1]] + c * N[F[2]];
-    const Vector3f ng = (obj.mesh.vertices[F[1]] - obj.mesh.vertices[F[0]])
-                            .cross(obj.mesh.vertices[F[2]] - obj.mesh.vertices[F[0]]);
+    const Vector3f ng =
+        (obj.mesh.vertices[F[1]] - obj.mesh.vertices[F[0]]).cross(obj.mesh.vertices[F[2]] - obj.mesh.vertices[F[0]]);
     if (n.dot(ng) < 0 || !(n.norm() > 1e-6f)) n = ng;
     smp.normal = n.normalized();
     smp.object = k;
@@ -203,8 +194,7 @@ int gridForSamples(int samples_per_pixel) {
   return g;
 }
 
-ImageF renderGrid(const SyntheticScene& scene, const Camera& cam, int grid, bool jitter,
-                  bool specular, bool alpha) {
+ImageF renderGrid(const SyntheticScene& scene, const Camera& cam, int grid, bool jitter, bool specular, bool alpha) {
   grid = std::max(grid, 1);
   const int W = cam.K.width, H = cam.K.height;
   ImageF img(W, H, alpha ? 4 : 3, 0.0f);
@@ -267,19 +257,19 @@ nlohmann::json toJson(const Eigen::Affine3f& T) {
 
 SyntheticScene makeSyntheticScene(const SyntheticOptions& opts) {
   if (opts.width <= 0 || opts.height <= 0)
-    throw InputError("options", "width/height",
-                     "expected a positive image size, got " + std::to_string(opts.width) + "x" +
-                         std::to_string(opts.height));
+    throw InputError(
+        "options", "width/height",
+        "expected a positive image size, got " + std::to_string(opts.width) + "x" + std::to_string(opts.height));
   if (opts.width > kMaxImageSide || opts.height > kMaxImageSide)
     throw InputError("options", "width/height",
-                     "expected at most " + std::to_string(kMaxImageSide) + " per side, got " + std::to_string(opts.width) + "x" +
-                         std::to_string(opts.height));
+                     "expected at most " + std::to_string(kMaxImageSide) + " per side, got " +
+                         std::to_string(opts.width) + "x" + std::to_string(opts.height));
   if (opts.num_views < 0 || opts.num_views > kMaxSyntheticViews)
     throw InputError("options", "num_views",
                      "expected 0 (the layout's default) .. " + std::to_string(kMaxSyntheticViews) + ", got " +
                          std::to_string(opts.num_views));
-  if (opts.layout != "object" && opts.layout != "room360" && opts.layout != "unbalanced" &&
-      opts.layout != "tworooms" && opts.layout != "corridor")
+  if (opts.layout != "object" && opts.layout != "room360" && opts.layout != "unbalanced" && opts.layout != "tworooms" &&
+      opts.layout != "corridor")
     throw InputError("options", "layout",
                      "expected object, room360, unbalanced, tworooms or corridor, got '" + opts.layout + "'");
   synth::Assets assets;
@@ -351,8 +341,7 @@ SyntheticScene makeSyntheticScene(const SyntheticOptions& opts) {
                 {"diffuse", lighting.diffuse},
                 {"specular", lighting.specular},
                 {"shininess", lighting.shininess}};
-  if (layout.room)
-    m["room"] = {{"min", toJson(layout.room->min())}, {"max", toJson(layout.room->max())}};
+  if (layout.room) m["room"] = {{"min", toJson(layout.room->min())}, {"max", toJson(layout.room->max())}};
   m["objects"] = nlohmann::json::array();
   for (const auto& o : layout.objects) {
     const Eigen::AlignedBox3f box = synth::boundingBox(o.mesh);

@@ -39,13 +39,13 @@
 namespace saresgs {
 
 struct SyntheticOptions {
-  std::string layout = "room360";    // object | room360 | unbalanced | tworooms | corridor
+  std::string layout = "room360";  // object | room360 | unbalanced | tworooms | corridor
   int width = 256, height = 192;
   std::uint64_t seed = 0;
-  int num_views = 0;                 // 0: the layout's default count (train + test)
-  std::vector<std::string> meshes;   // OFF/PLY/OBJ files (CGAL IO); empty: procedural
-  std::vector<std::string> textures; // photographs (PNG/JPEG); empty: procedural
-  std::string up_axis = "y";         // up axis of the given mesh files: x | y | z
+  int num_views = 0;                     // 0: the layout's default count (train + test)
+  std::vector<std::string> meshes;       // OFF/PLY/OBJ files (CGAL IO); empty: procedural
+  std::vector<std::string> textures;     // photographs (PNG/JPEG); empty: procedural
+  std::string up_axis = "y";             // up axis of the given mesh files: x | y | z
   std::string projection = "triplanar";  // how photographs map: triplanar | spherical
 };
 
@@ -57,10 +57,10 @@ struct RenderOptions {
 // One ray's first hit.
 struct SurfaceHit {
   bool hit = false;
-  float distance = 0;        // along the unit ray direction
+  float distance = 0;  // along the unit ray direction
   Eigen::Vector3f point = Eigen::Vector3f::Zero();
   Eigen::Vector3f normal = Eigen::Vector3f::Zero();  // unit, facing the ray origin
-  int object = -1;           // index into SyntheticScene::objectNames()
+  int object = -1;                                   // index into SyntheticScene::objectNames()
 };
 
 struct SurfaceSample {
@@ -75,25 +75,22 @@ class SyntheticWorld;  // meshes, materials and the Embree scene (synthetic_scen
 // thread-safe and deterministic.
 class SyntheticScene {
  public:
-  std::vector<Camera> cameras;     // all views, in order; names[i] belongs to cameras[i]
-  std::vector<std::string> names;  // image file names, e.g. "0000.png"
-  std::vector<int> train, test;    // indices into cameras
+  std::vector<Camera> cameras;          // all views, in order; names[i] belongs to cameras[i]
+  std::vector<std::string> names;       // image file names, e.g. "0000.png"
+  std::vector<int> train, test;         // indices into cameras
   Eigen::Vector3f background{1, 1, 1};  // colour of rays that miss (object layout)
   // Rooms: every ray meets a wall, so the data has no background (manifest null) and
   // their images are opaque; the object layout's misses are background.
   bool enclosed = false;
-  nlohmann::json manifest;         // layout, seed, meshes, textures, sizes, light
+  nlohmann::json manifest;  // layout, seed, meshes, textures, sizes, light
 
   // First hit along origin + s * dir (dir need not be unit), s in (tmin, tmax).
-  SurfaceHit intersect(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir,
-                       float tmin = 0.0f,
+  SurfaceHit intersect(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir, float tmin = 0.0f,
                        float tmax = std::numeric_limits<float>::infinity()) const;
   // True when something blocks the segment origin + s * dir, s in (tmin, tmax).
-  bool occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir, float tmin,
-                float tmax) const;
+  bool occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& dir, float tmin, float tmax) const;
   // Shaded colour (linear RGB in [0,1]) of a surface point seen from `eye`.
-  Eigen::Vector3f shade(const SurfaceHit& hit, const Eigen::Vector3f& eye,
-                        bool specular = false) const;
+  Eigen::Vector3f shade(const SurfaceHit& hit, const Eigen::Vector3f& eye, bool specular = false) const;
   // Colour image (3 channels, [0,1]), supersampled. TBB-parallel over rows.
   ImageF render(const Camera& cam, const RenderOptions& opts = {}) const;
   // RGBA: colour of the surfaces alone (straight alpha) and the fraction of samples that

@@ -38,9 +38,12 @@ inline int dominantAxis(const Vector3f& n) {
 }
 inline Eigen::Vector2f planeCoords(const Vector3f& p, int axis) {
   switch (axis) {
-    case 0: return {p.y(), p.z()};
-    case 1: return {p.x(), p.z()};
-    default: return {p.x(), p.y()};
+    case 0:
+      return {p.y(), p.z()};
+    case 1:
+      return {p.x(), p.z()};
+    default:
+      return {p.x(), p.y()};
   }
 }
 
@@ -105,10 +108,8 @@ class Marble final : public Texture {
 
 class Wood final : public Texture {
  public:
-  Wood(const Vector3f& axis, const Vector3f& centre, float spacing, Color light, Color dark,
-       std::uint64_t seed)
-      : axis_(axis.normalized()), centre_(centre), spacing_(spacing), light_(light), dark_(dark),
-        seed_(seed) {}
+  Wood(const Vector3f& axis, const Vector3f& centre, float spacing, Color light, Color dark, std::uint64_t seed)
+      : axis_(axis.normalized()), centre_(centre), spacing_(spacing), light_(light), dark_(dark), seed_(seed) {}
   Color albedo(const Vector3f& p, const Vector3f&) const override {
     const Vector3f q = p - centre_;
     const Vector3f radial = q - q.dot(axis_) * axis_;
@@ -181,8 +182,7 @@ class Bricks final : public Texture {
     const float du = std::min(fract(u), 1 - fract(u)) * w_;
     const float dv = std::min(fract(v), 1 - fract(v)) * h_;
     const float rough = fbm(p * 9.0f, 3, seed_ + 1);
-    if (std::min(du, dv) < 0.5f * mortar_ * (1.0f + 0.3f * rough))
-      return clamp01(joint_ * (0.9f + 0.1f * rough));
+    if (std::min(du, dv) < 0.5f * mortar_ * (1.0f + 0.3f * rough)) return clamp01(joint_ * (0.9f + 0.1f * rough));
     const std::uint64_t hsh = hashInts(row, col, axis, seed_);
     const float shade = 0.75f + 0.45f * unitFloat(hsh);
     const Color hue(1.0f + 0.12f * (unitFloat(mix64(hsh)) - 0.5f), 1.0f,
@@ -287,7 +287,7 @@ class ImageTexture final : public Texture {
       const Vector3f d = len > 0 ? Vector3f(p / len) : Vector3f::UnitZ();
       const float lon = std::atan2(d.y(), d.x());
       const float lat = std::acos(std::clamp(d.z(), -1.0f, 1.0f));
-      return sampleBilinear(im, (lon / (2 * std::numbers::pi_v<float>) + 0.5f) * im.width,
+      return sampleBilinear(im, (lon / (2 * std::numbers::pi_v<float>)+0.5f) * im.width,
                             lat / std::numbers::pi_v<float> * im.height, false);
     }
     // Triplanar: blend the three axis projections with weights |n|^4.
@@ -348,38 +348,33 @@ Projection parseProjection(const std::string& name) {
 std::shared_ptr<Texture> makeChecker(float cell, Color a, Color b, std::uint64_t seed) {
   return std::make_shared<Checker>(cell, a, b, seed);
 }
-std::shared_ptr<Texture> makeStripes(const Eigen::Vector3f& axis, float period, Color a, Color b,
-                                     Color c, std::uint64_t seed) {
+std::shared_ptr<Texture> makeStripes(const Eigen::Vector3f& axis, float period, Color a, Color b, Color c,
+                                     std::uint64_t seed) {
   return std::make_shared<Stripes>(axis, period, a, b, c, seed);
 }
 std::shared_ptr<Texture> makeMarble(float scale, Color base, Color vein, std::uint64_t seed) {
   return std::make_shared<Marble>(scale, base, vein, seed);
 }
-std::shared_ptr<Texture> makeWood(const Eigen::Vector3f& axis, const Eigen::Vector3f& centre,
-                                  float ring_spacing, Color light, Color dark, std::uint64_t seed) {
+std::shared_ptr<Texture> makeWood(const Eigen::Vector3f& axis, const Eigen::Vector3f& centre, float ring_spacing,
+                                  Color light, Color dark, std::uint64_t seed) {
   return std::make_shared<Wood>(axis, centre, ring_spacing, light, dark, seed);
 }
-std::shared_ptr<Texture> makePlanks(float width, float length, Color light, Color dark,
-                                    std::uint64_t seed) {
+std::shared_ptr<Texture> makePlanks(float width, float length, Color light, Color dark, std::uint64_t seed) {
   return std::make_shared<Planks>(width, length, light, dark, seed);
 }
-std::shared_ptr<Texture> makeBricks(float w, float h, float mortar, Color brick, Color joint,
-                                    std::uint64_t seed) {
+std::shared_ptr<Texture> makeBricks(float w, float h, float mortar, Color brick, Color joint, std::uint64_t seed) {
   return std::make_shared<Bricks>(w, h, mortar, brick, joint, seed);
 }
-std::shared_ptr<Texture> makeTiles(float size, float grout, Color a, Color b, Color joint,
-                                   std::uint64_t seed) {
+std::shared_ptr<Texture> makeTiles(float size, float grout, Color a, Color b, Color joint, std::uint64_t seed) {
   return std::make_shared<Tiles>(size, grout, a, b, joint, seed);
 }
 std::shared_ptr<Texture> makeSpeckle(float scale, Color base, Color spot, std::uint64_t seed) {
   return std::make_shared<Speckle>(scale, base, spot, seed);
 }
-std::shared_ptr<Texture> makeDots(float spacing, float radius, Color background, Color dot,
-                                  std::uint64_t seed) {
+std::shared_ptr<Texture> makeDots(float spacing, float radius, Color background, Color dot, std::uint64_t seed) {
   return std::make_shared<Dots>(spacing, radius, background, dot, seed);
 }
-std::shared_ptr<Texture> makeImageTexture(std::shared_ptr<const ImageF> image,
-                                          Projection projection, float scale,
+std::shared_ptr<Texture> makeImageTexture(std::shared_ptr<const ImageF> image, Projection projection, float scale,
                                           const std::string& source) {
   return std::make_shared<ImageTexture>(std::move(image), projection, scale, source);
 }

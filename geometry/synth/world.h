@@ -15,13 +15,13 @@
 namespace saresgs::synth {
 
 struct SceneObject {
-  std::string name;            // e.g. "room_floor", "torus"
-  std::string mesh_source;     // "procedural:torus" or the mesh file path
-  TriangleMesh mesh;           // world coordinates
+  std::string name;         // e.g. "room_floor", "torus"
+  std::string mesh_source;  // "procedural:torus" or the mesh file path
+  TriangleMesh mesh;        // world coordinates
   // The object's own frame, in which its texture is defined (world = to_world * local).
   Eigen::Affine3f to_world = Eigen::Affine3f::Identity();
   std::shared_ptr<const Texture> texture;
-  bool casts_shadow = true;    // the room shell does not (the light comes from outside)
+  bool casts_shadow = true;  // the room shell does not (the light comes from outside)
 };
 
 // One directional light plus ambient: colour = albedo * (ambient + diffuse * max(0, n.l))
@@ -58,8 +58,7 @@ class SyntheticWorld {
   const std::vector<std::pair<int, int>>& areaFaces() const { return area_faces_; }
 
  private:
-  static std::vector<const TriangleMesh*> meshPointers(const std::vector<synth::SceneObject>& o,
-                                                       bool casters_only);
+  static std::vector<const TriangleMesh*> meshPointers(const std::vector<synth::SceneObject>& o, bool casters_only);
   static std::vector<int> objectIds(const std::vector<synth::SceneObject>& o, bool casters_only);
 
   std::vector<synth::SceneObject> objects_;

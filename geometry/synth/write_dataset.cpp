@@ -65,9 +65,10 @@ std::string transformsJson(const SyntheticScene& scene, const std::vector<int>& 
   }
   j["frames"] = nlohmann::json::array();
   for (int i : which)
-    j["frames"].push_back({{"file_path", "./" + part + "/" + fs::path(scene.names[static_cast<std::size_t>(i)]).stem().string()},
-                           {"rotation", 0.0},
-                           {"transform_matrix", openGlTransform(scene.cameras[static_cast<std::size_t>(i)])}});
+    j["frames"].push_back(
+        {{"file_path", "./" + part + "/" + fs::path(scene.names[static_cast<std::size_t>(i)]).stem().string()},
+         {"rotation", 0.0},
+         {"transform_matrix", openGlTransform(scene.cameras[static_cast<std::size_t>(i)])}});
   return j.dump(2) + "\n";
 }
 
@@ -78,8 +79,7 @@ ColmapModel colmapModelOf(const SyntheticScene& scene) {
   std::vector<Intrinsics> distinct;
   for (size_t i = 0; i < scene.cameras.size(); ++i) {
     const Camera& cam = scene.cameras[i];
-    auto it = std::find_if(distinct.begin(), distinct.end(),
-                           [&](const Intrinsics& K) { return K == cam.K; });
+    auto it = std::find_if(distinct.begin(), distinct.end(), [&](const Intrinsics& K) { return K == cam.K; });
     std::uint32_t cam_id;
     if (it == distinct.end()) {
       distinct.push_back(cam.K);
@@ -205,8 +205,7 @@ WriteDatasetReport writeSyntheticDataset(const SyntheticScene& scene, const std:
   if (!blender) manifest["split"] = split;
   manifest["format"] = opts.format;
   manifest["depth"] = {{"format", "pfm"}, {"convention", "z along the camera axis; 0 where a ray misses"}};
-  manifest["render"] = {{"samples_per_pixel", opts.render.samples_per_pixel},
-                        {"specular", opts.render.specular}};
+  manifest["render"] = {{"samples_per_pixel", opts.render.samples_per_pixel}, {"specular", opts.render.specular}};
   manifest["sfm"] = {{"source", opts.sfm},
                      {"points", report.points},
                      {"mean_track_length", report.mean_track_length},

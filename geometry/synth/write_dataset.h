@@ -38,7 +38,7 @@ struct WriteDatasetReport {
   double mean_reprojection_error = 0;    // px, as stored in points3D (outliers included)
   double median_reprojection_error = 0;  // px; robust to the simulated outliers
   double render_seconds = 0;
-  double median_view_ms = 0;           // colour render of one view
+  double median_view_ms = 0;  // colour render of one view
   double sfm_seconds = 0;
 };
 

@@ -87,8 +87,8 @@ namespace {
 // Calls read(item, "key[i]") for every item of the config's array `key`, each an object
 // with a "name"; `expected` describes an item for the messages.
 template <class F>
-void forEachNamedObject(const nlohmann::json& j, const std::string& path, const std::string& key, const std::string& expected,
-                        F&& read) {
+void forEachNamedObject(const nlohmann::json& j, const std::string& path, const std::string& key,
+                        const std::string& expected, F&& read) {
   if (!j.is_array()) throw InputError(path, key, "expected an array of " + expected);
   for (std::size_t i = 0; i < j.size(); ++i) {
     const std::string f = key + "[" + std::to_string(i) + "]";
@@ -98,7 +98,8 @@ void forEachNamedObject(const nlohmann::json& j, const std::string& path, const 
 }
 
 // The item's folder-safe name, which no earlier item of the same array had.
-std::string uniqueName(const nlohmann::json& item, std::set<std::string>& seen, const std::string& path, const std::string& f) {
+std::string uniqueName(const nlohmann::json& item, std::set<std::string>& seen, const std::string& path,
+                       const std::string& f) {
   const std::string name = safeName(jsonString(item["name"], path, f + ".name"), path, f + ".name");
   if (!seen.insert(name).second) throw InputError(path, f + ".name", "'" + name + "' appears twice");
   return name;
@@ -109,56 +110,61 @@ std::vector<AblationScene> readScenes(const nlohmann::json& j, const std::string
     throw InputError(path, "scenes", "expected a non-empty array of {name, dataset[, layout]}");
   std::vector<AblationScene> scenes;
   std::set<std::string> names;
-  forEachNamedObject(j["scenes"], path, "scenes", "{name, dataset[, layout]}", [&](const nlohmann::json& s, const std::string& f) {
-    if (!s.contains("dataset")) throw InputError(path, f, "expected {name, dataset[, layout]}");
-    for (const auto& [key, value] : s.items())
-      if (key != "name" && key != "dataset" && key != "layout" && key != "scene_seed")
-        throw InputError(path, f + ".\"" + key + "\"", "unknown field (expected name, dataset, layout, scene_seed)");
-    AblationScene sc;
-    sc.name = uniqueName(s, names, path, f);
-    sc.dataset = jsonString(s["dataset"], path, f + ".dataset");
-    if (s.contains("layout")) sc.layout = jsonString(s["layout"], path, f + ".layout");
-    if (s.contains("scene_seed")) {
-      if (!s["scene_seed"].is_number_unsigned())
-        throw InputError(path, f + ".scene_seed", "expected a non-negative integer (saresgs scene --seed)");
-      if (sc.layout.empty()) throw InputError(path, f + ".scene_seed", "given without a layout to generate");
-      sc.scene_seed = s["scene_seed"].get<std::uint64_t>();
-    }
-    scenes.push_back(sc);
-  });
+  forEachNamedObject(
+      j["scenes"], path, "scenes", "{name, dataset[, layout]}", [&](const nlohmann::json& s, const std::string& f) {
+        if (!s.contains("dataset")) throw InputError(path, f, "expected {name, dataset[, layout]}");
+        for (const auto& [key, value] : s.items())
+          if (key != "name" && key != "dataset" && key != "layout" && key != "scene_seed")
+            throw InputError(path, f + ".\"" + key + "\"",
+                             "unknown field (expected name, dataset, layout, scene_seed)");
+        AblationScene sc;
+        sc.name = uniqueName(s, names, path, f);
+        sc.dataset = jsonString(s["dataset"], path, f + ".dataset");
+        if (s.contains("layout")) sc.layout = jsonString(s["layout"], path, f + ".layout");
+        if (s.contains("scene_seed")) {
+          if (!s["scene_seed"].is_number_unsigned())
+            throw InputError(path, f + ".scene_seed", "expected a non-negative integer (saresgs scene --seed)");
+          if (sc.layout.empty()) throw InputError(path, f + ".scene_seed", "given without a layout to generate");
+          sc.scene_seed = s["scene_seed"].get<std::uint64_t>();
+        }
+        scenes.push_back(sc);
+      });
   return scenes;
 }
 
 std::vector<AblationVariant> readVariants(const nlohmann::json& j, const std::string& path) {
   std::vector<AblationVariant> variants;
   std::set<std::string> names;
-  forEachNamedObject(j, path, "variants", "{name, methods?, args?, replay?}", [&](const nlohmann::json& v, const std::string& f) {
-    AblationVariant var;
-    var.name = uniqueName(v, names, path, f);
-    if (v.contains("methods")) var.methods = jsonStrings(v["methods"], path, f + ".methods");
-    for (const auto& m : var.methods) checkMethod(m, path, f + ".methods");
-    if (v.contains("args")) var.args = jsonStrings(v["args"], path, f + ".args");
-    if (v.contains("replay")) {
-      var.replay = jsonString(v["replay"], path, f + ".replay");
-      checkMethod(var.replay, path, f + ".replay");
-      if (var.name == "default") throw InputError(path, f + ".replay", "the default variant is what replays read: it cannot replay");
-    }
-    variants.push_back(var);
-  });
+  forEachNamedObject(
+      j, path, "variants", "{name, methods?, args?, replay?}", [&](const nlohmann::json& v, const std::string& f) {
+        AblationVariant var;
+        var.name = uniqueName(v, names, path, f);
+        if (v.contains("methods")) var.methods = jsonStrings(v["methods"], path, f + ".methods");
+        for (const auto& m : var.methods) checkMethod(m, path, f + ".methods");
+        if (v.contains("args")) var.args = jsonStrings(v["args"], path, f + ".args");
+        if (v.contains("replay")) {
+          var.replay = jsonString(v["replay"], path, f + ".replay");
+          checkMethod(var.replay, path, f + ".replay");
+          if (var.name == "default")
+            throw InputError(path, f + ".replay", "the default variant is what replays read: it cannot replay");
+        }
+        variants.push_back(var);
+      });
   return variants;
 }
 
 std::vector<AblationTableSpec> readTables(const nlohmann::json& j, const std::string& path) {
   std::vector<AblationTableSpec> tables;
   std::set<std::string> names;
-  forEachNamedObject(j, path, "tables", "{name, title, methods?, variants?}", [&](const nlohmann::json& t, const std::string& f) {
-    AblationTableSpec spec;
-    spec.name = uniqueName(t, names, path, f);
-    spec.title = t.contains("title") ? jsonString(t["title"], path, f + ".title") : spec.name;
-    if (t.contains("methods")) spec.methods = jsonStrings(t["methods"], path, f + ".methods");
-    if (t.contains("variants")) spec.variants = jsonStrings(t["variants"], path, f + ".variants");
-    tables.push_back(spec);
-  });
+  forEachNamedObject(j, path, "tables", "{name, title, methods?, variants?}",
+                     [&](const nlohmann::json& t, const std::string& f) {
+                       AblationTableSpec spec;
+                       spec.name = uniqueName(t, names, path, f);
+                       spec.title = t.contains("title") ? jsonString(t["title"], path, f + ".title") : spec.name;
+                       if (t.contains("methods")) spec.methods = jsonStrings(t["methods"], path, f + ".methods");
+                       if (t.contains("variants")) spec.variants = jsonStrings(t["variants"], path, f + ".variants");
+                       tables.push_back(spec);
+                     });
   return tables;
 }
 
@@ -173,7 +179,8 @@ SweepSpec readSweep(const nlohmann::json& s, const std::vector<AblationScene>& s
       throw InputError(path, "sweep.scenes", "'" + n + "' is not one of the scenes");
   if (s.contains("views")) {
     sw.view_counts.clear();
-    for (long long c : jsonIntegers(s["views"], path, "sweep.views", 1, kMaxSyntheticViews)) sw.view_counts.push_back(static_cast<int>(c));
+    for (long long c : jsonIntegers(s["views"], path, "sweep.views", 1, kMaxSyntheticViews))
+      sw.view_counts.push_back(static_cast<int>(c));
   }
   if (sw.view_counts.empty()) throw InputError(path, "sweep.views", "expected at least one view count");
   if (s.contains("encodings")) {
@@ -205,7 +212,8 @@ SweepSpec readSweep(const nlohmann::json& s, const std::vector<AblationScene>& s
     sw.keep_fraction = jsonNumberIn(s["keep"], path, "sweep.keep", 0, 1);
     if (!(sw.keep_fraction > 0)) throw InputError(path, "sweep.keep", "expected a fraction in (0, 1]");
   }
-  if (s.contains("timing_repeats")) sw.timing_repeats = static_cast<int>(jsonInteger(s["timing_repeats"], path, "sweep.timing_repeats", 1, 1000));
+  if (s.contains("timing_repeats"))
+    sw.timing_repeats = static_cast<int>(jsonInteger(s["timing_repeats"], path, "sweep.timing_repeats", 1, 1000));
   return sw;
 }
 
@@ -217,7 +225,8 @@ AblationGrid readAblationGrid(const std::string& path) {
   AblationGrid g;
   g.source = path;
   for (const auto& [key, value] : j.items())
-    if (!std::set<std::string>{"preset", "threads", "scenes", "methods", "seeds", "method_seeds", "method_args", "variants", "tables", "sweep", "comment"}
+    if (!std::set<std::string>{"preset", "threads", "scenes", "methods", "seeds", "method_seeds", "method_args",
+                               "variants", "tables", "sweep", "comment"}
              .count(key))
       // Quoted, so that an empty key (found by the ablation-config fuzz target) still names a field.
       throw InputError(path, "\"" + key + "\"", "unknown field");
@@ -241,7 +250,8 @@ AblationGrid readAblationGrid(const std::string& path) {
       std::vector<std::uint64_t> seeds;
       for (long long s : jsonIntegers(a, path, f, 0, std::numeric_limits<long long>::max())) {
         if (std::find(g.seeds.begin(), g.seeds.end(), static_cast<std::uint64_t>(s)) == g.seeds.end())
-          throw InputError(path, f, "seed " + std::to_string(s) + " is not among \"seeds\" (the tables pair seeds from there)");
+          throw InputError(path, f,
+                           "seed " + std::to_string(s) + " is not among \"seeds\" (the tables pair seeds from there)");
         seeds.push_back(static_cast<std::uint64_t>(s));
       }
       noRepeats(seeds, path, f);
@@ -287,7 +297,8 @@ std::vector<AblationJob> expandGrid(const AblationGrid& g) {
           j.id = sc.name + "__" + m + "__" + v.name + "__s" + std::to_string(seed);
           j.args = {"--dataset", sc.dataset, "--method", m, "--seed", std::to_string(seed), "--preset", g.preset};
           if (g.threads > 0) j.args.insert(j.args.end(), {"--threads", std::to_string(g.threads)});
-          if (auto it = g.method_args.find(m); it != g.method_args.end()) j.args.insert(j.args.end(), it->second.begin(), it->second.end());
+          if (auto it = g.method_args.find(m); it != g.method_args.end())
+            j.args.insert(j.args.end(), it->second.begin(), it->second.end());
           j.args.insert(j.args.end(), v.args.begin(), v.args.end());
           if (!v.replay.empty()) j.replay_of = sc.name + "__" + v.replay + "__default__s" + std::to_string(seed);
           jobs.push_back(j);
@@ -297,8 +308,9 @@ std::vector<AblationJob> expandGrid(const AblationGrid& g) {
   for (const AblationJob& j : jobs)
     if (!j.replay_of.empty() &&
         std::none_of(jobs.begin(), jobs.end(), [&](const AblationJob& s) { return s.id == j.replay_of; }))
-      throw InputError(g.source, "variants", "job " + j.id + " replays " + j.replay_of +
-                                                 ", which the grid does not run (the replayed method needs the default variant)");
+      throw InputError(g.source, "variants",
+                       "job " + j.id + " replays " + j.replay_of +
+                           ", which the grid does not run (the replayed method needs the default variant)");
   return jobs;
 }
 
@@ -317,7 +329,8 @@ std::pair<int, int> parseShard(const std::string& text) {
 std::vector<AblationJob> shardJobs(const std::vector<AblationJob>& jobs, int i, int n) {
   if (n < 1 || i < 0 || i >= n) throw std::invalid_argument("shard " + std::to_string(i) + "/" + std::to_string(n));
   std::vector<AblationJob> out;
-  for (std::size_t k = static_cast<std::size_t>(i); k < jobs.size(); k += static_cast<std::size_t>(n)) out.push_back(jobs[k]);
+  for (std::size_t k = static_cast<std::size_t>(i); k < jobs.size(); k += static_cast<std::size_t>(n))
+    out.push_back(jobs[k]);
   return out;
 }
 
@@ -333,8 +346,10 @@ std::vector<JobResult> loadFinishedJobs(const std::string& out, const std::vecto
     if (!jobFinished(out, j)) continue;
     const std::string file = jobResultFile(out, j);
     JobResult res{j, {}, {}};
-    if (j.kind == AblationJob::Kind::kSweep) res.sweep = sweepReportFromJson(readJsonFile(file), file);
-    else res.run = runReportFromJson(readJsonFile(file), file);
+    if (j.kind == AblationJob::Kind::kSweep)
+      res.sweep = sweepReportFromJson(readJsonFile(file), file);
+    else
+      res.run = runReportFromJson(readJsonFile(file), file);
     r.push_back(std::move(res));
   }
   return r;

@@ -99,8 +99,8 @@ bool variantApplies(const AblationVariant& v, const std::string& method);
 // How a run is named in tables and plots: "method", or "method (variant)".
 std::string runLabel(const std::string& method, const std::string& variant);
 
-std::string jobFolder(const std::string& out, const AblationJob& j);          // OUT/runs/<id>
-std::string jobResultFile(const std::string& out, const AblationJob& j);      // results.json or sweep.json
+std::string jobFolder(const std::string& out, const AblationJob& j);      // OUT/runs/<id>
+std::string jobResultFile(const std::string& out, const AblationJob& j);  // results.json or sweep.json
 bool jobFinished(const std::string& out, const AblationJob& j);
 // The results file a replay job replays (empty for other jobs).
 std::string replaySource(const std::string& out, const AblationJob& j);

@@ -35,11 +35,13 @@ double halfInterval95(const std::vector<double>& v) {
 void addPerViewPlot(const AblationGrid& g, const std::vector<JobResult>& results, std::vector<NamedPlot>& plots) {
   std::vector<PlotPanel> panels;
   for (const AblationScene& sc : g.scenes) {
-    PlotPanel p{sc.name + ": final-fit PSNR per test view (mean, seeds)", "test view (split order)", "PSNR dB", false, {}, {}};
+    PlotPanel p{
+        sc.name + ": final-fit PSNR per test view (mean, seeds)", "test view (split order)", "PSNR dB", false, {}, {}};
     for (const std::string& l : labelsFor(results, sc.name)) {
       std::vector<std::vector<double>> per_view;
       for (const JobResult& r : results) {
-        if (r.job.kind != AblationJob::Kind::kActive || r.job.scene != sc.name || label(r.job) != l || !r.run.final_fit) continue;
+        if (r.job.kind != AblationJob::Kind::kActive || r.job.scene != sc.name || label(r.job) != l || !r.run.final_fit)
+          continue;
         const auto& views = r.run.final_fit->views;
         if (per_view.size() < views.size()) per_view.resize(views.size());
         for (std::size_t k = 0; k < views.size(); ++k) per_view[k].push_back(views[k].psnr);
@@ -78,8 +80,8 @@ void addBetterBaselinePlot(const AblationGrid& g, const std::vector<JobResult>& 
       labels.push_back(r.method);
     }
     if (labels.empty()) continue;
-    PlotPanel p{sc.name + ": final-fit PSNR minus " + baseline + "'s (the better baseline)", "method", "dB", false,
-                labels, {}};
+    PlotPanel p{
+        sc.name + ": final-fit PSNR minus " + baseline + "'s (the better baseline)", "method", "dB", false, labels, {}};
     // The zero line first, so that the points are drawn over it.
     p.series.push_back({"0", {0.0, static_cast<double>(labels.size() - 1)}, {0.0, 0.0}, {}, {}, true});
     p.series.push_back(diff);
@@ -194,7 +196,8 @@ NamedPlot sweepPlot(const JobResult& r) {
 
 std::vector<NamedPlot> ablationPlots(const AblationGrid& g, const std::vector<JobResult>& results) {
   std::vector<NamedPlot> plots;
-  if (std::any_of(results.begin(), results.end(), [](const JobResult& r) { return r.job.kind == AblationJob::Kind::kActive; }))
+  if (std::any_of(results.begin(), results.end(),
+                  [](const JobResult& r) { return r.job.kind == AblationJob::Kind::kActive; }))
     addActivePlots(g, results, plots);
   for (const JobResult& r : results)
     if (r.job.kind == AblationJob::Kind::kSweep) plots.push_back(sweepPlot(r));

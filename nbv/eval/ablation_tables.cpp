@@ -127,14 +127,15 @@ Table resultsTable(const AblationGrid& g, const std::vector<JobResult>& results)
           "(residual supervision for resgs and sa-resgs: selection judged apart from the schedule); and the plain "
           "refit, plain 3DGS on the same views (selection judged apart from the training too; the final fit itself "
           "for the methods that train plainly)",
-          {"scene", "method", "seeds", "PSNR", "SSIM", "AUSE", "final-fit PSNR", "final-fit SSIM", "plain-refit PSNR"}, {}};
+          {"scene", "method", "seeds", "PSNR", "SSIM", "AUSE", "final-fit PSNR", "final-fit SSIM", "plain-refit PSNR"},
+          {}};
   forEachCombo(g, [&](const std::string& s, const std::string& m, const std::string& v) {
     const Key k{s, m, v};
     const auto p = metric(by, k, psnrOf);
     if (p.empty()) return;
     t.rows.push_back({s, runLabel(m, v), std::to_string(p.size()), pm(p, 2), pm(metric(by, k, ssimOf), 4),
-                      pm(metric(by, k, auseOf), 4), pm(metric(by, k, finalPsnrOf), 2), pm(metric(by, k, finalSsimOf), 4),
-                      pm(metric(by, k, plainRefitPsnrOf), 2)});
+                      pm(metric(by, k, auseOf), 4), pm(metric(by, k, finalPsnrOf), 2),
+                      pm(metric(by, k, finalSsimOf), 4), pm(metric(by, k, plainRefitPsnrOf), 2)});
   });
   return t;
 }
@@ -189,7 +190,8 @@ Table psnrVsViewsTable(const AblationGrid& g, const std::vector<JobResult>& resu
   Table t{"psnr_vs_views",
           "PSNR on the progress test views against the number of training views (mean over seeds; the "
           "progress views are 3 of the test views, so these are noisier than the final table)",
-          {"scene", "method"}, {}};
+          {"scene", "method"},
+          {}};
   int max_views = 0;
   for (const JobResult& r : results)
     if (isActive(r))
@@ -223,7 +225,8 @@ Table psnrVsViewsTable(const AblationGrid& g, const std::vector<JobResult>& resu
 Table finalFitPerViewTable(const AblationGrid& g, const std::vector<JobResult>& results) {
   Table t{"final_fit_per_view",
           "Final-fit PSNR per test view (mean over seeds; columns: the scene's test views in split order)",
-          {"scene", "method", "n"}, {}};
+          {"scene", "method", "n"},
+          {}};
   std::size_t max_views = 0;
   for (const JobResult& r : results)
     if (isActive(r) && r.run.final_fit) max_views = std::max(max_views, r.run.final_fit->views.size());
@@ -254,8 +257,8 @@ Table timeTable(const AblationGrid& g, const std::vector<JobResult>& results) {
           "Time per run (mean over scenes and seeds, seconds): selection stages, training per iteration, end to "
           "end; coverage = the hybrid's visible-surface sets and counts; exhaustive Fisher = Fisher over all "
           "candidates timed in the same run",
-          {"method", "runs", "lifting", "triangulation", "prefilter", "Fisher", "coverage", "selection", "exhaustive Fisher",
-           "selection saved", "train ms/it", "end to end"},
+          {"method", "runs", "lifting", "triangulation", "prefilter", "Fisher", "coverage", "selection",
+           "exhaustive Fisher", "selection saved", "train ms/it", "end to end"},
           {}};
   for (const auto& m : g.methods)
     for (const auto& v : g.variants) {
@@ -278,23 +281,27 @@ Table timeTable(const AblationGrid& g, const std::vector<JobResult>& results) {
         e2e.push_back(r.run.end_to_end_seconds);
       }
       if (li.empty()) continue;
-      auto mean = [](const std::vector<double>& x, int d) { return x.empty() ? std::string("") : fmt(meanStd(x).first, d); };
-      t.rows.push_back({runLabel(m, v.name), std::to_string(li.size()), mean(li, 2), mean(tr, 3), mean(pf, 3), mean(fi, 1),
-                        mean(cv, 2), mean(sel, 1), mean(ex, 1), saved.empty() ? "" : mean(saved, 0) + " %", mean(it_ms, 1), mean(e2e, 0)});
+      auto mean = [](const std::vector<double>& x, int d) {
+        return x.empty() ? std::string("") : fmt(meanStd(x).first, d);
+      };
+      t.rows.push_back({runLabel(m, v.name), std::to_string(li.size()), mean(li, 2), mean(tr, 3), mean(pf, 3),
+                        mean(fi, 1), mean(cv, 2), mean(sel, 1), mean(ex, 1), saved.empty() ? "" : mean(saved, 0) + " %",
+                        mean(it_ms, 1), mean(e2e, 0)});
     }
   return t;
 }
 
 // Prefilter sweep: per (set, score, encoding), the mean over observed states.
 Table sweepTable(const std::vector<JobResult>& results) {
-  Table t{"prefilter_sweep",
-          "Prefilter variants against the exact visible-set reference (same score): top-N % overlap and Kendall "
-          "tau-b of the candidate ranking (mean over observed states), scoring time per selection (encode + "
-          "compare all candidates, median of repeats) and the time to build every candidate's voxel set once; "
-          "grid: the scene type's occupancy grid (resolution, SfM points per voxel, scene-occupied voxels); load: "
-          "scene voxels / hash table size",
-          {"scene", "grid", "set", "score", "encoding", "load", "top-N overlap", "Kendall tau", "scoring ms", "sets ms"},
-          {}};
+  Table t{
+      "prefilter_sweep",
+      "Prefilter variants against the exact visible-set reference (same score): top-N % overlap and Kendall "
+      "tau-b of the candidate ranking (mean over observed states), scoring time per selection (encode + "
+      "compare all candidates, median of repeats) and the time to build every candidate's voxel set once; "
+      "grid: the scene type's occupancy grid (resolution, SfM points per voxel, scene-occupied voxels); load: "
+      "scene voxels / hash table size",
+      {"scene", "grid", "set", "score", "encoding", "load", "top-N overlap", "Kendall tau", "scoring ms", "sets ms"},
+      {}};
   for (const JobResult& r : results) {
     if (r.job.kind != AblationJob::Kind::kSweep) continue;
     using RowKey = std::tuple<std::string, std::string, std::string>;
@@ -305,8 +312,8 @@ Table sweepTable(const std::vector<JobResult>& results) {
       if (!rows.count(k)) order.push_back(k);
       rows[k].push_back(&row);
     }
-    const std::string grid = r.sweep.resolution > 0 ? r.sweep.scene_type + " r" + std::to_string(r.sweep.resolution) + " m" +
-                                                          std::to_string(r.sweep.min_points) + ", " +
+    const std::string grid = r.sweep.resolution > 0 ? r.sweep.scene_type + " r" + std::to_string(r.sweep.resolution) +
+                                                          " m" + std::to_string(r.sweep.min_points) + ", " +
                                                           std::to_string(r.sweep.scene_voxels) + " voxels"
                                                     : "-";
     for (const auto& k : order) {
@@ -319,9 +326,9 @@ Table sweepTable(const std::vector<JobResult>& results) {
         st.push_back(1000 * row->seconds_sets);
         load = row->load;  // the same in every observed state
       }
-      t.rows.push_back({r.job.scene, grid, std::get<0>(k), std::get<1>(k), std::get<2>(k), load > 0 ? fmt(load, 3) : "-",
-                        fmt(meanStd(ov).first, 3), fmt(meanStd(tau).first, 3), fmt(meanStd(sc).first, 2),
-                        fmt(meanStd(st).first, 1)});
+      t.rows.push_back({r.job.scene, grid, std::get<0>(k), std::get<1>(k), std::get<2>(k),
+                        load > 0 ? fmt(load, 3) : "-", fmt(meanStd(ov).first, 3), fmt(meanStd(tau).first, 3),
+                        fmt(meanStd(sc).first, 2), fmt(meanStd(st).first, 1)});
     }
   }
   return t;
@@ -339,9 +346,11 @@ Table pairedTable(const AblationGrid& g, const std::vector<JobResult>& results) 
           {"scene", "method", "baseline", "metric", "mean_diff", "ci_low", "ci_high", "n", "win_rate"},
           {}};
   // The run of (scene, method, variant, seed), if finished.
-  auto find = [&](const std::string& scene, const std::string& m, const std::string& v, std::uint64_t seed) -> const RunReport* {
+  auto find = [&](const std::string& scene, const std::string& m, const std::string& v,
+                  std::uint64_t seed) -> const RunReport* {
     for (const JobResult& r : results)
-      if (isActive(r) && r.job.scene == scene && r.job.method == m && r.job.variant == v && r.job.seed == seed) return &r.run;
+      if (isActive(r) && r.job.scene == scene && r.job.method == m && r.job.variant == v && r.job.seed == seed)
+        return &r.run;
     return nullptr;
   };
   enum class Model { kFinalFit, kPlainRefit, kLoop, kNone };  // kNone: no per-view figures
@@ -356,8 +365,9 @@ Table pairedTable(const AblationGrid& g, const std::vector<JobResult>& results) 
                             {"ause", auseOf, Model::kNone}};
   auto viewPsnrs = [](const RunReport& r, Model m) {
     std::vector<double> v;
-    const std::vector<ViewReport>& views =
-        m == Model::kFinalFit ? r.final_fit->views : m == Model::kPlainRefit ? r.final_fit_views->views : r.views;
+    const std::vector<ViewReport>& views = m == Model::kFinalFit     ? r.final_fit->views
+                                           : m == Model::kPlainRefit ? r.final_fit_views->views
+                                                                     : r.views;
     for (const ViewReport& x : views) v.push_back(x.psnr);
     return v;
   };
@@ -380,9 +390,12 @@ Table pairedTable(const AblationGrid& g, const std::vector<JobResult>& results) 
         }
         if (a.empty()) continue;
         const PairedDifference d = pairedDifference(a, b, va, vb);
-        auto opt = [](const std::optional<double>& x, int digits) { return x ? fmt(*x, digits) : std::string("undefined"); };
-        t.rows.push_back({scene, runLabel(m, v), baseline, metric.name, fmt(d.mean, 3), opt(d.ci_low, 3), opt(d.ci_high, 3),
-                          std::to_string(d.n), d.win_rate ? fmt(*d.win_rate, 3) : std::string("n/a")});
+        auto opt = [](const std::optional<double>& x, int digits) {
+          return x ? fmt(*x, digits) : std::string("undefined");
+        };
+        t.rows.push_back({scene, runLabel(m, v), baseline, metric.name, fmt(d.mean, 3), opt(d.ci_low, 3),
+                          opt(d.ci_high, 3), std::to_string(d.n),
+                          d.win_rate ? fmt(*d.win_rate, 3) : std::string("n/a")});
       }
     });
   }

@@ -107,7 +107,8 @@ Image8 plotCoverage(const Scene& scene, const CoverageAnalysis& a, int size) {
     if (c.kept) frustum(c.view, cv::Scalar(40, 170, 40), 2);
   for (int v : a.views) frustum(v, cv::Scalar(30, 30, 220), 2);
   char title[200];
-  std::snprintf(title, sizeof title, "from above: occupied (grey) %zu, observed (blue) %zu = %.1f %%; red: views, green: top %zu",
+  std::snprintf(title, sizeof title,
+                "from above: occupied (grey) %zu, observed (blue) %zu = %.1f %%; red: views, green: top %zu",
                 a.scene_voxels, a.observed_voxels, 100 * a.observed_fraction, a.top.size());
   cv::putText(img, title, cv::Point(8, 20), cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
   Image8 out(size, size + top_margin, 3);

@@ -20,9 +20,9 @@ struct CandidateCoverage {
 };
 
 struct CoverageAnalysis {
-  std::vector<int> views;  // observed
+  std::vector<int> views;                     // observed
   std::vector<CandidateCoverage> candidates;  // in view order
-  std::vector<int> top;    // kept views, best first
+  std::vector<int> top;                       // kept views, best first
   double observed_fraction = 0;
   std::size_t scene_voxels = 0, observed_voxels = 0;
   LiftingReport lifting;

@@ -8,10 +8,10 @@
 namespace saresgs {
 
 struct PairedDifference {
-  int n = 0;                        // seeds with both methods
-  double mean = 0;                  // mean of (a - b) over those seeds
+  int n = 0;                              // seeds with both methods
+  double mean = 0;                        // mean of (a - b) over those seeds
   std::optional<double> ci_low, ci_high;  // 95 % t interval; undefined for n < 2
-  std::optional<double> win_rate;   // share of (seed, test view) pairs where a > b (ties count half)
+  std::optional<double> win_rate;         // share of (seed, test view) pairs where a > b (ties count half)
 };
 
 // a[i], b[i]: one seed's metric for the two methods; views_a[i], views_b[i]: that seed's

@@ -11,17 +11,21 @@ namespace saresgs {
 
 namespace {
 
-const cv::Scalar kPalette[] = {{180, 119, 31}, {14, 127, 255}, {44, 160, 44}, {40, 39, 214},
-                               {189, 103, 148}, {75, 86, 140}, {194, 119, 227}, {127, 127, 127},
-                               {34, 189, 188}, {207, 190, 23}};  // BGR, the usual ten
+const cv::Scalar kPalette[] = {{180, 119, 31},  {14, 127, 255}, {44, 160, 44},   {40, 39, 214},
+                               {189, 103, 148}, {75, 86, 140},  {194, 119, 227}, {127, 127, 127},
+                               {34, 189, 188},  {207, 190, 23}};  // BGR, the usual ten
 
 std::string tick(double v) {
   char b[32];
   const double a = std::abs(v);
-  if (a != 0 && (a < 1e-2 || a >= 1e5)) std::snprintf(b, sizeof b, "%.0e", v);
-  else if (a >= 100 || v == std::round(v)) std::snprintf(b, sizeof b, "%.0f", v);
-  else if (a >= 1) std::snprintf(b, sizeof b, "%.1f", v);
-  else std::snprintf(b, sizeof b, "%.2f", v);
+  if (a != 0 && (a < 1e-2 || a >= 1e5))
+    std::snprintf(b, sizeof b, "%.0e", v);
+  else if (a >= 100 || v == std::round(v))
+    std::snprintf(b, sizeof b, "%.0f", v);
+  else if (a >= 1)
+    std::snprintf(b, sizeof b, "%.1f", v);
+  else
+    std::snprintf(b, sizeof b, "%.2f", v);
   return b;
 }
 
@@ -37,7 +41,8 @@ std::vector<double> linearTicks(double lo, double hi) {
       break;
     }
   std::vector<double> t;
-  for (double v = std::ceil(lo / step) * step; v <= hi + 1e-9 * span; v += step) t.push_back(std::abs(v) < 1e-12 * span ? 0 : v);
+  for (double v = std::ceil(lo / step) * step; v <= hi + 1e-9 * span; v += step)
+    t.push_back(std::abs(v) < 1e-12 * span ? 0 : v);
   return t;
 }
 
@@ -129,7 +134,8 @@ void drawPanel(cv::Mat& img, const PlotPanel& p) {
         if (lx < x0 || lx > x1) continue;
         const cv::Point a = Praw(lx, y0), b = Praw(lx, y1);
         cv::line(img, a, b, grey, 1);
-        cv::putText(img, tick(m * std::pow(10.0, e)), cv::Point(a.x - 12, top + ph + 16), font, 0.38, black, 1, cv::LINE_AA);
+        cv::putText(img, tick(m * std::pow(10.0, e)), cv::Point(a.x - 12, top + ph + 16), font, 0.38, black, 1,
+                    cv::LINE_AA);
       }
   } else {
     for (double x : linearTicks(x0, x1)) {
@@ -139,8 +145,9 @@ void drawPanel(cv::Mat& img, const PlotPanel& p) {
     }
   }
   cv::rectangle(img, cv::Point(left, top), cv::Point(left + pw, top + ph), black, 1);
-  cv::putText(img, p.xlabel, cv::Point(left + pw / 2 - 4 * static_cast<int>(p.xlabel.size()), top + ph + (stagger ? 46 : 36)), font, 0.42, black, 1,
-              cv::LINE_AA);
+  cv::putText(img, p.xlabel,
+              cv::Point(left + pw / 2 - 4 * static_cast<int>(p.xlabel.size()), top + ph + (stagger ? 46 : 36)), font,
+              0.42, black, 1, cv::LINE_AA);
   cv::putText(img, p.ylabel, cv::Point(4, top - 8 + 0), font, 0.38, black, 1, cv::LINE_AA);
 
   for (std::size_t si = 0; si < p.series.size(); ++si) {
@@ -169,8 +176,10 @@ void drawPanel(cv::Mat& img, const PlotPanel& p) {
       const cv::Point q = P(s.x[i], s.y[i]);
       if (!s.band && i < s.err.size() && std::isfinite(s.err[i]) && s.err[i] > 0) {
         cv::line(img, P(s.x[i], s.y[i] - s.err[i]), P(s.x[i], s.y[i] + s.err[i]), c, 1, cv::LINE_AA);
-        cv::line(img, P(s.x[i], s.y[i] - s.err[i]) + cv::Point(-4, 0), P(s.x[i], s.y[i] - s.err[i]) + cv::Point(4, 0), c, 1);
-        cv::line(img, P(s.x[i], s.y[i] + s.err[i]) + cv::Point(-4, 0), P(s.x[i], s.y[i] + s.err[i]) + cv::Point(4, 0), c, 1);
+        cv::line(img, P(s.x[i], s.y[i] - s.err[i]) + cv::Point(-4, 0), P(s.x[i], s.y[i] - s.err[i]) + cv::Point(4, 0),
+                 c, 1);
+        cv::line(img, P(s.x[i], s.y[i] + s.err[i]) + cv::Point(-4, 0), P(s.x[i], s.y[i] + s.err[i]) + cv::Point(4, 0),
+                 c, 1);
       }
       cv::circle(img, q, 4, c, cv::FILLED, cv::LINE_AA);
       if (i < s.point_labels.size() && !s.point_labels[i].empty())

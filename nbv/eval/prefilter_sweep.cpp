@@ -25,7 +25,8 @@ std::vector<int> observedOrder(const Scene& scene, int count, std::uint64_t seed
   std::vector<Eigen::Vector3d> centers;
   for (int v : scene.train) centers.push_back(scene.views[static_cast<std::size_t>(v)].camera.center());
   std::vector<int> order;
-  for (int i : farthestPointSampling(centers, std::min(4, count), 0)) order.push_back(scene.train[static_cast<std::size_t>(i)]);
+  for (int i : farthestPointSampling(centers, std::min(4, count), 0))
+    order.push_back(scene.train[static_cast<std::size_t>(i)]);
   std::vector<int> rest;
   for (int v : scene.train)
     if (std::find(order.begin(), order.end(), v) == order.end()) rest.push_back(v);
@@ -42,7 +43,8 @@ std::vector<int> observedOrder(const Scene& scene, int count, std::uint64_t seed
 
 std::vector<CoverageScoring> SweepSpec::defaultEncodings() {
   std::vector<CoverageScoring> e;
-  for (int bits = 11; bits <= 19; ++bits) e.push_back({CoverageEncoding::Hashed, CoverageCriterion::Hamming, std::size_t{1} << bits});
+  for (int bits = 11; bits <= 19; ++bits)
+    e.push_back({CoverageEncoding::Hashed, CoverageCriterion::Hamming, std::size_t{1} << bits});
   e.push_back({CoverageEncoding::Exact, CoverageCriterion::Hamming, 0});
   return e;
 }
@@ -54,12 +56,20 @@ nlohmann::json toJson(const SweepReport& r) {
   res["lifting"] = r.lifting;
   res["reference"] = r.reference;
   if (r.resolution > 0)
-    res["grid"] = {{"scene_type", r.scene_type}, {"resolution", r.resolution}, {"min_points", r.min_points},
+    res["grid"] = {{"scene_type", r.scene_type},
+                   {"resolution", r.resolution},
+                   {"min_points", r.min_points},
                    {"scene_voxels", r.scene_voxels}};
   for (const SweepRow& w : r.rows)
-    res["rows"].push_back({{"set", w.set}, {"encoding", w.encoding}, {"score", w.score}, {"views", w.views},
-                           {"candidates", w.candidates}, {"overlap", w.overlap}, {"kendall_tau", w.kendall_tau},
-                           {"seconds_scoring", w.seconds_scoring}, {"seconds_sets", w.seconds_sets},
+    res["rows"].push_back({{"set", w.set},
+                           {"encoding", w.encoding},
+                           {"score", w.score},
+                           {"views", w.views},
+                           {"candidates", w.candidates},
+                           {"overlap", w.overlap},
+                           {"kendall_tau", w.kendall_tau},
+                           {"seconds_scoring", w.seconds_scoring},
+                           {"seconds_sets", w.seconds_sets},
                            {"load", w.load}});
   return res;
 }
@@ -77,7 +87,8 @@ SweepReport sweepReportFromJson(const nlohmann::json& j, const std::string& sour
     return jsonNumber(jsonMember(o, key, source, path), source, jsonPath(path, key));
   };
   auto count = [&](const nlohmann::json& o, const char* key, const std::string& path) {
-    return static_cast<int>(jsonInteger(jsonMember(o, key, source, path), source, jsonPath(path, key), 0, kMaxSweepCount));
+    return static_cast<int>(
+        jsonInteger(jsonMember(o, key, source, path), source, jsonPath(path, key), 0, kMaxSweepCount));
   };
   r.scene = text(j, "scene", "");
   r.dataset = text(j, "dataset", "");
@@ -109,10 +120,14 @@ double kendallTauB(const std::vector<double>& a, const std::vector<double>& b) {
     for (std::size_t j = i + 1; j < a.size(); ++j) {
       const double da = a[i] - a[j], db = b[i] - b[j];
       if (da == 0 && db == 0) continue;  // tied in both: counted in neither denominator term
-      if (da == 0) ++ties_a;
-      else if (db == 0) ++ties_b;
-      else if ((da > 0) == (db > 0)) ++concordant;
-      else ++discordant;
+      if (da == 0)
+        ++ties_a;
+      else if (db == 0)
+        ++ties_b;
+      else if ((da > 0) == (db > 0))
+        ++concordant;
+      else
+        ++discordant;
     }
   const double n1 = static_cast<double>(concordant + discordant + ties_a);
   const double n2 = static_cast<double>(concordant + discordant + ties_b);
@@ -147,7 +162,8 @@ std::vector<SweepRow> prefilterSweep(const Scene& scene, const SweepSpec& spec, 
   // Every train view's candidate sets, once per kind, timed per view; the reference
   // always needs the visible sets, whether or not they are swept.
   std::vector<CandidateSetKind> kinds = spec.sets;
-  if (std::find(kinds.begin(), kinds.end(), CandidateSetKind::kVisible) == kinds.end()) kinds.push_back(CandidateSetKind::kVisible);
+  if (std::find(kinds.begin(), kinds.end(), CandidateSetKind::kVisible) == kinds.end())
+    kinds.push_back(CandidateSetKind::kVisible);
   std::map<CandidateSetKind, std::vector<VoxelSet>> sets;
   std::map<CandidateSetKind, std::vector<double>> set_seconds;
   const CandidateSetBuilder builder(grids);
@@ -178,7 +194,8 @@ std::vector<SweepRow> prefilterSweep(const Scene& scene, const SweepSpec& spec, 
     };
     auto values = [&](const std::vector<VoxelSet>& s, const CoverageScoring& o) {
       std::vector<double> out;
-      for (const auto& c : scoreCandidates(obs, s, grids.sceneCount(), o)) out.push_back(criterionValue(c, o.criterion));
+      for (const auto& c : scoreCandidates(obs, s, grids.sceneCount(), o))
+        out.push_back(criterionValue(c, o.criterion));
       return out;
     };
     for (CoverageCriterion score : spec.scores) {
@@ -190,7 +207,8 @@ std::vector<SweepRow> prefilterSweep(const Scene& scene, const SweepSpec& spec, 
         for (CoverageScoring o : spec.encodings) {
           o.criterion = score;
           // hash:auto resolves here as in the active loop (load <= 0.5 on this grid).
-          if (o.encoding == CoverageEncoding::Hashed && o.table_size == 0) o.table_size = hashTableSizeFor(grids.sceneCount());
+          if (o.encoding == CoverageEncoding::Hashed && o.table_size == 0)
+            o.table_size = hashTableSizeFor(grids.sceneCount());
           std::vector<double> times, v;
           for (int r = 0; r < std::max(1, spec.timing_repeats); ++r) {
             const auto t0 = Clock::now();

@@ -19,7 +19,7 @@ namespace saresgs {
 // What a sweep covers; parsed from the ablation grid's "sweep" object.
 struct SweepSpec {
   std::vector<std::string> scenes;
-  std::vector<int> view_counts = {4, 8, 12};  // observed states: initial views, then random additions
+  std::vector<int> view_counts = {4, 8, 12};                    // observed states: initial views, then random additions
   std::vector<CoverageScoring> encodings = defaultEncodings();  // their criteria are ignored
   std::vector<CandidateSetKind> sets = {CandidateSetKind::kFrustum, CandidateSetKind::kVisible};
   std::vector<CoverageCriterion> scores = {CoverageCriterion::Hamming, CoverageCriterion::NewCount};
@@ -34,7 +34,7 @@ inline constexpr int kSweepMinHashBits = 2, kSweepMaxHashBits = 30;
 
 struct SweepRow {
   std::string set, encoding, score;
-  int views = 0;               // observed views in this state
+  int views = 0;  // observed views in this state
   int candidates = 0;
   double overlap = 0;          // |top N % (variant) n top N % (reference)| / |top N % (reference)|
   double kendall_tau = 0;      // tau-b between the variant's and the reference's scores

@@ -9,7 +9,8 @@ namespace saresgs {
 
 void writeRunFiles(const ActiveRun& run, const ActiveResult& r, const Scene& scene, const std::string& out) {
   writeGaussiansPly(out + "/point_cloud.ply", gaussiansToWorld(run.trainer().gaussians(), scene.frame));
-  if (const Trainer* f = run.finalFitTrainer()) writeGaussiansPly(out + "/final_fit.ply", gaussiansToWorld(f->gaussians(), scene.frame));
+  if (const Trainer* f = run.finalFitTrainer())
+    writeGaussiansPly(out + "/final_fit.ply", gaussiansToWorld(f->gaussians(), scene.frame));
   if (const Trainer* f = run.finalFitViewsTrainer())
     writeGaussiansPly(out + "/final_fit_views.ply", gaussiansToWorld(f->gaussians(), scene.frame));
   writeCamerasJson(out + "/cameras.json", scene);

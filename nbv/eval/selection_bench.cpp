@@ -15,8 +15,9 @@ namespace saresgs {
 
 SelectionBenchResult benchSelection(const Scene& scene, const SelectionBenchOptions& opt) {
   if (opt.held < 1 || static_cast<std::size_t>(opt.held) >= scene.train.size())
-    throw std::invalid_argument("bench select: --held " + std::to_string(opt.held) + " must be at least 1 and below the " +
-                                std::to_string(scene.train.size()) + " train views");
+    throw std::invalid_argument("bench select: --held " + std::to_string(opt.held) +
+                                " must be at least 1 and below the " + std::to_string(scene.train.size()) +
+                                " train views");
   std::vector<Eigen::Vector3d> centres;
   for (int v : scene.train) centres.push_back(scene.views.at(static_cast<std::size_t>(v)).camera.center());
   std::vector<int> held;

@@ -16,8 +16,8 @@ struct SelectionBenchOptions {
   int train_iterations = 300;  // training of the model on them first
   int rounds = 5;              // each round times one step of each method
   std::uint64_t seed = 0;
-  int threads = 0;             // 0: every core
-  double kappa = 0.01;         // path-variance's relative damping
+  int threads = 0;      // 0: every core
+  double kappa = 0.01;  // path-variance's relative damping
 };
 
 struct SelectionBenchResult {

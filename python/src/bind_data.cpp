@@ -16,7 +16,8 @@ namespace {
 
 const SceneView& viewAt(const Scene& s, int i) {
   if (i < 0 || i >= static_cast<int>(s.views.size()))
-    throw py::index_error("view " + std::to_string(i) + " outside 0.." + std::to_string(s.views.size()) + " (the dataset's views)");
+    throw py::index_error("view " + std::to_string(i) + " outside 0.." + std::to_string(s.views.size()) +
+                          " (the dataset's views)");
   return s.views[static_cast<std::size_t>(i)];
 }
 
@@ -30,9 +31,10 @@ Eigen::Matrix4d worldToCamera(const Camera& c) {
 }  // namespace
 
 void bindData(py::module_& m) {
-  py::class_<Camera>(m, "Camera",
-                     "A pinhole camera in the COLMAP/OpenCV convention: x_cam = R x_world + t, x right, y down, z forward; "
-                     "pixel (i, j) covers [i, i+1) x [j, j+1).")
+  py::class_<Camera>(
+      m, "Camera",
+      "A pinhole camera in the COLMAP/OpenCV convention: x_cam = R x_world + t, x right, y down, z forward; "
+      "pixel (i, j) covers [i, i+1) x [j, j+1).")
       .def(py::init([](int width, int height, double fx, double fy, double cx, double cy, const Eigen::Matrix3d& R,
                        const Eigen::Vector3d& t) {
              Camera c;
@@ -52,20 +54,23 @@ void bindData(py::module_& m) {
             return Camera::lookAt({width, height, fx, fy, width / 2.0, height / 2.0}, eye, target, up);
           },
           py::arg("width"), py::arg("height"), py::arg("fx"), py::arg("fy"), py::arg("eye"), py::arg("target"),
-          py::arg("up") = Eigen::Vector3d::UnitZ(), "A camera at `eye` looking at `target`, principal point at the centre.")
+          py::arg("up") = Eigen::Vector3d::UnitZ(),
+          "A camera at `eye` looking at `target`, principal point at the centre.")
       .def_property_readonly("width", [](const Camera& c) { return c.K.width; })
       .def_property_readonly("height", [](const Camera& c) { return c.K.height; })
       .def_property_readonly("fx", [](const Camera& c) { return c.K.fx; })
       .def_property_readonly("fy", [](const Camera& c) { return c.K.fy; })
       .def_property_readonly("cx", [](const Camera& c) { return c.K.cx; })
       .def_property_readonly("cy", [](const Camera& c) { return c.K.cy; })
-      .def_property_readonly("K", [](const Camera& c) { return c.K.matrix(); }, "3x3 intrinsic matrix")
+      .def_property_readonly(
+          "K", [](const Camera& c) { return c.K.matrix(); }, "3x3 intrinsic matrix")
       .def_readwrite("R", &Camera::R, "3x3 world-to-camera rotation")
       .def_readwrite("t", &Camera::t, "world-to-camera translation (3,)")
       .def_property_readonly("world_to_camera", &worldToCamera, "4x4 world-to-camera transform [R t; 0 1]")
       .def_property_readonly("center", &Camera::center, "camera centre in world coordinates (3,)")
-      .def_property_readonly("fov", [](const Camera& c) { return py::make_tuple(c.K.fovX(), c.K.fovY()); },
-                             "horizontal and vertical field of view, radians")
+      .def_property_readonly(
+          "fov", [](const Camera& c) { return py::make_tuple(c.K.fovX(), c.K.fovY()); },
+          "horizontal and vertical field of view, radians")
       .def(
           "project",
           [](const Camera& c, const Eigen::Vector3d& x) -> py::object {
@@ -76,27 +81,36 @@ void bindData(py::module_& m) {
           py::arg("x"), "Pixel coordinates of world point x, or None at or behind the camera plane.")
       .def("__repr__", [](const Camera& c) {
         std::ostringstream s;
-        s << "Camera(" << c.K.width << "x" << c.K.height << ", fx " << c.K.fx << ", centre " << c.center().transpose() << ")";
+        s << "Camera(" << c.K.width << "x" << c.K.height << ", fx " << c.K.fx << ", centre " << c.center().transpose()
+          << ")";
         return s.str();
       });
 
   py::class_<Scene, std::shared_ptr<Scene>>(
-      m, "Dataset", "A loaded dataset: views (cameras and lazily read images), the train/test split and the SfM points.")
+      m, "Dataset",
+      "A loaded dataset: views (cameras and lazily read images), the train/test split and the SfM points.")
       .def_readonly("source", &Scene::source, "the folder it was loaded from")
-      .def_property_readonly("names", [](const Scene& s) {
-        std::vector<std::string> v;
-        for (const auto& x : s.views) v.push_back(x.name);
-        return v;
-      }, "image names, by view index")
+      .def_property_readonly(
+          "names",
+          [](const Scene& s) {
+            std::vector<std::string> v;
+            for (const auto& x : s.views) v.push_back(x.name);
+            return v;
+          },
+          "image names, by view index")
       .def_readonly("train", &Scene::train, "indices of the train views (the candidates of an active run)")
       .def_readonly("test", &Scene::test, "indices of the test views")
       .def("__len__", [](const Scene& s) { return s.views.size(); })
-      .def("camera", [](const Scene& s, int i) { return viewAt(s, i).camera; }, py::arg("view"), "the camera of a view")
-      .def_property_readonly("cameras", [](const Scene& s) {
-        std::vector<Camera> v;
-        for (const auto& x : s.views) v.push_back(x.camera);
-        return v;
-      }, "every view's camera, by view index")
+      .def(
+          "camera", [](const Scene& s, int i) { return viewAt(s, i).camera; }, py::arg("view"), "the camera of a view")
+      .def_property_readonly(
+          "cameras",
+          [](const Scene& s) {
+            std::vector<Camera> v;
+            for (const auto& x : s.views) v.push_back(x.camera);
+            return v;
+          },
+          "every view's camera, by view index")
       .def(
           "image",
           [](const std::shared_ptr<Scene>& s, int i) {
@@ -113,43 +127,77 @@ void bindData(py::module_& m) {
             return a;
           },
           py::arg("view"), "the view's image, H x W x 3 uint8 (read-only, no copy)")
-      .def("image_float", [](const Scene& s, int i) { (void)viewAt(s, i); return imageArray(s.imageFloat(i)); }, py::arg("view"),
-           "the view's image, H x W x 3 float32 in [0, 1]")
-      .def("has_depth", [](const Scene& s, int i) { (void)viewAt(s, i); return s.hasDepth(i); }, py::arg("view"))
-      .def("depth", [](const Scene& s, int i) { (void)viewAt(s, i); return imageArray(s.depth(i)); }, py::arg("view"),
-           "ground-truth depth (z along the camera axis), H x W float32; raises when the dataset has none")
-      .def_property_readonly("points", [](const Scene& s) {
-        std::vector<double> xyz;
-        xyz.reserve(s.points.size() * 3);
-        for (const auto& p : s.points) xyz.insert(xyz.end(), {p.xyz.x(), p.xyz.y(), p.xyz.z()});
-        return ownedArray(std::move(xyz), {static_cast<py::ssize_t>(s.points.size()), 3});
-      }, "SfM points, N x 3 float64")
-      .def_property_readonly("point_colors", [](const Scene& s) {
-        std::vector<std::uint8_t> rgb;
-        rgb.reserve(s.points.size() * 3);
-        for (const auto& p : s.points) rgb.insert(rgb.end(), p.rgb.begin(), p.rgb.end());
-        return ownedArray(std::move(rgb), {static_cast<py::ssize_t>(s.points.size()), 3});
-      }, "SfM point colours, N x 3 uint8")
-      .def_readonly("extent", &Scene::extent, "3DGS scene scale (1.1 x the train cameras' largest distance from their mean)")
-      .def_property_readonly("frame_center", [](const Scene& s) { return s.frame.center; },
-                             "the frame the dataset is computed in: world = internal * frame_scale + frame_center; "
-                             "cameras, points and extent are internal, .ply files world (the identity for a scene "
-                             "of metres about the origin)")
-      .def_property_readonly("frame_scale", [](const Scene& s) { return s.frame.scale; }, "see frame_center")
-      .def_property_readonly("background", [](const Scene& s) -> py::object {
-        if (!s.background) return py::none();
-        return py::make_tuple((*s.background)[0], (*s.background)[1], (*s.background)[2]);
-      }, "the colour behind the content (RGBA images are composited on it, renders are against it); None: the data has none")
+      .def(
+          "image_float",
+          [](const Scene& s, int i) {
+            (void)viewAt(s, i);
+            return imageArray(s.imageFloat(i));
+          },
+          py::arg("view"), "the view's image, H x W x 3 float32 in [0, 1]")
+      .def(
+          "has_depth",
+          [](const Scene& s, int i) {
+            (void)viewAt(s, i);
+            return s.hasDepth(i);
+          },
+          py::arg("view"))
+      .def(
+          "depth",
+          [](const Scene& s, int i) {
+            (void)viewAt(s, i);
+            return imageArray(s.depth(i));
+          },
+          py::arg("view"),
+          "ground-truth depth (z along the camera axis), H x W float32; raises when the dataset has none")
+      .def_property_readonly(
+          "points",
+          [](const Scene& s) {
+            std::vector<double> xyz;
+            xyz.reserve(s.points.size() * 3);
+            for (const auto& p : s.points) xyz.insert(xyz.end(), {p.xyz.x(), p.xyz.y(), p.xyz.z()});
+            return ownedArray(std::move(xyz), {static_cast<py::ssize_t>(s.points.size()), 3});
+          },
+          "SfM points, N x 3 float64")
+      .def_property_readonly(
+          "point_colors",
+          [](const Scene& s) {
+            std::vector<std::uint8_t> rgb;
+            rgb.reserve(s.points.size() * 3);
+            for (const auto& p : s.points) rgb.insert(rgb.end(), p.rgb.begin(), p.rgb.end());
+            return ownedArray(std::move(rgb), {static_cast<py::ssize_t>(s.points.size()), 3});
+          },
+          "SfM point colours, N x 3 uint8")
+      .def_readonly("extent", &Scene::extent,
+                    "3DGS scene scale (1.1 x the train cameras' largest distance from their mean)")
+      .def_property_readonly(
+          "frame_center", [](const Scene& s) { return s.frame.center; },
+          "the frame the dataset is computed in: world = internal * frame_scale + frame_center; "
+          "cameras, points and extent are internal, .ply files world (the identity for a scene "
+          "of metres about the origin)")
+      .def_property_readonly(
+          "frame_scale", [](const Scene& s) { return s.frame.scale; }, "see frame_center")
+      .def_property_readonly(
+          "background",
+          [](const Scene& s) -> py::object {
+            if (!s.background) return py::none();
+            return py::make_tuple((*s.background)[0], (*s.background)[1], (*s.background)[2]);
+          },
+          "the colour behind the content (RGBA images are composited on it, renders are against it); None: the data "
+          "has none")
       .def_readonly("random_background", &Scene::random_background, "training draws a fresh background colour per step")
       .def_readonly("background_from", &Scene::background_from, "where the background came from")
-      .def("warnings", [](const Scene& s) {
-        std::vector<std::string> v;
-        for (const DatasetWarning& w : checkDataset(s)) v.push_back(w.view + ": " + w.field + ": " + w.message);
-        return v;
-      }, "the dataset checks' warnings (fields of view, principal points, views that see no point)")
+      .def(
+          "warnings",
+          [](const Scene& s) {
+            std::vector<std::string> v;
+            for (const DatasetWarning& w : checkDataset(s)) v.push_back(w.view + ": " + w.field + ": " + w.message);
+            return v;
+          },
+          "the dataset checks' warnings (fields of view, principal points, views that see no point)")
       .def("__repr__", [](const Scene& s) {
-        return "Dataset('" + s.source + "', " + std::to_string(s.views.size()) + " views: " + std::to_string(s.train.size()) +
-               " train, " + std::to_string(s.test.size()) + " test, " + std::to_string(s.points.size()) + " points)";
+        return "Dataset('" + s.source + "', " + std::to_string(s.views.size()) +
+               " views: " + std::to_string(s.train.size()) + " train, " + std::to_string(s.test.size()) + " test, " +
+               std::to_string(s.points.size()) + " points)";
       });
 
   m.def(
@@ -168,9 +216,11 @@ void bindData(py::module_& m) {
           warnings = checkDataset(*s);  // refuses a dataset that no train view sees (InputError)
         }
         // As the command line prints them: implausible intrinsics, views that see no point.
-        if (!warnings.empty() && PyErr_WarnEx(PyExc_UserWarning, (path + ":\n" + formatWarnings(warnings)).c_str(), 1) != 0)
+        if (!warnings.empty() &&
+            PyErr_WarnEx(PyExc_UserWarning, (path + ":\n" + formatWarnings(warnings)).c_str(), 1) != 0)
           throw py::error_already_set();
-        if (const std::string w = backgroundWarning(*s); !w.empty() && PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) != 0)
+        if (const std::string w = backgroundWarning(*s);
+            !w.empty() && PyErr_WarnEx(PyExc_UserWarning, w.c_str(), 1) != 0)
           throw py::error_already_set();
         return s;
       },
@@ -198,7 +248,8 @@ void bindData(py::module_& m) {
       },
       py::arg("layout"), py::arg("out"), py::arg("width") = 256, py::arg("height") = 192, py::arg("seed") = 0,
       py::arg("views") = 0,
-      "Writes a built-in synthetic scene (`saresgs scene`: object, room360, unbalanced, tworooms or corridor) as a COLMAP "
+      "Writes a built-in synthetic scene (`saresgs scene`: object, room360, unbalanced, tworooms or corridor) as a "
+      "COLMAP "
       "folder at `out` and loads it.");
 }
 
@@ -209,7 +260,8 @@ std::optional<BackgroundChoice> backgroundArg(const py::object& value) {
   try {
     c = value.cast<std::vector<double>>();
   } catch (const py::cast_error&) {
-    throw py::type_error("background: expected None, a string (" + std::string(kBackgroundForms) + ") or three numbers");
+    throw py::type_error("background: expected None, a string (" + std::string(kBackgroundForms) +
+                         ") or three numbers");
   }
   if (c.size() != 3 || !(c[0] >= 0 && c[0] <= 1 && c[1] >= 0 && c[1] <= 1 && c[2] >= 0 && c[2] <= 1))
     throw py::value_error("background: expected three numbers in 0..1");

@@ -31,12 +31,13 @@ void assign(std::vector<float>& dst, const py::array& a, std::size_t n, std::siz
   dst.assign(f.data(), f.data() + f.size());
 }
 
-RasterSettings settingsFor(const Gaussians& g, py::object sh_degree, const std::array<float, 3>& background, int threads) {
+RasterSettings settingsFor(const Gaussians& g, py::object sh_degree, const std::array<float, 3>& background,
+                           int threads) {
   RasterSettings s;
   s.sh_degree = sh_degree.is_none() ? g.max_sh_degree : sh_degree.cast<int>();
   if (s.sh_degree < 0 || s.sh_degree > g.max_sh_degree)
-    throw py::value_error("sh_degree " + std::to_string(s.sh_degree) + ": expected 0.." + std::to_string(g.max_sh_degree) +
-                          " (the model's degree)");
+    throw py::value_error("sh_degree " + std::to_string(s.sh_degree) + ": expected 0.." +
+                          std::to_string(g.max_sh_degree) + " (the model's degree)");
   s.background = background;
   s.execution.threads = threads;
   return s;
@@ -84,16 +85,32 @@ void bindModel(py::module_& m) {
       .def("__len__", &Gaussians::size)
       .def_readonly("max_sh_degree", &Gaussians::max_sh_degree)
       .def_property(
-          "means", [](py::object self) { auto& g = self.cast<Gaussians&>(); return view(self, g.means, {static_cast<py::ssize_t>(g.size()), 3}); },
+          "means",
+          [](py::object self) {
+            auto& g = self.cast<Gaussians&>();
+            return view(self, g.means, {static_cast<py::ssize_t>(g.size()), 3});
+          },
           [](Gaussians& g, const py::array& a) { assign(g.means, a, g.size(), 3, "means", "(N, 3)"); })
       .def_property(
-          "log_scales", [](py::object self) { auto& g = self.cast<Gaussians&>(); return view(self, g.log_scales, {static_cast<py::ssize_t>(g.size()), 3}); },
+          "log_scales",
+          [](py::object self) {
+            auto& g = self.cast<Gaussians&>();
+            return view(self, g.log_scales, {static_cast<py::ssize_t>(g.size()), 3});
+          },
           [](Gaussians& g, const py::array& a) { assign(g.log_scales, a, g.size(), 3, "log_scales", "(N, 3)"); })
       .def_property(
-          "rotations", [](py::object self) { auto& g = self.cast<Gaussians&>(); return view(self, g.rotations, {static_cast<py::ssize_t>(g.size()), 4}); },
+          "rotations",
+          [](py::object self) {
+            auto& g = self.cast<Gaussians&>();
+            return view(self, g.rotations, {static_cast<py::ssize_t>(g.size()), 4});
+          },
           [](Gaussians& g, const py::array& a) { assign(g.rotations, a, g.size(), 4, "rotations", "(N, 4)"); })
       .def_property(
-          "opacities", [](py::object self) { auto& g = self.cast<Gaussians&>(); return view(self, g.opacities, {static_cast<py::ssize_t>(g.size())}); },
+          "opacities",
+          [](py::object self) {
+            auto& g = self.cast<Gaussians&>();
+            return view(self, g.opacities, {static_cast<py::ssize_t>(g.size())});
+          },
           [](Gaussians& g, const py::array& a) { assign(g.opacities, a, g.size(), 1, "opacities", "(N,)"); })
       .def_property(
           "sh",
@@ -104,16 +121,32 @@ void bindModel(py::module_& m) {
           [](Gaussians& g, const py::array& a) {
             assign(g.sh, a, g.size(), static_cast<std::size_t>(g.shCoeffs()) * 3, "sh", "(N, K, 3)");
           })
-      .def("copy", [](const Gaussians& g) { return Gaussians(g); }, "a deep copy")
-      .def_static("read_ply", [](const std::string& path) { py::gil_scoped_release nogil; return readGaussiansPly(path); },
-                  py::arg("path"), "Reads a 3DGS .ply (as the reference implementation, SuperSplat and splat-transform write it).")
-      .def("write_ply", [](const Gaussians& g, const std::string& path) { checkModel(g); py::gil_scoped_release nogil; writeGaussiansPly(path, g); },
-           py::arg("path"), "Writes the standard 3DGS .ply (atomically: a temporary name, then renamed).")
-      .def("to_world", [](const Gaussians& g, const Scene& d) { return gaussiansToWorld(g, d.frame); }, py::arg("dataset"),
-           "The model in world coordinates, from the dataset's internal frame (Dataset.frame_scale, frame_center), "
-           "as .ply files hold it; a copy (the identity frame: unchanged).")
-      .def("from_world", [](const Gaussians& g, const Scene& d) { return gaussiansFromWorld(g, d.frame); }, py::arg("dataset"),
-           "The model in the dataset's internal frame, from world coordinates (read_ply's); a copy.")
+      .def(
+          "copy", [](const Gaussians& g) { return Gaussians(g); }, "a deep copy")
+      .def_static(
+          "read_ply",
+          [](const std::string& path) {
+            py::gil_scoped_release nogil;
+            return readGaussiansPly(path);
+          },
+          py::arg("path"),
+          "Reads a 3DGS .ply (as the reference implementation, SuperSplat and splat-transform write it).")
+      .def(
+          "write_ply",
+          [](const Gaussians& g, const std::string& path) {
+            checkModel(g);
+            py::gil_scoped_release nogil;
+            writeGaussiansPly(path, g);
+          },
+          py::arg("path"), "Writes the standard 3DGS .ply (atomically: a temporary name, then renamed).")
+      .def(
+          "to_world", [](const Gaussians& g, const Scene& d) { return gaussiansToWorld(g, d.frame); },
+          py::arg("dataset"),
+          "The model in world coordinates, from the dataset's internal frame (Dataset.frame_scale, frame_center), "
+          "as .ply files hold it; a copy (the identity frame: unchanged).")
+      .def(
+          "from_world", [](const Gaussians& g, const Scene& d) { return gaussiansFromWorld(g, d.frame); },
+          py::arg("dataset"), "The model in the dataset's internal frame, from world coordinates (read_ply's); a copy.")
       .def("__repr__", [](const Gaussians& g) {
         return "Gaussians(" + std::to_string(g.size()) + ", sh degree " + std::to_string(g.max_sh_degree) + ")";
       });
@@ -134,8 +167,8 @@ void bindModel(py::module_& m) {
 
   m.def(
       "render_gradient",
-      [](const Gaussians& g, const Camera& cam, const py::array& dL_drgb, py::object sh_degree, std::array<float, 3> background,
-         int threads) {
+      [](const Gaussians& g, const Camera& cam, const py::array& dL_drgb, py::object sh_degree,
+         std::array<float, 3> background, int threads) {
         checkModel(g);
         const RasterSettings s = settingsFor(g, sh_degree, background, threads);
         const ImageF w = imageFromArray(dL_drgb, 3, "dL_drgb");
@@ -180,10 +213,14 @@ void bindModel(py::module_& m) {
       "3DGS's training loss (1 - l) L1 + l (1 - SSIM) of the render against `target` (H x W x 3 in [0, 1]) and its "
       "gradient: (loss, Gaussians).");
 
-  m.def("psnr", [](const py::array& a, const py::array& b) { return psnr(imageFromArray(a, 3, "a"), imageFromArray(b, 3, "b")); },
-        py::arg("a"), py::arg("b"), "PSNR of two H x W x 3 images in [0, 1] (clamped), as 3DGS and FisherRF compute it.");
-  m.def("ssim", [](const py::array& a, const py::array& b) { return ssim(imageFromArray(a, 3, "a"), imageFromArray(b, 3, "b")); },
-        py::arg("a"), py::arg("b"), "SSIM (11 x 11 Gaussian window, sigma 1.5) of two H x W x 3 images in [0, 1].");
+  m.def(
+      "psnr",
+      [](const py::array& a, const py::array& b) { return psnr(imageFromArray(a, 3, "a"), imageFromArray(b, 3, "b")); },
+      py::arg("a"), py::arg("b"), "PSNR of two H x W x 3 images in [0, 1] (clamped), as 3DGS and FisherRF compute it.");
+  m.def(
+      "ssim",
+      [](const py::array& a, const py::array& b) { return ssim(imageFromArray(a, 3, "a"), imageFromArray(b, 3, "b")); },
+      py::arg("a"), py::arg("b"), "SSIM (11 x 11 Gaussian window, sigma 1.5) of two H x W x 3 images in [0, 1].");
 }
 
 }  // namespace saresgs::python

@@ -41,7 +41,8 @@ FisherCriterion parseCriterion(const std::string& c) {
 struct PySelectionContext {
   const SelectionContext* ctx = nullptr;
   const SelectionContext& get() const {
-    if (!ctx) throw std::runtime_error("SelectionContext: used after the selector returned (it is valid during the call only)");
+    if (!ctx)
+      throw std::runtime_error("SelectionContext: used after the selector returned (it is valid during the call only)");
     return *ctx;
   }
 };
@@ -104,12 +105,15 @@ struct PyActiveRun {
   }
 
   // Installs the callbacks that point here (before every call into the loop).
-  void wire() { run->setProgress([this](const ActiveProgress& p) { onProgress(p); }); }
+  void wire() {
+    run->setProgress([this](const ActiveProgress& p) { onProgress(p); });
+  }
 
   py::object report(const std::string& dataset_path) const {
     if (!result) throw std::runtime_error("ActiveRun: no result yet (run() or finish() first)");
-    const RunReport r = makeRunReport(*dataset, opt, *result,
-                                      {dataset_path, preset, {}, run->trainer().gaussians().size(), rasterThreadCount(opt.trainer.raster.execution)});
+    const RunReport r = makeRunReport(
+        *dataset, opt, *result,
+        {dataset_path, preset, {}, run->trainer().gaussians().size(), rasterThreadCount(opt.trainer.raster.execution)});
     return jsonToPython(toJson(r));
   }
 };
@@ -121,8 +125,9 @@ void bindNbv(py::module_& m) {
 
   m.def(
       "fisher_scores",
-      [](const Gaussians& g, const std::shared_ptr<Scene>& scene, const std::vector<int>& held, const std::vector<int>& candidates,
-         py::object sh_degree, double lambda, const std::string& criterion, int threads) {
+      [](const Gaussians& g, const std::shared_ptr<Scene>& scene, const std::vector<int>& held,
+         const std::vector<int>& candidates, py::object sh_degree, double lambda, const std::string& criterion,
+         int threads) {
         RasterSettings s;
         s.sh_degree = sh_degree.is_none() ? g.max_sh_degree : sh_degree.cast<int>();
         if (scene->background) s.background = *scene->background;
@@ -133,8 +138,9 @@ void bindNbv(py::module_& m) {
         py::gil_scoped_release nogil;
         return fisherScores(g, s, *scene, held, candidates, lambda, {}, c);
       },
-      py::arg("gaussians"), py::arg("dataset"), py::arg("held"), py::arg("candidates"), py::arg("sh_degree") = py::none(),
-      py::arg("fisher_lambda") = 1e-6, py::arg("criterion") = "trace", py::arg("threads") = 0,
+      py::arg("gaussians"), py::arg("dataset"), py::arg("held"), py::arg("candidates"),
+      py::arg("sh_degree") = py::none(), py::arg("fisher_lambda") = 1e-6, py::arg("criterion") = "trace",
+      py::arg("threads") = 0,
       "FisherRF's expected information gain of each candidate view given the held views: trace "
       "(sum H_v / (H_train + lambda)) or logdet (sum log(1 + H_v / (H_train + lambda))).");
 
@@ -144,8 +150,10 @@ void bindNbv(py::module_& m) {
          const std::string& metric) {
         checkTrainViews(*scene, held, "held");
         checkTrainViews(*scene, candidates, "candidates");
-        if (metric != "euclidean" && metric != "great-circle") throw py::value_error("metric: expected euclidean or great-circle");
-        return fvsScores(*scene, held, candidates, metric == "euclidean" ? ViewDistance::kEuclidean : ViewDistance::kGreatCircle);
+        if (metric != "euclidean" && metric != "great-circle")
+          throw py::value_error("metric: expected euclidean or great-circle");
+        return fvsScores(*scene, held, candidates,
+                         metric == "euclidean" ? ViewDistance::kEuclidean : ViewDistance::kGreatCircle);
       },
       py::arg("dataset"), py::arg("held"), py::arg("candidates"), py::arg("metric") = "euclidean",
       "Farthest view sampling: each candidate camera's distance to the nearest held one.");
@@ -199,25 +207,32 @@ void bindNbv(py::module_& m) {
       "(set frustum | visible, encoding hash:auto | hash:K | exact, score xor | new, lifting flow | depth | oracle, "
       "scene_type indoor | outdoor | None).");
 
-  py::class_<PySelectionContext>(m, "SelectionContext",
-                                 "What a Python selector sees when the loop asks for the next view (valid during the call only).")
-      .def_property_readonly("held", [](const PySelectionContext& c) { return c.get().held; }, "the views held, in order")
-      .def_property_readonly("candidates", [](const PySelectionContext& c) { return c.get().candidates; },
-                             "the train views not held: the selector returns one of them")
-      .def_property_readonly("dataset", [](const PySelectionContext& c) { return std::make_shared<Scene>(c.get().scene); })
-      .def_property_readonly("gaussians", [](const PySelectionContext& c) { return Gaussians(c.get().trainer.gaussians()); },
-                             "a copy of the model trained on the held views")
+  py::class_<PySelectionContext>(
+      m, "SelectionContext",
+      "What a Python selector sees when the loop asks for the next view (valid during the call only).")
+      .def_property_readonly(
+          "held", [](const PySelectionContext& c) { return c.get().held; }, "the views held, in order")
+      .def_property_readonly(
+          "candidates", [](const PySelectionContext& c) { return c.get().candidates; },
+          "the train views not held: the selector returns one of them")
+      .def_property_readonly("dataset",
+                             [](const PySelectionContext& c) { return std::make_shared<Scene>(c.get().scene); })
+      .def_property_readonly(
+          "gaussians", [](const PySelectionContext& c) { return Gaussians(c.get().trainer.gaussians()); },
+          "a copy of the model trained on the held views")
       .def(
           "render",
           [](const PySelectionContext& c, int view) {
             const SelectionContext& x = c.get();
-            if (view < 0 || view >= static_cast<int>(x.scene.views.size())) throw py::index_error("view outside the dataset");
+            if (view < 0 || view >= static_cast<int>(x.scene.views.size()))
+              throw py::index_error("view outside the dataset");
             RenderResult r;
             {
               py::gil_scoped_release nogil;
               r = x.trainer.render(x.scene.views[static_cast<std::size_t>(view)].camera);
             }
-            return py::make_tuple(imageArray(std::move(r.rgb)), imageArray(std::move(r.depth)), imageArray(std::move(r.alpha)));
+            return py::make_tuple(imageArray(std::move(r.rgb)), imageArray(std::move(r.depth)),
+                                  imageArray(std::move(r.alpha)));
           },
           py::arg("view"), "the model's render of a view: (rgb, depth, alpha)")
       .def(
@@ -228,7 +243,8 @@ void bindNbv(py::module_& m) {
             checkTrainViews(x.scene, cand, "candidates");
             const FisherCriterion cr = parseCriterion(criterion);
             py::gil_scoped_release nogil;
-            return fisherScores(x.trainer.gaussians(), x.trainer.rasterSettings(), x.scene, x.held, cand, x.fisher_lambda, {}, cr);
+            return fisherScores(x.trainer.gaussians(), x.trainer.rasterSettings(), x.scene, x.held, cand,
+                                x.fisher_lambda, {}, cr);
           },
           py::arg("candidates") = py::none(), py::arg("criterion") = "trace",
           "FisherRF's scores of the candidates (default: all) on the current model, as the fisher method computes them")
@@ -251,17 +267,19 @@ void bindNbv(py::module_& m) {
           py::arg("candidates") = py::none(),
           "a uniformly random candidate drawn from the run's own generator (the one the random method draws from)");
 
-  py::class_<PyActiveRun>(m, "ActiveRun",
-                          "One active run (`saresgs active`): hold initial views, then per phase train and add the "
-                          "selector's view, until max_views; then the final evaluation and final fit. run() does it all; "
-                          "train_phase(), next_view(), add_view() and finish() step through it. `selector` (a callable "
-                          "taking a SelectionContext and returning a candidate, or (candidate, scores)) replaces the "
-                          "method's selection: the run is then method 'custom'.")
-      .def(py::init([](const std::shared_ptr<Scene>& dataset, const std::string& method, py::object selector, std::uint64_t seed,
-                       const std::string& preset, int threads, std::optional<int> max_views, std::optional<int> interval,
-                       std::optional<int> min_iterations, std::optional<int> final_iterations,
-                       std::optional<std::size_t> max_gaussians, const std::string& prefilter_scene, const std::string& checkpoint,
-                       bool plain_refit, bool final_residual, const py::object& background) {
+  py::class_<PyActiveRun>(
+      m, "ActiveRun",
+      "One active run (`saresgs active`): hold initial views, then per phase train and add the "
+      "selector's view, until max_views; then the final evaluation and final fit. run() does it all; "
+      "train_phase(), next_view(), add_view() and finish() step through it. `selector` (a callable "
+      "taking a SelectionContext and returning a candidate, or (candidate, scores)) replaces the "
+      "method's selection: the run is then method 'custom'.")
+      .def(py::init([](const std::shared_ptr<Scene>& dataset, const std::string& method, py::object selector,
+                       std::uint64_t seed, const std::string& preset, int threads, std::optional<int> max_views,
+                       std::optional<int> interval, std::optional<int> min_iterations,
+                       std::optional<int> final_iterations, std::optional<std::size_t> max_gaussians,
+                       const std::string& prefilter_scene, const std::string& checkpoint, bool plain_refit,
+                       bool final_residual, const py::object& background) {
              auto r = std::make_unique<PyActiveRun>();
              r->dataset = withBackground(dataset, background);
              r->preset = preset;
@@ -281,13 +299,17 @@ void bindNbv(py::module_& m) {
              ActiveOptions& o = r->opt;
              o = activeOptionsFrom(settings);
              // As `saresgs active --prefilter-scene`: auto reads a `saresgs scene` manifest's layout.
-             applySceneType(o.prefilter, prefilter_scene == "auto" ? sceneTypeOfDataset(dataset->source).value_or(SceneType::kOutdoor)
-                                                                   : parseSceneType(prefilter_scene));
+             applySceneType(o.prefilter, prefilter_scene == "auto"
+                                             ? sceneTypeOfDataset(dataset->source).value_or(SceneType::kOutdoor)
+                                             : parseSceneType(prefilter_scene));
              if (!selector.is_none()) {
-               if (!PyCallable_Check(selector.ptr())) throw py::type_error("selector: expected a callable(SelectionContext)");
+               if (!PyCallable_Check(selector.ptr()))
+                 throw py::type_error("selector: expected a callable(SelectionContext)");
                r->selector = selector;
                PyActiveRun* self = r.get();
-               o.custom_selector = [self](const SelectionContext& c, SelectionLog& log) { return self->select(c, log); };
+               o.custom_selector = [self](const SelectionContext& c, SelectionLog& log) {
+                 return self->select(c, log);
+               };
              }
              py::gil_scoped_release nogil;
              r->run = std::make_unique<ActiveRun>(*r->dataset, o, checkpoint);
@@ -295,16 +317,19 @@ void bindNbv(py::module_& m) {
            }),
            py::arg("dataset"), py::arg("method") = "adaptive", py::arg("selector") = py::none(), py::arg("seed") = 0,
            py::arg("preset") = "quick", py::arg("threads") = 0, py::arg("max_views") = py::none(),
-           py::arg("interval") = py::none(), py::arg("min_iterations") = py::none(), py::arg("final_iterations") = py::none(),
-           py::arg("max_gaussians") = py::none(), py::arg("prefilter_scene") = "auto", py::arg("checkpoint") = "",
-           py::arg("plain_refit") = true, py::arg("final_residual") = false, py::arg("background") = py::none(),
+           py::arg("interval") = py::none(), py::arg("min_iterations") = py::none(),
+           py::arg("final_iterations") = py::none(), py::arg("max_gaussians") = py::none(),
+           py::arg("prefilter_scene") = "auto", py::arg("checkpoint") = "", py::arg("plain_refit") = true,
+           py::arg("final_residual") = false, py::arg("background") = py::none(),
            "Options as `saresgs active`'s (the preset's where not given); `checkpoint` names a checkpoint file "
            "written after every added view and resumed when present; plain_refit=False is --no-plain-refit, "
            "final_residual=True is --final-residual; background as load_dataset's (None: the dataset's own).")
       .def_property_readonly("method", [](const PyActiveRun& r) { return std::string(toString(r.opt.method)); })
-      .def_property_readonly("held", [](const PyActiveRun& r) { return r.run->held(); }, "the views held, in order")
-      .def_property_readonly("finished", [](const PyActiveRun& r) { return r.run->finished(); },
-                             "the last phase is trained (finish() is next)")
+      .def_property_readonly(
+          "held", [](const PyActiveRun& r) { return r.run->held(); }, "the views held, in order")
+      .def_property_readonly(
+          "finished", [](const PyActiveRun& r) { return r.run->finished(); },
+          "the last phase is trained (finish() is next)")
       .def(
           "run",
           [](PyActiveRun& r, py::object progress) {
@@ -370,17 +395,20 @@ void bindNbv(py::module_& m) {
             return r.report(r.dataset->source);
           },
           py::arg("progress") = py::none(), "The final evaluation and final fit; returns the report (a dict).")
-      .def_property_readonly("gaussians", [](const PyActiveRun& r) { return Gaussians(r.run->trainer().gaussians()); },
-                             "a copy of the loop's current model")
-      .def_property_readonly("final_fit_gaussians", [](const PyActiveRun& r) -> py::object {
-        const Trainer* t = r.run->finalFitTrainer();
-        return t ? py::cast(Gaussians(t->gaussians())) : py::none();
-      })
+      .def_property_readonly(
+          "gaussians", [](const PyActiveRun& r) { return Gaussians(r.run->trainer().gaussians()); },
+          "a copy of the loop's current model")
+      .def_property_readonly("final_fit_gaussians",
+                             [](const PyActiveRun& r) -> py::object {
+                               const Trainer* t = r.run->finalFitTrainer();
+                               return t ? py::cast(Gaussians(t->gaussians())) : py::none();
+                             })
       .def(
           "write",
           [](const PyActiveRun& r, const std::string& out, bool html) -> py::object {
             py::object report = r.report(r.dataset->source);
-            const std::string text = py::module_::import("json").attr("dumps")(report, py::arg("indent") = 2).cast<std::string>();
+            const std::string text =
+                py::module_::import("json").attr("dumps")(report, py::arg("indent") = 2).cast<std::string>();
             py::gil_scoped_release nogil;
             std::filesystem::create_directories(out);
             writeRunFiles(*r.run, *r.result, *r.dataset, out);

@@ -51,8 +51,9 @@ void bindTrain(py::module_& m) {
   py::class_<Trainer>(m, "Trainer",
                       "3DGS training (3DGS's schedule, densification and Adam) on a dataset's views, from its SfM "
                       "points; optionally with SA-ResGS's residual supervision.")
-      .def(py::init([](const std::shared_ptr<Scene>& scene, std::uint64_t seed, double schedule_scale, std::size_t max_gaussians,
-                       int max_sh_degree, bool residual, int threads, const py::object& background) {
+      .def(py::init([](const std::shared_ptr<Scene>& scene, std::uint64_t seed, double schedule_scale,
+                       std::size_t max_gaussians, int max_sh_degree, bool residual, int threads,
+                       const py::object& background) {
              TrainerOptions o;
              o.seed = seed;
              o.max_sh_degree = max_sh_degree;
@@ -89,14 +90,15 @@ void bindTrain(py::module_& m) {
           py::arg("views"), py::arg("iterations"), py::arg("callback") = py::none(), py::arg("every") = 1,
           "Trains `iterations` iterations on `views` (indices into the dataset); callback(progress) is called every "
           "`every` iterations with a dict (iteration, done, total, loss, loss_ema, gaussians).")
-      .def("step",
-           [](Trainer& t, int view) {
-             checkViews(t.scene(), {view});
-             py::gil_scoped_release nogil;
-             const auto limit = limitThreads(t.rasterSettings().execution.threads);
-             return t.step(view);
-           },
-           py::arg("view"), "One iteration on one view; returns its loss.")
+      .def(
+          "step",
+          [](Trainer& t, int view) {
+            checkViews(t.scene(), {view});
+            py::gil_scoped_release nogil;
+            const auto limit = limitThreads(t.rasterSettings().execution.threads);
+            return t.step(view);
+          },
+          py::arg("view"), "One iteration on one view; returns its loss.")
       .def(
           "evaluate",
           [](const Trainer& t, py::object views) {
@@ -119,7 +121,8 @@ void bindTrain(py::module_& m) {
               py::gil_scoped_release nogil;
               r = t.render(cam);
             }
-            return py::make_tuple(imageArray(std::move(r.rgb)), imageArray(std::move(r.depth)), imageArray(std::move(r.alpha)));
+            return py::make_tuple(imageArray(std::move(r.rgb)), imageArray(std::move(r.depth)),
+                                  imageArray(std::move(r.alpha)));
           },
           py::arg("camera"), "Renders the current model at its active SH degree: (rgb, depth, alpha).")
       .def_property(
@@ -130,17 +133,33 @@ void bindTrain(py::module_& m) {
                                     std::to_string(t.gaussians().max_sh_degree));
             t.mutableGaussians() = g;
           },
-          "a copy of the current model, in the dataset's internal frame; assigning a model (e.g. Gaussians.read_ply(p).from_world(dataset)) continues training from it "
+          "a copy of the current model, in the dataset's internal frame; assigning a model (e.g. "
+          "Gaussians.read_ply(p).from_world(dataset)) continues training from it "
           "(the optimiser's moments restart when the count changes)")
       .def_property_readonly("iteration", &Trainer::iteration)
       .def_property_readonly("active_sh_degree", &Trainer::activeShDegree)
       .def("reset", &Trainer::reset, "back to the initial model and optimiser (the random generator continues)")
-      .def("save_ply", [](const Trainer& t, const std::string& path) { py::gil_scoped_release nogil; writeGaussiansPly(path, gaussiansToWorld(t.gaussians(), t.scene().frame)); },
-           py::arg("path"))
-      .def("save_checkpoint", [](const Trainer& t, const std::string& path) { py::gil_scoped_release nogil; t.saveCheckpoint(path); },
-           py::arg("path"), "model, optimiser and schedules, for a bit-identical resume")
-      .def("load_checkpoint", [](Trainer& t, const std::string& path) { py::gil_scoped_release nogil; t.loadCheckpoint(path); },
-           py::arg("path"));
+      .def(
+          "save_ply",
+          [](const Trainer& t, const std::string& path) {
+            py::gil_scoped_release nogil;
+            writeGaussiansPly(path, gaussiansToWorld(t.gaussians(), t.scene().frame));
+          },
+          py::arg("path"))
+      .def(
+          "save_checkpoint",
+          [](const Trainer& t, const std::string& path) {
+            py::gil_scoped_release nogil;
+            t.saveCheckpoint(path);
+          },
+          py::arg("path"), "model, optimiser and schedules, for a bit-identical resume")
+      .def(
+          "load_checkpoint",
+          [](Trainer& t, const std::string& path) {
+            py::gil_scoped_release nogil;
+            t.loadCheckpoint(path);
+          },
+          py::arg("path"));
 }
 
 }  // namespace saresgs::python

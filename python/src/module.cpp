@@ -10,10 +10,12 @@ namespace saresgs::python {
 ImageF imageFromArray(const py::array& a, int channels, const std::string& what) {
   const auto f = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(a);
   if (!f) throw py::value_error(what + ": expected a float array");
-  const bool ok = channels == 1 ? (f.ndim() == 2 || (f.ndim() == 3 && f.shape(2) == 1)) : (f.ndim() == 3 && f.shape(2) == channels);
+  const bool ok =
+      channels == 1 ? (f.ndim() == 2 || (f.ndim() == 3 && f.shape(2) == 1)) : (f.ndim() == 3 && f.shape(2) == channels);
   if (!ok)
-    throw py::value_error(what + ": expected shape (H, W" + (channels == 1 ? std::string(")") : ", " + std::to_string(channels) + ")") +
-                          ", got ndim " + std::to_string(f.ndim()));
+    throw py::value_error(what + ": expected shape (H, W" +
+                          (channels == 1 ? std::string(")") : ", " + std::to_string(channels) + ")") + ", got ndim " +
+                          std::to_string(f.ndim()));
   ImageF img(static_cast<int>(f.shape(1)), static_cast<int>(f.shape(0)), channels);
   std::copy(f.data(), f.data() + img.data.size(), img.data.begin());
   return img;

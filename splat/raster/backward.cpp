@@ -23,8 +23,7 @@ void chainSlots(const GaussiansT<T>& g, const Camera& cam, const RasterStateT<T>
     [[maybe_unused]] raster_kernels::ProjectGradOut pout{};
     if constexpr (std::is_same_v<T, float>) {
       pin = projectInput(g, camT, rs);
-      pout = {grad.means.data(), grad.log_scales.data(), grad.rotations.data(), grad.opacities.data(),
-              grad.sh.data()};
+      pout = {grad.means.data(), grad.log_scales.data(), grad.rotations.data(), grad.opacities.data(), grad.sh.data()};
     }
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kChunk), [&](const auto& r) {
       const FloatEnvGuard fenv;  // geometry/float_env.h
@@ -74,8 +73,7 @@ void backwardSlots(const RasterStateT<T>& st, int W, int H, const T* dL_drgb, T*
   constexpr int kSlot = kGradSlot;
   walkAllPixels(
       st, W, H, [&](std::size_t pix) { return &dL_drgb[pix * 3]; },
-      [&](std::uint32_t e, const TileGaussian<T>& q, T dx, T dy, T G, bool unclamped, T dL_dalpha, T wcol,
-          const T* w) {
+      [&](std::uint32_t e, const TileGaussian<T>& q, T dx, T dy, T G, bool unclamped, T dL_dalpha, T wcol, const T* w) {
         T* sl = &slots[static_cast<std::size_t>(e) * kSlot];
         alphaToProjected(q, dx, dy, G, unclamped, dL_dalpha, sl);
         for (int c = 0; c < 3; ++c) sl[6 + c] += wcol * w[c];
@@ -103,9 +101,8 @@ namespace saresgs {
 using namespace raster_stage;
 
 template <typename T>
-void rasterizeBackwardT(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& s,
-                        const RenderOutputT<T>& fwd, const T* dL_drgb, GaussiansT<T>& grad,
-                        std::vector<T>* grad_mean2d) {
+void rasterizeBackwardT(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& s, const RenderOutputT<T>& fwd,
+                        const T* dL_drgb, GaussiansT<T>& grad, std::vector<T>* grad_mean2d) {
   const RasterStateT<T>& st = *fwd.state;
   const int W = fwd.width, H = fwd.height;
   const std::size_t n = g.size();
@@ -125,9 +122,8 @@ void rasterizeBackwardT(const GaussiansT<T>& g, const Camera& cam, const RasterS
   chainSlots(g, cam, st, slots, grad, grad_mean2d);
 }
 
-void rasterizeBackward(const Gaussians& g, const Camera& cam, const RasterSettings& s,
-                       const RenderResult& fwd, const ImageF& dL_drgb, Gaussians& grad,
-                       std::vector<float>* grad_mean2d) {
+void rasterizeBackward(const Gaussians& g, const Camera& cam, const RasterSettings& s, const RenderResult& fwd,
+                       const ImageF& dL_drgb, Gaussians& grad, std::vector<float>* grad_mean2d) {
   if (dL_drgb.width != fwd.rgb.width || dL_drgb.height != fwd.rgb.height || dL_drgb.channels != 3)
     throw std::invalid_argument("rasterizeBackward: dL/drgb must match the render (3 channels)");
   if (!fwd.state)  // the subset of a RenderPair: rasterizeBackwardWithSubset
@@ -137,8 +133,7 @@ void rasterizeBackward(const Gaussians& g, const Camera& cam, const RasterSettin
 }
 
 template void rasterizeBackwardT(const GaussiansT<float>&, const Camera&, const RasterSettings&,
-                                 const RenderOutputT<float>&, const float*, GaussiansT<float>&,
-                                 std::vector<float>*);
+                                 const RenderOutputT<float>&, const float*, GaussiansT<float>&, std::vector<float>*);
 template void rasterizeBackwardT(const GaussiansT<double>&, const Camera&, const RasterSettings&,
                                  const RenderOutputT<double>&, const double*, GaussiansT<double>&,
                                  std::vector<double>*);

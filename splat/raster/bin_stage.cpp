@@ -75,22 +75,23 @@ void binAndSort(const TileCover& cover, int W, int H, RasterStateT<T>& st) {
   assignKept(slot_tile, pairs, 0u);
   arena(st).execute([&] {
     // The pairs' tiles and the depth order (serial) do not depend on each other.
-    tbb::parallel_invoke([&] {
-                           const FloatEnvGuard fenv;  // geometry/float_env.h (depths are floats)
-                           depthOrder(st.proj, cover.count, sc);
-                         },
-                         [&] {
-                           tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& r) {
-                             const FloatEnvGuard fenv;  // geometry/float_env.h
-                             for (std::size_t i = r.begin(); i < r.end(); ++i) {
-                               if (!cover.count[i]) continue;
-                               std::uint32_t k = st.gauss_start[i];
-                               forEachCoveredTile(cover, i, st.tile_data[i], W, H, [&](int tx, int ty) {
-                                 slot_tile[k++] = static_cast<std::uint32_t>(ty * st.tiles_x + tx);
-                               });
-                             }
-                           });
-                         });
+    tbb::parallel_invoke(
+        [&] {
+          const FloatEnvGuard fenv;  // geometry/float_env.h (depths are floats)
+          depthOrder(st.proj, cover.count, sc);
+        },
+        [&] {
+          tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const auto& r) {
+            const FloatEnvGuard fenv;  // geometry/float_env.h
+            for (std::size_t i = r.begin(); i < r.end(); ++i) {
+              if (!cover.count[i]) continue;
+              std::uint32_t k = st.gauss_start[i];
+              forEachCoveredTile(cover, i, st.tile_data[i], W, H, [&](int tx, int ty) {
+                slot_tile[k++] = static_cast<std::uint32_t>(ty * st.tiles_x + tx);
+              });
+            }
+          });
+        });
   });
   // A stable counting sort of the pairs by tile, the Gaussians taken in depth order, in
   // parallel: the depth order is cut into chunks, each chunk counts its pairs per tile,
@@ -145,7 +146,6 @@ void binAndSort(const TileCover& cover, int W, int H, RasterStateT<T>& st) {
     }
   });
 }
-
 
 template void binAndSort(const TileCover&, int, int, RasterStateT<float>&);
 template void binAndSort(const TileCover&, int, int, RasterStateT<double>&);

@@ -28,15 +28,18 @@ tbb::task_arena& arena(int threads) {
 
 int kernelIndex(RasterKernels kernels) {
   switch (kernels) {
-    case RasterKernels::kBaseline: return 0;
+    case RasterKernels::kBaseline:
+      return 0;
     case RasterKernels::kAvx2:
-      if (!rasterCpuHasAvx2()) throw std::invalid_argument("raster kernels avx2: this CPU or build has no AVX2 and FMA");
+      if (!rasterCpuHasAvx2())
+        throw std::invalid_argument("raster kernels avx2: this CPU or build has no AVX2 and FMA");
       return 1;
     case RasterKernels::kAvx512:
       if (!rasterCpuHasAvx512())
         throw std::invalid_argument("raster kernels avx512: this CPU or build has no AVX-512F and AVX-512VL");
       return 2;
-    case RasterKernels::kDefault: break;
+    case RasterKernels::kDefault:
+      break;
   }
   // The best kernels this CPU runs, unless SARESGS_RASTER_ISA names others ("baseline",
   // "avx2", "avx512" or "default"): read at the first render, like the process's other

@@ -69,8 +69,7 @@ void fisherMoments(const RasterStateT<float>& st, int W, int H, float* slots) {
 // (alphaToProjected's 2D gradients through the Jacobian), so its square summed over the
 // pixels is a quadratic form in the moments: o^2 k^T E k + 2 o Jc k.F + Jc^2 W, with k
 // the coefficients of (dx, dy, dx^2, dx dy, dy^2) in u_p.
-void squaredGradientsFloat(const Gaussians& g, const Camera& cam, const RenderOutputT<float>& fwd,
-                           Gaussians& sq) {
+void squaredGradientsFloat(const Gaussians& g, const Camera& cam, const RenderOutputT<float>& fwd, Gaussians& sq) {
   using namespace raster_kernels;
   const RasterStateT<float>& st = *fwd.state;
   const RasterSettings& rs = st.settings;
@@ -106,7 +105,6 @@ void squaredGradientsFloat(const Gaussians& g, const Camera& cam, const RenderOu
     });
   });
 }
-
 
 }  // namespace
 }  // namespace saresgs::raster_stage
@@ -157,8 +155,7 @@ void fisherChainReference(const Gaussians& g, const Camera& cam, const RasterSet
   // SH: d C / d sh_kc = alpha T Y_k for unclamped channels.
   for (int k = 0; k < active; ++k)
     for (int ch = 0; ch < 3; ++ch)
-      if (!P.clamped[ch])
-        sq.sh[(i * K + k) * 3 + ch] += static_cast<float>(mo[kW] * frame.basis[k] * frame.basis[k]);
+      if (!P.clamped[ch]) sq.sh[(i * K + k) * 3 + ch] += static_cast<float>(mo[kW] * frame.basis[k] * frame.basis[k]);
 }
 
 void fisherChainFloat(const Gaussians& g, const Camera& cam, const RasterSettings& s,
@@ -200,9 +197,12 @@ void rasterizeSquaredGradientsWalkT(const GaussiansT<T>& g, const Camera& cam, c
         dlogit[i] = P.opacity * (T(1) - P.opacity);
         for (int in = 1; in < kIn; ++in) {  // input 0 (opacity) touches only the logit
           ProjectedGrad<T> dP;
-          if (in <= 2) dP.mean2d[in - 1] = 1;
-          else if (in <= 5) dP.conic[in - 3] = 1;
-          else dP.color[in - 6] = 1;
+          if (in <= 2)
+            dP.mean2d[in - 1] = 1;
+          else if (in <= 5)
+            dP.conic[in - 3] = 1;
+          else
+            dP.color[in - 6] = 1;
           T* J = &jac[(i * kIn + in) * 6];
           projection::ParamGradRef<T> ref;
           ref.mean = J;
@@ -220,8 +220,7 @@ void rasterizeSquaredGradientsWalkT(const GaussiansT<T>& g, const Camera& cam, c
   const T ones[3] = {1, 1, 1};
   walkAllPixels(
       st, W, H, [&](std::size_t) { return ones; },
-      [&](std::uint32_t e, const TileGaussian<T>& q, T dx, T dy, T G, bool unclamped, T dL_dalpha, T wcol,
-          const T*) {
+      [&](std::uint32_t e, const TileGaussian<T>& q, T dx, T dy, T G, bool unclamped, T dL_dalpha, T wcol, const T*) {
         const std::uint32_t i = st.entry_gauss[e];
         T in[kIn] = {0, 0, 0, 0, 0, 0, wcol, wcol, wcol};
         alphaToProjected(q, dx, dy, G, unclamped, dL_dalpha, in);
@@ -273,8 +272,8 @@ void rasterizeSquaredGradientsT(const GaussiansT<T>& g, const Camera& cam, const
     rasterizeSquaredGradientsWalkT(g, cam, s, fwd, sq);
 }
 
-void rasterizeSquaredGradients(const Gaussians& g, const Camera& cam, const RasterSettings& s,
-                               const RenderResult& fwd, Gaussians& sq) {
+void rasterizeSquaredGradients(const Gaussians& g, const Camera& cam, const RasterSettings& s, const RenderResult& fwd,
+                               Gaussians& sq) {
   rasterizeSquaredGradientsT(g, cam, s, renderView(fwd), sq);
 }
 

@@ -20,8 +20,8 @@ void tileSpan(T mean, T half, int origin, int limit, int& lo, int& hi) {
 // rectangle, so the inner loop runs over contiguous pixels without branches. Each
 // pixel sees exactly the per-pixel sequence of rule 7.
 template <typename T>
-void compositeTile(const std::vector<TileGaussian<T>>& q, int x0, int y0, int x1, int y1, const T bg[3],
-                   int W, RenderOutputT<T>& out, RasterStateT<T>& st) {
+void compositeTile(const std::vector<TileGaussian<T>>& q, int x0, int y0, int x1, int y1, const T bg[3], int W,
+                   RenderOutputT<T>& out, RasterStateT<T>& st) {
   constexpr int P = kTileSize * kTileSize;
   alignas(64) T Tr[P], C0[P], C1[P], C2[P], D[P];
   alignas(64) std::int32_t walked[P], contrib[P], active[P];
@@ -62,7 +62,8 @@ void compositeTile(const std::vector<TileGaussian<T>>& q, int x0, int y0, int x1
         const T oG = g.o * G;
         const T alpha = oG < projection::Thresholds<T>::max_alpha ? oG : projection::Thresholds<T>::max_alpha;
         // Non-short-circuit '&' keeps the body branch-free so it vectorises.
-        const bool ok = (ac[c] != 0) & (std::abs(dx) <= g.hx) & (power <= T(0)) & (alpha >= projection::Thresholds<T>::min_alpha);
+        const bool ok =
+            (ac[c] != 0) & (std::abs(dx) <= g.hx) & (power <= T(0)) & (alpha >= projection::Thresholds<T>::min_alpha);
         const T next = tr[c] * (T(1) - alpha);
         const bool stop = ok & (next < projection::Thresholds<T>::min_transmittance);
         const bool take = ok & !stop;
@@ -113,8 +114,13 @@ void allocateImages(int W, int H, bool depth_and_contributors, RenderOutputT<flo
 
 raster_kernels::ForwardOut forwardOut(int W, RenderOutputT<float>& out, float* final_T, std::uint32_t* n_walked) {
   const bool aux = !out.depth.empty();
-  return {W, out.rgb.data(), out.alpha.data(), aux ? out.depth.data() : nullptr,
-          aux ? out.contributors.data() : nullptr, final_T, n_walked};
+  return {W,
+          out.rgb.data(),
+          out.alpha.data(),
+          aux ? out.depth.data() : nullptr,
+          aux ? out.contributors.data() : nullptr,
+          final_T,
+          n_walked};
 }
 
 void toRenderResult(RenderOutputT<float>&& o, RenderResult& r) {

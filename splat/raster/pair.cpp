@@ -9,10 +9,10 @@
 namespace saresgs {
 
 struct SubsetRasterState {
-  std::vector<std::uint8_t> mask;              // per Gaussian, as given
-  std::vector<std::uint8_t> entry_in_subset;   // per full tile entry: its Gaussian's mask
-  std::vector<float> final_T;                  // per pixel, of the subset render
-  std::vector<std::uint32_t> n_walked;         // per pixel: full-list entries walked
+  std::vector<std::uint8_t> mask;             // per Gaussian, as given
+  std::vector<std::uint8_t> entry_in_subset;  // per full tile entry: its Gaussian's mask
+  std::vector<float> final_T;                 // per pixel, of the subset render
+  std::vector<std::uint32_t> n_walked;        // per pixel: full-list entries walked
 };
 
 namespace {
@@ -29,15 +29,13 @@ constexpr PairKernelSet kPairKernelSets[] = {
     {raster_kernels::avx512::compositeTilePair, raster_kernels::avx512::backwardTilePair},
 };
 
-
 }  // namespace
 
 using namespace raster_stage;
 
 void rasterizeWithSubset(const Gaussians& g, const Camera& cam, const RasterSettings& s,
                          std::span<const std::uint8_t> mask, RenderPair& into) {
-  if (mask.size() != g.size())
-    throw std::invalid_argument("rasterizeWithSubset: the mask needs one byte per Gaussian");
+  if (mask.size() != g.size()) throw std::invalid_argument("rasterizeWithSubset: the mask needs one byte per Gaussian");
   const int W = cam.K.width, H = cam.K.height;
   RenderOutputT<float> full = fromRenderResult(into.full), sub = fromRenderResult(into.subset);
   sub.state.reset();
@@ -53,8 +51,7 @@ void rasterizeWithSubset(const Gaussians& g, const Camera& cam, const RasterSett
   std::shared_ptr<SubsetRasterState> ss = reuseOrMake(into.subset_state);
   ss->mask.assign(mask.begin(), mask.end());
   ss->entry_in_subset.resize(st->entry_gauss.size());
-  for (std::size_t e = 0; e < st->entry_gauss.size(); ++e)
-    ss->entry_in_subset[e] = mask[st->entry_gauss[e]] != 0;
+  for (std::size_t e = 0; e < st->entry_gauss.size(); ++e) ss->entry_in_subset[e] = mask[st->entry_gauss[e]] != 0;
   // Per Gaussian, projection does not depend on the mask, so the subset's radii and
   // visibility are the full render's where the mask keeps the Gaussian (rule 8).
   sub.radii.assign(g.size(), 0.0f);
@@ -76,8 +73,8 @@ void rasterizeWithSubset(const Gaussians& g, const Camera& cam, const RasterSett
   const raster_kernels::ForwardOut fo_sub = forwardOut(W, sub, ss->final_T.data(), ss->n_walked.data());
   const raster_kernels::CompositePairFn kernel = kPairKernelSets[st->isa].composite;
   forEachTile(*st, W, H, [&](int tile, const std::vector<TileGaussian<float>>& q, int x0, int y0, int x1, int y1) {
-    kernel(q.data(), ss->entry_in_subset.data() + st->tile_start[tile], static_cast<int>(q.size()), x0, y0, x1, y1,
-           bg, fo_full, fo_sub);
+    kernel(q.data(), ss->entry_in_subset.data() + st->tile_start[tile], static_cast<int>(q.size()), x0, y0, x1, y1, bg,
+           fo_full, fo_sub);
   });
 
   full.state = std::move(st);
@@ -93,9 +90,8 @@ RenderPair rasterizeWithSubset(const Gaussians& g, const Camera& cam, const Rast
   return out;
 }
 
-void rasterizeBackwardWithSubset(const Gaussians& g, const Camera& cam, const RasterSettings& s,
-                                 const RenderPair& fwd, const ImageF& dL_drgb_full,
-                                 const ImageF& dL_drgb_subset, Gaussians& grad,
+void rasterizeBackwardWithSubset(const Gaussians& g, const Camera& cam, const RasterSettings& s, const RenderPair& fwd,
+                                 const ImageF& dL_drgb_full, const ImageF& dL_drgb_subset, Gaussians& grad,
                                  std::vector<float>* grad_mean2d) {
   const int W = fwd.full.rgb.width, H = fwd.full.rgb.height;
   for (const ImageF* d : {&dL_drgb_full, &dL_drgb_subset})

@@ -103,8 +103,8 @@ inline QuatLanes quatLanes(const LaneSet& ls, const float* rotations) {
 }
 
 // The scales (safeExp of the log-scales), M = Rq diag(sc) and Sigma = M M^T.
-inline void covarianceLanes(const LaneSet& ls, const float* log_scales, const QuatLanes& q, vf sc[3],
-                            vf M[3][3], vf Sig[3][3]) {
+inline void covarianceLanes(const LaneSet& ls, const float* log_scales, const QuatLanes& q, vf sc[3], vf M[3][3],
+                            vf Sig[3][3]) {
   for (int k = 0; k < 3; ++k) sc[k] = lanesExp(clampLanes(ls.at(log_scales, 3, k), -60.0f, 60.0f));
   for (int r = 0; r < 3; ++r)
     for (int k = 0; k < 3; ++k) M[r][k] = q.R[r][k] * sc[k];
@@ -159,7 +159,6 @@ inline vf viewBasisLanes(const ProjectIn& in, const vf m[3], vf d[3], vf basis[1
   return dn;
 }
 
-
 // backwardFrame: what projectBackward recomputes of project() (projection.h).
 struct FrameLanes {
   vf p[3], iz, iz2, d[3], dn, basis[16];
@@ -175,16 +174,14 @@ inline FrameLanes frameLanes(const ProjectIn& in, const LaneSet& ls) {
   f.dn = viewBasisLanes(in, m, f.d, f.basis);
   f.q = quatLanes(ls, in.rotations);
   covarianceLanes(ls, in.log_scales, f.q, f.sc, f.M, f.Sig);
-  jacobianTimesW(in, vs(in.fx) * f.iz, vs(-in.fx) * f.p[0] * f.iz2, vs(in.fy) * f.iz, vs(-in.fy) * f.p[1] * f.iz2,
-                 f.A);
+  jacobianTimesW(in, vs(in.fx) * f.iz, vs(-in.fx) * f.p[0] * f.iz2, vs(in.fy) * f.iz, vs(-in.fy) * f.p[1] * f.iz2, f.A);
   return f;
 }
 
 // colorBackward's view-direction part: the mean's gradient dm through the SH basis and
 // the normalisation, for the colour gradients dc (zero where clamped); zero at SH degree
 // 0 and where the mean is the camera centre.
-inline void viewDirectionGrad(const ProjectIn& in, const LaneSet& ls, const FrameLanes& f, const vf dc[3],
-                              vf dm[3]) {
+inline void viewDirectionGrad(const ProjectIn& in, const LaneSet& ls, const FrameLanes& f, const vf dc[3], vf dm[3]) {
   using namespace sh_constants;
   const vf zero = vs(0.0f);
   const std::size_t stride = static_cast<std::size_t>(in.sh_stride);
@@ -194,7 +191,8 @@ inline void viewDirectionGrad(const ProjectIn& in, const LaneSet& ls, const Fram
   vf gb[16];
   for (int k = 0; k < active; ++k) {
     const std::size_t o3 = static_cast<std::size_t>(k * 3);
-    gb[k] = dc[0] * ls.at(in.sh, stride, o3) + dc[1] * ls.at(in.sh, stride, o3 + 1) + dc[2] * ls.at(in.sh, stride, o3 + 2);
+    gb[k] =
+        dc[0] * ls.at(in.sh, stride, o3) + dc[1] * ls.at(in.sh, stride, o3 + 1) + dc[2] * ls.at(in.sh, stride, o3 + 2);
   }
   const vf x = f.d[0], y = f.d[1], z = f.d[2];
   const float c1 = static_cast<float>(C1);
@@ -398,7 +396,7 @@ void projectBackwardList(const ProjectIn& in, const std::uint32_t* idx, int coun
     }
 
     const FrameLanes f = frameLanes(in, ls);
-    const vf (&p)[3] = f.p;
+    const vf(&p)[3] = f.p;
     const vf iz = f.iz, iz2 = f.iz2;
     const vf(&M)[3][3] = f.M;
     const vf(&Sig)[3][3] = f.Sig;
@@ -430,7 +428,8 @@ void projectBackwardList(const ProjectIn& in, const std::uint32_t* idx, int coun
       for (int k = 0; k < 3; ++k) gSig[r][k] = A[0][r] * G2A[0][k] + A[1][r] * G2A[1][k];
     vf gA[2][3];
     for (int r = 0; r < 2; ++r)
-      for (int k = 0; k < 3; ++k) gA[r][k] = two * (G2A[r][0] * Sig[0][k] + G2A[r][1] * Sig[1][k] + G2A[r][2] * Sig[2][k]);
+      for (int k = 0; k < 3; ++k)
+        gA[r][k] = two * (G2A[r][0] * Sig[0][k] + G2A[r][1] * Sig[1][k] + G2A[r][2] * Sig[2][k]);
     // gJ's entries (0, 0), (0, 2), (1, 1) and (1, 2): the ones p reaches.
     auto gJ = [&](int r, int k) {
       return gA[r][0] * vs(in.R[k][0]) + gA[r][1] * vs(in.R[k][1]) + gA[r][2] * vs(in.R[k][2]);
@@ -473,8 +472,8 @@ void projectBackwardList(const ProjectIn& in, const std::uint32_t* idx, int coun
     gq[0] = two * (-z * gR[0][1] + y * gR[0][2] + z * gR[1][0] - x * gR[1][2] - y * gR[2][0] + x * gR[2][1]);
     gq[1] = two * (y * gR[0][1] + z * gR[0][2] + y * gR[1][0] - two * x * gR[1][1] - w * gR[1][2] + z * gR[2][0] +
                    w * gR[2][1] - two * x * gR[2][2]);
-    gq[2] = two * (vs(-2.0f) * y * gR[0][0] + x * gR[0][1] + w * gR[0][2] + x * gR[1][0] + z * gR[1][2] -
-                   w * gR[2][0] + z * gR[2][1] - two * y * gR[2][2]);
+    gq[2] = two * (vs(-2.0f) * y * gR[0][0] + x * gR[0][1] + w * gR[0][2] + x * gR[1][0] + z * gR[1][2] - w * gR[2][0] +
+                   z * gR[2][1] - two * y * gR[2][2]);
     gq[3] = two * (vs(-2.0f) * z * gR[0][0] - w * gR[0][1] + x * gR[0][2] + w * gR[1][0] - two * z * gR[1][1] +
                    y * gR[1][2] + x * gR[2][0] + y * gR[2][1]);
     const vf qdot = gq[0] * w + gq[1] * x + gq[2] * y + gq[3] * z;
@@ -550,10 +549,8 @@ void fisherChainList(const ProjectIn& in, const std::uint32_t* idx, int count, c
       for (int k = 0; k < 3; ++k) rA[j][k] = qm[j][0] * f.A[0][k] + qm[j][1] * f.A[1][k];
       vf sS[3];
       for (int k = 0; k < 3; ++k) sS[k] = f.Sig[k][0] * rA[j][0] + f.Sig[k][1] * rA[j][1] + f.Sig[k][2] * rA[j][2];
-      for (int k = 0; k < 3; ++k)
-        wR[j][k] = vs(in.R[k][0]) * sS[0] + vs(in.R[k][1]) * sS[1] + vs(in.R[k][2]) * sS[2];
-      for (int k = 0; k < 3; ++k)
-        tR[j][k] = f.q.R[0][k] * rA[j][0] + f.q.R[1][k] * rA[j][1] + f.q.R[2][k] * rA[j][2];
+      for (int k = 0; k < 3; ++k) wR[j][k] = vs(in.R[k][0]) * sS[0] + vs(in.R[k][1]) * sS[1] + vs(in.R[k][2]) * sS[2];
+      for (int k = 0; k < 3; ++k) tR[j][k] = f.q.R[0][k] * rA[j][0] + f.q.R[1][k] * rA[j][1] + f.q.R[2][k] * rA[j][2];
     }
     vi scale_live[3];
     for (int k = 0; k < 3; ++k) {
@@ -585,7 +582,8 @@ void fisherChainList(const ProjectIn& in, const std::uint32_t* idx, int count, c
     vd mo[kFisherSlot];
     for (int m = 0; m < kFisherSlot; ++m)
       for (int l = 0; l < L; ++l) mo[m][l] = moments[static_cast<std::size_t>(jx[l]) * kFisherSlot + m];
-    const vd a = __builtin_convertvector(Pa, vd), b = __builtin_convertvector(Pb, vd), c = __builtin_convertvector(Pc, vd), o = __builtin_convertvector(Po, vd);
+    const vd a = __builtin_convertvector(Pa, vd), b = __builtin_convertvector(Pb, vd),
+             c = __builtin_convertvector(Pc, vd), o = __builtin_convertvector(Po, vd);
     const vd E[5][5] = {{mo[kE20], mo[kE11], mo[kE30], mo[kE21], mo[kE12]},
                         {mo[kE11], mo[kE02], mo[kE21], mo[kE12], mo[kE03]},
                         {mo[kE30], mo[kE21], mo[kE40], mo[kE31], mo[kE22]},
@@ -595,8 +593,8 @@ void fisherChainList(const ProjectIn& in, const std::uint32_t* idx, int count, c
     vd res[6];
     for (int p = 0; p < 6; ++p) {
       const vd J0 = __builtin_convertvector(J[0][p], vd), J1 = __builtin_convertvector(J[1][p], vd);
-      const vd k[5] = {a * J0 + b * J1, b * J0 + c * J1, (-0.5 - vd{}) * __builtin_convertvector(J[2][p], vd), -__builtin_convertvector(J[3][p], vd),
-                       (-0.5 - vd{}) * __builtin_convertvector(J[4][p], vd)};
+      const vd k[5] = {a * J0 + b * J1, b * J0 + c * J1, (-0.5 - vd{}) * __builtin_convertvector(J[2][p], vd),
+                       -__builtin_convertvector(J[3][p], vd), (-0.5 - vd{}) * __builtin_convertvector(J[4][p], vd)};
       vd quad = (0.0 - vd{}), lin = (0.0 - vd{});
       for (int u = 0; u < 5; ++u) {
         vd row = (0.0 - vd{});

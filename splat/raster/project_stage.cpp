@@ -46,8 +46,8 @@ void projectRangeWith(const GaussiansT<float>& g, const CameraT<float>& camT, co
 }
 
 template <typename T>
-void projectAll(const GaussiansT<T>& g, const CameraT<T>& camT, std::span<const std::uint8_t> mask, int W,
-                int H, RasterStateT<T>& st, RenderOutputT<T>& out, TileCover& cover) {
+void projectAll(const GaussiansT<T>& g, const CameraT<T>& camT, std::span<const std::uint8_t> mask, int W, int H,
+                RasterStateT<T>& st, RenderOutputT<T>& out, TileCover& cover) {
   const std::size_t n = g.size();
   const RasterSettings& rs = st.settings;
   out.radii.assign(n, T(0));
@@ -91,11 +91,9 @@ void projectAll(const GaussiansT<T>& g, const CameraT<T>& camT, std::span<const 
   });
 }
 
-
 void checkChainInputs(const Gaussians& g, const std::vector<std::uint32_t>& idx, std::size_t per_listed,
                       const std::vector<Projected<float>>& proj, const Gaussians& out, const char* who) {
-  if (idx.size() != per_listed || proj.size() != g.size() || out.size() != g.size() ||
-      out.shCoeffs() != g.shCoeffs())
+  if (idx.size() != per_listed || proj.size() != g.size() || out.size() != g.size() || out.shCoeffs() != g.shCoeffs())
     throw std::invalid_argument(std::string(who) + ": sizes disagree");
   for (const std::uint32_t i : idx)
     if (i >= g.size()) throw std::invalid_argument(std::string(who) + ": index beyond the model");
@@ -106,7 +104,7 @@ template void projectAll(const GaussiansT<float>&, const CameraT<float>&, std::s
 template void projectAll(const GaussiansT<double>&, const CameraT<double>&, std::span<const std::uint8_t>, int, int,
                          RasterStateT<double>&, RenderOutputT<double>&, TileCover&);
 
-}  // namespace raster_stage
+}  // namespace saresgs::raster_stage
 
 namespace saresgs {
 using namespace raster_stage;
@@ -130,10 +128,9 @@ void projectBackwardFloat(const GaussiansT<float>& g, const Camera& cam, const R
   beginState(st, s, g.max_sh_degree, cam.K.width, cam.K.height);
   const CameraT<float> camT(cam, s.guard_band);
   const FloatEnvGuard fenv;
-  kKernelSets[st.isa].project_backward(projectInput(g, camT, st.settings), idx.data(), static_cast<int>(idx.size()),
-                                       proj.data(), dP.data(),
-                                       {grad.means.data(), grad.log_scales.data(), grad.rotations.data(),
-                                        grad.opacities.data(), grad.sh.data()});
+  kKernelSets[st.isa].project_backward(
+      projectInput(g, camT, st.settings), idx.data(), static_cast<int>(idx.size()), proj.data(), dP.data(),
+      {grad.means.data(), grad.log_scales.data(), grad.rotations.data(), grad.opacities.data(), grad.sh.data()});
 }
 
 }  // namespace saresgs

@@ -127,13 +127,11 @@ T viewBasis(const GaussiansT<T>& g, std::size_t i, const CameraT<T>& cam, int sh
 }
 
 template <typename T>
-Projected<T> project(const GaussiansT<T>& g, std::size_t i, const CameraT<T>& cam,
-                     const RasterSettings& s) {
+Projected<T> project(const GaussiansT<T>& g, std::size_t i, const CameraT<T>& cam, const RasterSettings& s) {
   Projected<T> P;
   const T* m = &g.means[3 * i];
   T p[3];
-  for (int r = 0; r < 3; ++r)
-    p[r] = cam.R[r][0] * m[0] + cam.R[r][1] * m[1] + cam.R[r][2] * m[2] + cam.t[r];
+  for (int r = 0; r < 3; ++r) p[r] = cam.R[r][0] * m[0] + cam.R[r][1] * m[1] + cam.R[r][2] * m[2] + cam.t[r];
   if (!(p[2] >= T(s.near_plane))) return P;  // also rejects NaN
   const T xz = p[0] / p[2], yz = p[1] / p[2];
   if (!(std::abs(xz - cam.gx_mid) <= cam.gx_half && std::abs(yz - cam.gy_mid) <= cam.gy_half)) return P;
@@ -185,8 +183,8 @@ Projected<T> project(const GaussiansT<T>& g, std::size_t i, const CameraT<T>& ca
     P.half[0] = P.half[1] = T(3) * std::sqrt(lmax);
   }
   P.radius = std::max(P.half[0], P.half[1]);
-  if (P.mean2d[0] + P.half[0] < 0 || P.mean2d[0] - P.half[0] > T(cam.width) ||
-      P.mean2d[1] + P.half[1] < 0 || P.mean2d[1] - P.half[1] > T(cam.height) || !std::isfinite(P.radius))
+  if (P.mean2d[0] + P.half[0] < 0 || P.mean2d[0] - P.half[0] > T(cam.width) || P.mean2d[1] + P.half[1] < 0 ||
+      P.mean2d[1] - P.half[1] > T(cam.height) || !std::isfinite(P.radius))
     return P;
 
   // Rule 5: colour from SH along the view direction.
@@ -239,8 +237,7 @@ template <typename T>
 BackwardFrame<T> backwardFrame(const GaussiansT<T>& g, std::size_t i, const CameraT<T>& cam, const RasterSettings& s) {
   BackwardFrame<T> f;
   const T* m = &g.means[3 * i];
-  for (int r = 0; r < 3; ++r)
-    f.p[r] = cam.R[r][0] * m[0] + cam.R[r][1] * m[1] + cam.R[r][2] * m[2] + cam.t[r];
+  for (int r = 0; r < 3; ++r) f.p[r] = cam.R[r][0] * m[0] + cam.R[r][1] * m[1] + cam.R[r][2] * m[2] + cam.t[r];
   f.iz = T(1) / f.p[2];
   f.iz2 = f.iz * f.iz;
   f.dn = viewBasis(g, i, cam, s.sh_degree, f.d, f.basis);
@@ -294,11 +291,10 @@ void colorBackward(const GaussiansT<T>& g, std::size_t i, const RasterSettings& 
     }
     if (s.sh_degree > 2) {
       const T xx = x * x, yy = y * y, zz = z * z;
-      const T c30 = T(C3[0]), c31 = T(C3[1]), c32 = T(C3[2]), c33 = T(C3[3]), c34 = T(C3[4]),
-            c35 = T(C3[5]), c36 = T(C3[6]);
-      gd[0] += 6 * c30 * x * y * gb[9] + c31 * y * z * gb[10] - 2 * c32 * x * y * gb[11] -
-               6 * c33 * x * z * gb[12] + c34 * (4 * zz - 3 * xx - yy) * gb[13] + 2 * c35 * x * z * gb[14] +
-               c36 * (3 * xx - 3 * yy) * gb[15];
+      const T c30 = T(C3[0]), c31 = T(C3[1]), c32 = T(C3[2]), c33 = T(C3[3]), c34 = T(C3[4]), c35 = T(C3[5]),
+              c36 = T(C3[6]);
+      gd[0] += 6 * c30 * x * y * gb[9] + c31 * y * z * gb[10] - 2 * c32 * x * y * gb[11] - 6 * c33 * x * z * gb[12] +
+               c34 * (4 * zz - 3 * xx - yy) * gb[13] + 2 * c35 * x * z * gb[14] + c36 * (3 * xx - 3 * yy) * gb[15];
       gd[1] += c30 * (3 * xx - 3 * yy) * gb[9] + c31 * x * z * gb[10] + c32 * (4 * zz - xx - 3 * yy) * gb[11] -
                6 * c33 * y * z * gb[12] - 2 * c34 * x * y * gb[13] - 2 * c35 * y * z * gb[14] -
                6 * c36 * x * y * gb[15];
@@ -313,8 +309,8 @@ void colorBackward(const GaussiansT<T>& g, std::size_t i, const RasterSettings& 
 
 // Conic -> the camera-space mean's gradient gpc (J's dependence on p) and dL/dM.
 template <typename T>
-void conicBackward(const CameraT<T>& cam, const Projected<T>& P, const BackwardFrame<T>& f, const T dconic[3],
-                   T gpc[3], T gM[3][3]) {
+void conicBackward(const CameraT<T>& cam, const Projected<T>& P, const BackwardFrame<T>& f, const T dconic[3], T gpc[3],
+                   T gM[3][3]) {
   const T* p = f.p;
   const T iz = f.iz, iz2 = f.iz2;
   // Covariance chain: conic -> Sigma2D -> (A, Sigma) -> (J, M) -> (p, scales, rotation).
@@ -350,12 +346,11 @@ void conicBackward(const CameraT<T>& cam, const Projected<T>& P, const BackwardF
   // J's dependence on p.
   gpc[0] = gJ[0][2] * (-cam.fx * iz2);
   gpc[1] = gJ[1][2] * (-cam.fy * iz2);
-  gpc[2] = gJ[0][0] * (-cam.fx * iz2) + gJ[0][2] * (T(2) * cam.fx * p[0] * iz2 * iz) +
-           gJ[1][1] * (-cam.fy * iz2) + gJ[1][2] * (T(2) * cam.fy * p[1] * iz2 * iz);
+  gpc[2] = gJ[0][0] * (-cam.fx * iz2) + gJ[0][2] * (T(2) * cam.fx * p[0] * iz2 * iz) + gJ[1][1] * (-cam.fy * iz2) +
+           gJ[1][2] * (T(2) * cam.fy * p[1] * iz2 * iz);
   // Sigma = M M^T: dL/dM = 2 gSig M.
   for (int r = 0; r < 3; ++r)
-    for (int k = 0; k < 3; ++k)
-      gM[r][k] = T(2) * (gSig[r][0] * M[0][k] + gSig[r][1] * M[1][k] + gSig[r][2] * M[2][k]);
+    for (int k = 0; k < 3; ++k) gM[r][k] = T(2) * (gSig[r][0] * M[0][k] + gSig[r][1] * M[1][k] + gSig[r][2] * M[2][k]);
 }
 
 // Adds the 2D mean's gradient to gpc, giving the camera-space mean's gradient gp (the
@@ -421,8 +416,8 @@ template <typename T>
                  w * gR[2][1] - 2 * x * gR[2][2]);
     gq[2] = 2 * (-2 * y * gR[0][0] + x * gR[0][1] + w * gR[0][2] + x * gR[1][0] + z * gR[1][2] - w * gR[2][0] +
                  z * gR[2][1] - 2 * y * gR[2][2]);
-    gq[3] = 2 * (-2 * z * gR[0][0] - w * gR[0][1] + x * gR[0][2] + w * gR[1][0] - 2 * z * gR[1][1] +
-                 y * gR[1][2] + x * gR[2][0] + y * gR[2][1]);
+    gq[3] = 2 * (-2 * z * gR[0][0] - w * gR[0][1] + x * gR[0][2] + w * gR[1][0] - 2 * z * gR[1][1] + y * gR[1][2] +
+                 x * gR[2][0] + y * gR[2][1]);
     // Through the normalisation q / |q|.
     const T dot = gq[0] * qn[0] + gq[1] * qn[1] + gq[2] * qn[2] + gq[3] * qn[3];
     for (int k = 0; k < 4; ++k) out.rotation[k] += (gq[k] - qn[k] * dot) / qnorm;
@@ -473,8 +468,8 @@ void projectJacobian(const GaussiansT<T>& g, std::size_t i, const CameraT<T>& ca
     T gp[3];
     gp[0] = gJ[0][2] * (-cam.fx * iz2);
     gp[1] = gJ[1][2] * (-cam.fy * iz2);
-    gp[2] = gJ[0][0] * (-cam.fx * iz2) + gJ[0][2] * (T(2) * cam.fx * p[0] * iz2 * iz) +
-            gJ[1][1] * (-cam.fy * iz2) + gJ[1][2] * (T(2) * cam.fy * p[1] * iz2 * iz);
+    gp[2] = gJ[0][0] * (-cam.fx * iz2) + gJ[0][2] * (T(2) * cam.fx * p[0] * iz2 * iz) + gJ[1][1] * (-cam.fy * iz2) +
+            gJ[1][2] * (T(2) * cam.fy * p[1] * iz2 * iz);
     cameraToMean(cam, gp, zero3, J[2 + r]);
     for (int k = 0; k < 3; ++k) {
       const T raw = g.log_scales[3 * i + k];
@@ -488,9 +483,8 @@ void projectJacobian(const GaussiansT<T>& g, std::size_t i, const CameraT<T>& ca
 }
 
 template <typename T>
-void projectBackward(const GaussiansT<T>& g, std::size_t i, const CameraT<T>& cam,
-                     const RasterSettings& s, const Projected<T>& P, const ProjectedGrad<T>& dP,
-                     const ParamGradRef<T>& out) {
+void projectBackward(const GaussiansT<T>& g, std::size_t i, const CameraT<T>& cam, const RasterSettings& s,
+                     const Projected<T>& P, const ProjectedGrad<T>& dP, const ParamGradRef<T>& out) {
   projectBackward(g, i, cam, s, P, dP, out, backwardFrame(g, i, cam, s));
 }
 

@@ -65,14 +65,14 @@ struct BackwardIn {
 };
 
 // Pixels [x0, x1) x [y0, y1) composited front to back over q[0, nq) (rule 7).
-using CompositeFn = void (*)(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1,
-                             const float bg[3], const ForwardOut& out);
+using CompositeFn = void (*)(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
+                             const ForwardOut& out);
 // The back-to-front walk of a tile: for each tile entry jj its 9 gradient sums
 // (opacity, mean2d 2, conic 3, colour 3) go to slots[jj * 9], `slots` being the tile's
 // first entry's slot: slots follow the tile lists, so a tile's are one run of memory
 // (every entry's slot is written, zeros where no pixel reaches it).
-using BackwardFn = void (*)(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1,
-                            const float bg[3], const BackwardIn& in, float* slots);
+using BackwardFn = void (*)(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
+                            const BackwardIn& in, float* slots);
 
 // FisherRF's squared-gradient pass (splat/fisher.h) works on the per-pixel gradient of
 // C_r + C_g + C_b, which is linear in a contribution's 2D inputs: dL/dalpha times G (e,
@@ -84,8 +84,25 @@ using BackwardFn = void (*)(const TileGaussian<float>* q, int nq, int x0, int y0
 // (fisher_pass.cpp) instead of at every pixel. E_ij = sum e^2 dx^i dy^j, F_ij = sum e wc
 // dx^i dy^j, W = sum wc^2.
 enum FisherMoment {
-  kE00, kE20, kE11, kE02, kE30, kE21, kE12, kE03, kE40, kE31, kE22, kE13, kE04,
-  kF10, kF01, kF20, kF11, kF02, kW,
+  kE00,
+  kE20,
+  kE11,
+  kE02,
+  kE30,
+  kE21,
+  kE12,
+  kE03,
+  kE40,
+  kE31,
+  kE22,
+  kE13,
+  kE04,
+  kF10,
+  kF01,
+  kF20,
+  kF11,
+  kF02,
+  kW,
   kFisherSlot  // floats per pair slot
 };
 
@@ -100,8 +117,8 @@ struct FisherIn {
 // entry jj its kFisherSlot moments go to slots[jj * kFisherSlot], `slots` being the
 // tile's first entry's slot (every entry's slot is written, zeros where no pixel reaches
 // it).
-using FisherFn = void (*)(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1,
-                          const float bg[3], const FisherIn& in, float* slots);
+using FisherFn = void (*)(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
+                          const FisherIn& in, float* slots);
 
 // What the projection kernels (splat/raster/project_kernels_impl.h) read: the model's
 // arrays (GaussiansT<float>'s storage), the camera in float (projection::CameraT<float>)
@@ -124,8 +141,7 @@ struct ProjectIn {
 // [begin, end), SARESGS_KERNEL_LANES at a time, into out[i] for each i: bit for bit what
 // project() returns for every visible Gaussian, and visible = false where it culls (the
 // other fields of a culled Gaussian are unspecified there as here).
-using ProjectFn = void (*)(const ProjectIn& in, std::size_t begin, std::size_t end,
-                           projection::Projected<float>* out);
+using ProjectFn = void (*)(const ProjectIn& in, std::size_t begin, std::size_t end, projection::Projected<float>* out);
 // Where the projection's backward kernels add a Gaussian's parameter gradients
 // (GaussiansT<float>'s storage; sh with ProjectIn::sh_stride per Gaussian).
 struct ProjectGradOut {
@@ -140,8 +156,8 @@ struct ProjectGradOut {
 // idx[0, count) (distinct), given their projections (proj[idx[j]]) and the gradients of
 // their projected quantities (dP[j]): adds to `out` bit for bit what projectBackward adds.
 using ProjectBackwardFn = void (*)(const ProjectIn& in, const std::uint32_t* idx, int count,
-                                   const projection::Projected<float>* proj,
-                                   const projection::ProjectedGrad<float>* dP, const ProjectGradOut& out);
+                                   const projection::Projected<float>* proj, const projection::ProjectedGrad<float>* dP,
+                                   const ProjectGradOut& out);
 namespace base4 {
 void projectBackwardList(const ProjectIn& in, const std::uint32_t* idx, int count,
                          const projection::Projected<float>* proj, const projection::ProjectedGrad<float>* dP,
@@ -240,37 +256,33 @@ void backwardTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, 
 // render's pair slots (every entry's slot, zeros where neither branch walks it): equal to
 // the two single backward passes' slots added, up to float rounding. `slots` is the tile's
 // first entry's slot, as for BackwardFn.
-using CompositePairFn = void (*)(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0,
-                                 int y0, int x1, int y1, const float bg[3], const ForwardOut& full,
-                                 const ForwardOut& subset);
-using BackwardPairFn = void (*)(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0,
-                                int y0, int x1, int y1, const float bg[3], const BackwardIn& full,
-                                const BackwardIn& subset, float* slots);
+using CompositePairFn = void (*)(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0,
+                                 int x1, int y1, const float bg[3], const ForwardOut& full, const ForwardOut& subset);
+using BackwardPairFn = void (*)(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0,
+                                int x1, int y1, const float bg[3], const BackwardIn& full, const BackwardIn& subset,
+                                float* slots);
 
 namespace base4 {
-void compositeTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0,
-                       int x1, int y1, const float bg[3], const ForwardOut& full, const ForwardOut& subset);
+void compositeTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0, int x1,
+                       int y1, const float bg[3], const ForwardOut& full, const ForwardOut& subset);
 void backwardTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0, int x1,
-                      int y1, const float bg[3], const BackwardIn& full, const BackwardIn& subset,
-                      float* slots);
+                      int y1, const float bg[3], const BackwardIn& full, const BackwardIn& subset, float* slots);
 }  // namespace base4
 
 namespace avx2 {
-void compositeTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0,
-                       int x1, int y1, const float bg[3], const ForwardOut& full, const ForwardOut& subset);
+void compositeTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0, int x1,
+                       int y1, const float bg[3], const ForwardOut& full, const ForwardOut& subset);
 void backwardTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0, int x1,
-                      int y1, const float bg[3], const BackwardIn& full, const BackwardIn& subset,
-                      float* slots);
+                      int y1, const float bg[3], const BackwardIn& full, const BackwardIn& subset, float* slots);
 }  // namespace avx2
 
 // The AVX2 pair kernels on AVX-512VL's 32 registers (raster_kernels_avx512.cpp):
 // bit-identical to avx2::compositeTilePair and avx2::backwardTilePair.
 namespace avx512 {
-void compositeTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0,
-                       int x1, int y1, const float bg[3], const ForwardOut& full, const ForwardOut& subset);
+void compositeTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0, int x1,
+                       int y1, const float bg[3], const ForwardOut& full, const ForwardOut& subset);
 void backwardTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0, int x1,
-                      int y1, const float bg[3], const BackwardIn& full, const BackwardIn& subset,
-                      float* slots);
+                      int y1, const float bg[3], const BackwardIn& full, const BackwardIn& subset, float* slots);
 }  // namespace avx512
 
 }  // namespace raster_kernels

@@ -45,16 +45,14 @@ bool compiled() { return true; }
 
 namespace saresgs::raster_kernels::avx512 {
 bool compiled() { return false; }
-void fisherTile(const TileGaussian<float>*, int, int, int, int, int, const float*, const FisherIn&,
-                float*) {
+void fisherTile(const TileGaussian<float>*, int, int, int, int, int, const float*, const FisherIn&, float*) {
   std::abort();
 }
 void compositeTilePair(const TileGaussian<float>*, const std::uint8_t*, int, int, int, int, int, const float*,
                        const ForwardOut&, const ForwardOut&) {
   std::abort();
 }
-void backwardTile(const TileGaussian<float>*, int, int, int, int, int, const float*, const BackwardIn&,
-                  float*) {
+void backwardTile(const TileGaussian<float>*, int, int, int, int, int, const float*, const BackwardIn&, float*) {
   std::abort();
 }
 void backwardTilePair(const TileGaussian<float>*, const std::uint8_t*, int, int, int, int, int, const float*,

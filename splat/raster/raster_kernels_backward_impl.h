@@ -65,14 +65,16 @@ struct BackwardState {
         B.walked = __builtin_convertvector(nw, vf);
         jm = jm > nw ? jm : nw;
         v4f r[2], g[2], bl[2];
-        for (int half = 0; half < kBH; ++half) deinterleave3(in.dL_drgb + (pix + half * W) * 3, r[half], g[half], bl[half]);
+        for (int half = 0; half < kBH; ++half)
+          deinterleave3(in.dL_drgb + (pix + half * W) * 3, r[half], g[half], bl[half]);
         B.w0 = joinRows(r[0], r[kBH - 1]);
         B.w1 = joinRows(g[0], g[kBH - 1]);
         B.w2 = joinRows(bl[0], bl[kBH - 1]);
         B.acc0 = B.acc1 = B.acc2 = vs(0.0f);
         B.bgdot = vs(bg[0]) * B.w0 + vs(bg[1]) * B.w1 + vs(bg[2]) * B.w2;
       }
-      for (int i = 0; i < L; ++i) jmax = static_cast<std::uint32_t>(jm[i]) > jmax ? static_cast<std::uint32_t>(jm[i]) : jmax;
+      for (int i = 0; i < L; ++i)
+        jmax = static_cast<std::uint32_t>(jm[i]) > jmax ? static_cast<std::uint32_t>(jm[i]) : jmax;
       return;
     }
     for (int k = 0; k < kTile * kTile; ++k) {

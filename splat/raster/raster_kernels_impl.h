@@ -54,8 +54,8 @@ typedef std::int32_t vi __attribute__((vector_size(4 * L)));
 // a b + c: one fused rounding where the kernels are built for FMA, else two.
 inline vf fma(vf a, vf b, vf c) {
 #if SARESGS_KERNEL_FMA
-  return reinterpret_cast<vf>(_mm256_fmadd_ps(reinterpret_cast<__m256>(a), reinterpret_cast<__m256>(b),
-                                              reinterpret_cast<__m256>(c)));
+  return reinterpret_cast<vf>(
+      _mm256_fmadd_ps(reinterpret_cast<__m256>(a), reinterpret_cast<__m256>(b), reinterpret_cast<__m256>(c)));
 #else
   return a * b + c;
 #endif
@@ -213,8 +213,8 @@ inline vf vsqrt(vf a) {
 // is 2^-125 (~2.4e-38) instead of 2^x, which the kernels never see, as they use G only
 // where o G >= 1/255.
 inline vf exp2Core(vf xc) {
-  const vf magic = vs(12582912.0f);     // 1.5 * 2^23
-  const vf m = xc + magic;              // rounds to the nearest whole number (even on ties)
+  const vf magic = vs(12582912.0f);  // 1.5 * 2^23
+  const vf m = xc + magic;           // rounds to the nearest whole number (even on ties)
   const vf n = m - magic;
   const vf r = xc - n;
   const vf r2 = r * r;
@@ -297,8 +297,8 @@ inline void tileSpan(std::int32_t span_lo, std::int32_t span_hi, int origin, int
 // backward kernel's cycles on room360 at 512x384, and with early returns its branches
 // mispredicted.
 constexpr int kBlockRows = kTile / kBH;
-inline void blockRowSpans(const TileGaussian<float>& g, int x0, int y0, int rb0, int rbl, int c0, int c1,
-                          int* lo, int* hi) {
+inline void blockRowSpans(const TileGaussian<float>& g, int x0, int y0, int rb0, int rbl, int c0, int c1, int* lo,
+                          int* hi) {
   const vf c0f = vs(static_cast<float>(c0)), c1f = vs(static_cast<float>(c1));
   const vi c0v = vi{} + c0, c1v = vi{} + c1;
   for (int base = rb0 - rb0 % L; base <= rbl; base += L) {
@@ -318,8 +318,8 @@ inline void blockRowSpans(const TileGaussian<float>& g, int x0, int y0, int rb0,
     l = l <= c1f + vs(1.0f) ? l : c1f + vs(1.0f);
     u = u >= c0f - vs(1.0f) ? u : c0f - vs(1.0f);
     const vi lt = __builtin_convertvector(l, vi), ut = __builtin_convertvector(u, vi);  // truncation
-    const vi li = lt - (__builtin_convertvector(lt, vf) < l);  // masks are -1: ceiling, l >= 0
-    const vi ui = ut + (__builtin_convertvector(ut, vf) > u);  // floor, u >= -1
+    const vi li = lt - (__builtin_convertvector(lt, vf) < l);                           // masks are -1: ceiling, l >= 0
+    const vi ui = ut + (__builtin_convertvector(ut, vf) > u);                           // floor, u >= -1
     const vi none = ~(t >= zero);
     const vi lov = none ? c1v + 1 : li, hiv = none ? c0v - 1 : ui;
     for (int i = 0; i < L && base + i < kBlockRows; ++i) {
@@ -365,8 +365,7 @@ struct Lattice {
 // (rbl + 1) kBH) of the tile at x0, y0) suits the lattice: at least kLatticeMinBlocks
 // blocks, and p >= kLatticeFloor at its corners (a concave quadratic takes its minimum
 // over a rectangle at a corner; NaN coefficients fail every comparison).
-inline bool latticeFits(const TileGaussian<float>& g, int x0, int y0, int cb0, int cbl, int rb0, int rbl,
-                        Lattice& lt) {
+inline bool latticeFits(const TileGaussian<float>& g, int x0, int y0, int cb0, int cbl, int rb0, int rbl, Lattice& lt) {
   if (((cbl - cb0) / kBW + 1) * (rbl - rb0 + 1) < kLatticeMinBlocks) return false;
   lt.al = -0.5f * kLog2e * g.a;
   lt.be = -kLog2e * g.b;
@@ -389,8 +388,8 @@ inline bool latticeFits(const TileGaussian<float>& g, int x0, int y0, int cb0, i
 // computing each afresh. G comes from the lattice above where it fits, else from
 // evalLanes' exponent and exp2 per block.
 template <typename Body>
-__attribute__((always_inline)) inline void forEachBlock(const TileGaussian<float>& g, int x0, int y0, int x1,
-                                                        int y1, Body&& body) {
+__attribute__((always_inline)) inline void forEachBlock(const TileGaussian<float>& g, int x0, int y0, int x1, int y1,
+                                                        Body&& body) {
   int c0, c1, r0, r1;
   tileSpan(g.px0, g.px1, x0, x1, c0, c1);
   tileSpan(g.py0, g.py1, y0, y1, r0, r1);
@@ -415,10 +414,10 @@ __attribute__((always_inline)) inline void forEachBlock(const TileGaussian<float
       const vf al = vs(lt.al), be = vs(lt.be), ga = vs(lt.ga);
       // G at the first block, its step factor to the right and its step factor down.
       vf g_row = exp2Clamped(fma(al * dx0 + be * dy0, dx0, ga * dy0 * dy0));
-      vf e_row = exp2Clamped(fma(al, fma(vs(2.0f * kBW), dx0, vs(static_cast<float>(kBW * kBW))),
-                                 vs(static_cast<float>(kBW)) * be * dy0));
-      vf f = exp2Clamped(fma(ga, fma(vs(2.0f * kBH), dy0, vs(static_cast<float>(kBH * kBH))),
-                             vs(static_cast<float>(kBH)) * be * dx0));
+      vf e_row = exp2Clamped(
+          fma(al, fma(vs(2.0f * kBW), dx0, vs(static_cast<float>(kBW * kBW))), vs(static_cast<float>(kBW)) * be * dy0));
+      vf f = exp2Clamped(
+          fma(ga, fma(vs(2.0f * kBH), dy0, vs(static_cast<float>(kBH * kBH))), vs(static_cast<float>(kBH)) * be * dx0));
       vf kv = vs(0.0f);
       kv[0] = 2.0f * kBW * kBW * lt.al;
       kv[1] = 2.0f * kBH * kBH * lt.ga;
@@ -574,7 +573,10 @@ struct ForwardState {
 struct ForwardColour {
   vf col0, col1, col2, dep, jf;
   ForwardColour(const TileGaussian<float>& g, int j)
-      : col0(vs(g.col[0])), col1(vs(g.col[1])), col2(vs(g.col[2])), dep(vs(g.depth)),
+      : col0(vs(g.col[0])),
+        col1(vs(g.col[1])),
+        col2(vs(g.col[2])),
+        dep(vs(g.depth)),
         jf(vs(static_cast<float>(j + 1))) {}
 };
 
@@ -605,8 +607,10 @@ void compositeTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int
 
 void compositeTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
                    const ForwardOut& out) {
-  if (out.depth) compositeTileImpl<true>(q, nq, x0, y0, x1, y1, bg, out);
-  else compositeTileImpl<false>(q, nq, x0, y0, x1, y1, bg, out);
+  if (out.depth)
+    compositeTileImpl<true>(q, nq, x0, y0, x1, y1, bg, out);
+  else
+    compositeTileImpl<false>(q, nq, x0, y0, x1, y1, bg, out);
 }
 
 // The machine's floor for the forward kernel's arithmetic (raster_kernels.h): the same

@@ -27,8 +27,8 @@ namespace saresgs::raster_kernels::SARESGS_KERNEL_NS {
 
 namespace {
 template <bool kAux>
-void compositeTilePairImpl(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0,
-                           int x1, int y1, const float bg[3], const ForwardOut& full, const ForwardOut& subset) {
+void compositeTilePairImpl(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0, int x1,
+                           int y1, const float bg[3], const ForwardOut& full, const ForwardOut& subset) {
   const int w = x1 - x0, h = y1 - y0;
   ForwardState F, S;
   F.init(w, h);
@@ -50,9 +50,12 @@ void compositeTilePairImpl(const TileGaussian<float>* q, const std::uint8_t* in_
         if constexpr (kSub) stopped_s -= S.template step<kAux>(S.b[blk], Ln, fc.col0, fc.col1, fc.col2, fc.dep, fc.jf);
       });
     };
-    if (do_full && do_sub) walk.template operator()<true, true>();
-    else if (do_full) walk.template operator()<true, false>();
-    else walk.template operator()<false, true>();
+    if (do_full && do_sub)
+      walk.template operator()<true, true>();
+    else if (do_full)
+      walk.template operator()<true, false>();
+    else
+      walk.template operator()<false, true>();
     F.n_active -= hsumInt(stopped_f);
     S.n_active -= hsumInt(stopped_s);
   }
@@ -62,19 +65,20 @@ void compositeTilePairImpl(const TileGaussian<float>* q, const std::uint8_t* in_
 }  // namespace
 
 // Depth and contributors for both renders or for neither (full.depth decides).
-void compositeTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0,
-                       int x1, int y1, const float bg[3], const ForwardOut& full, const ForwardOut& subset) {
-  if (full.depth) compositeTilePairImpl<true>(q, in_subset, nq, x0, y0, x1, y1, bg, full, subset);
-  else compositeTilePairImpl<false>(q, in_subset, nq, x0, y0, x1, y1, bg, full, subset);
+void compositeTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0, int x1,
+                       int y1, const float bg[3], const ForwardOut& full, const ForwardOut& subset) {
+  if (full.depth)
+    compositeTilePairImpl<true>(q, in_subset, nq, x0, y0, x1, y1, bg, full, subset);
+  else
+    compositeTilePairImpl<false>(q, in_subset, nq, x0, y0, x1, y1, bg, full, subset);
 }
 
 #if !SARESGS_KERNEL_PAIR_COMPOSITE_ONLY
 namespace {
 
 template <bool kBg>
-void backwardTilePairImpl(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0,
-                          int x1, int y1, const float bg[3], const BackwardIn& full, const BackwardIn& subset,
-                          float* slots) {
+void backwardTilePairImpl(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0, int x1,
+                          int y1, const float bg[3], const BackwardIn& full, const BackwardIn& subset, float* slots) {
   const int w = x1 - x0, h = y1 - y0;
   BackwardState F, S;
   F.init(x0, y0, w, h, bg, full);
@@ -117,9 +121,12 @@ void backwardTilePairImpl(const TileGaussian<float>* q, const std::uint8_t* in_s
         }
       });
     };
-    if (do_full && do_sub) walk.template operator()<true, true>();
-    else if (do_full) walk.template operator()<true, false>();
-    else walk.template operator()<false, true>();
+    if (do_full && do_sub)
+      walk.template operator()<true, true>();
+    else if (do_full)
+      walk.template operator()<true, false>();
+    else
+      walk.template operator()<false, true>();
     writeSums(g, s, slots + static_cast<std::size_t>(jj) * kSlot);
   }
 }
@@ -127,8 +134,7 @@ void backwardTilePairImpl(const TileGaussian<float>* q, const std::uint8_t* in_s
 }  // namespace
 
 void backwardTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0, int x1,
-                      int y1, const float bg[3], const BackwardIn& full, const BackwardIn& subset,
-                      float* slots) {
+                      int y1, const float bg[3], const BackwardIn& full, const BackwardIn& subset, float* slots) {
   if (nq == 0) return;
   if (bg[0] != 0.0f || bg[1] != 0.0f || bg[2] != 0.0f)
     backwardTilePairImpl<true>(q, in_subset, nq, x0, y0, x1, y1, bg, full, subset, slots);

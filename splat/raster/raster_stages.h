@@ -34,7 +34,7 @@ template <typename T>
 struct RasterStateT {
   RasterSettings settings;
   std::vector<projection::Projected<T>> proj;  // per Gaussian
-  std::vector<TileGaussian<T>> tile_data;  // per Gaussian: what the tile kernels read
+  std::vector<TileGaussian<T>> tile_data;      // per Gaussian: what the tile kernels read
   int tiles_x = 0, tiles_y = 0;
   std::vector<std::uint32_t> gauss_start;  // N + 1: each Gaussian's pairs (k in its range)
   std::vector<std::uint32_t> tile_start;   // tiles + 1
@@ -45,9 +45,9 @@ struct RasterStateT {
   // the backward stage of bench step 512x384/100k took 1.1-1.2 times as long); the
   // per-Gaussian reductions read them through this map, in pair order.
   std::vector<std::uint32_t> pair_entry;
-  std::vector<T> final_T;                  // per pixel
-  std::vector<std::uint32_t> n_walked;     // per pixel: tile entries walked (last contributor + 1)
-  int isa = 0;                             // the float kernels the forward pass used
+  std::vector<T> final_T;               // per pixel
+  std::vector<std::uint32_t> n_walked;  // per pixel: tile entries walked (last contributor + 1)
+  int isa = 0;                          // the float kernels the forward pass used
 };
 
 namespace raster_stage {
@@ -222,9 +222,13 @@ inline double expNonPositive(double x) { return std::exp(x); }
 // backward passes round identically (their threshold decisions must agree). The row
 // terms are separate so the forward pass can hoist them out of its pixel loop.
 template <typename T>
-T rowQuad(const TileGaussian<T>& q, T dy) { return T(-0.5) * q.c * dy * dy; }
+T rowQuad(const TileGaussian<T>& q, T dy) {
+  return T(-0.5) * q.c * dy * dy;
+}
 template <typename T>
-T rowCross(const TileGaussian<T>& q, T dy) { return q.b * dy; }
+T rowCross(const TileGaussian<T>& q, T dy) {
+  return q.b * dy;
+}
 template <typename T>
 T powerAt(const TileGaussian<T>& q, T dx, T row_quad, T row_cross) {
   return T(-0.5) * q.a * dx * dx + row_quad - row_cross * dx;
@@ -246,15 +250,13 @@ bool evalAlpha(const TileGaussian<T>& q, T px, T py, T& dx, T& dy, T& G, T& alph
   return alpha >= projection::Thresholds<T>::min_alpha;
 }
 template <typename T>
-void tilePixels(const RasterStateT<T>& st, int tile, int width, int height, int& x0, int& y0, int& x1,
-                int& y1) {
+void tilePixels(const RasterStateT<T>& st, int tile, int width, int height, int& x0, int& y0, int& x1, int& y1) {
   const int tx = tile % st.tiles_x, ty = tile / st.tiles_x;
   x0 = tx * kTileSize;
   y0 = ty * kTileSize;
   x1 = std::min(width, x0 + kTileSize);
   y1 = std::min(height, y0 + kTileSize);
 }
-
 
 // The tile walk every tile pass shares: tiles in parallel in the render's arena, each task
 // with the float environment guarded (geometry/float_env.h), the tile's Gaussians gathered
@@ -277,7 +279,6 @@ void forEachTile(const RasterStateT<T>& st, int W, int H, F&& f) {
 // --- Projection (project_stage.cpp) and binning (bin_stage.cpp) --------------------------
 // The forward pass runs three stages: projectAll (rules 1-5, per Gaussian), binAndSort
 // (rule 6, per tile) and compositeTiles (rule 7, per pixel).
-
 
 // What projection leaves for binning: the tiles each projected Gaussian touches.
 struct TileCover {
@@ -320,8 +321,7 @@ inline int metMaskWidth(const std::array<int, 4>& rect) {
 // The tiles of rect that g's alpha ellipse meets, for binning (forEachCoveredTile): their
 // count, and their mask where rect suits one (TileCover::met).
 template <typename T>
-std::uint32_t coverTiles(const TileGaussian<T>& g, const std::array<int, 4>& rect, int W, int H,
-                         std::uint64_t& met) {
+std::uint32_t coverTiles(const TileGaussian<T>& g, const std::array<int, 4>& rect, int W, int H, std::uint64_t& met) {
   const int rw = metMaskWidth(rect);
   if (rw == 0) {
     std::uint32_t count = 0;
@@ -329,7 +329,8 @@ std::uint32_t coverTiles(const TileGaussian<T>& g, const std::array<int, 4>& rec
     return count;
   }
   std::uint64_t m = 0;
-  forEachTileMet(g, rect, W, H, [&](int tx, int ty) { m |= std::uint64_t{1} << ((ty - rect[2]) * rw + (tx - rect[0])); });
+  forEachTileMet(g, rect, W, H,
+                 [&](int tx, int ty) { m |= std::uint64_t{1} << ((ty - rect[2]) * rw + (tx - rect[0])); });
   met = m;
   return static_cast<std::uint32_t>(std::popcount(m));
 }
@@ -370,7 +371,6 @@ void beginState(RasterStateT<T>& st, const RasterSettings& s, int max_sh_degree,
   st.tiles_y = (H + kTileSize - 1) / kTileSize;
 }
 
-
 // The projection kernels' view of a float model and camera (raster_kernels::ProjectIn).
 raster_kernels::ProjectIn projectInput(const GaussiansT<float>& g, const CameraT<float>& cam, const RasterSettings& rs);
 
@@ -382,8 +382,8 @@ void projectRangeWith(const GaussiansT<float>& g, const CameraT<float>& camT, co
 // and counts the tiles its pixel rectangle touches. `cover` is the caller's (kept between
 // renders: rasterizeIntoT).
 template <typename T>
-void projectAll(const GaussiansT<T>& g, const CameraT<T>& camT, std::span<const std::uint8_t> mask, int W,
-                int H, RasterStateT<T>& st, RenderOutputT<T>& out, TileCover& cover);
+void projectAll(const GaussiansT<T>& g, const CameraT<T>& camT, std::span<const std::uint8_t> mask, int W, int H,
+                RasterStateT<T>& st, RenderOutputT<T>& out, TileCover& cover);
 
 // The tests' entries to the per-Gaussian kernels: one gradient entry per listed Gaussian,
 // arrays of the model's sizes, indices inside it.
@@ -444,8 +444,7 @@ inline float* keptGradSlots(KeptBuffers<GradSlots>& kept, std::uint32_t pairs) {
 // k + 32 fetched ahead (both of its ends): the per-Gaussian reductions read the slots in
 // pair order, which scatters over the buffer. `pairs` bounds the lookahead.
 template <typename T>
-inline const T* pairSlot(const RasterStateT<T>& st, const T* slots, std::uint32_t k, int count,
-                         std::uint32_t pairs) {
+inline const T* pairSlot(const RasterStateT<T>& st, const T* slots, std::uint32_t k, int count, std::uint32_t pairs) {
   constexpr std::uint32_t kAhead = 32;
   if (k + kAhead < pairs) {
     const T* next = &slots[static_cast<std::size_t>(st.pair_entry[k + kAhead]) * count];
@@ -486,8 +485,8 @@ void chainSlots(const GaussiansT<T>& g, const Camera& cam, const RasterStateT<T>
 // visit(entry, dx, dy, G, alpha, unclamped, dL_dalpha, dL_dcolor_weight) where dL_dalpha
 // is for the per-pixel objective sum_c w_c C_c and dL_dcolor_weight = alpha T.
 template <typename T, typename Visit>
-void walkBack(const std::vector<TileGaussian<T>>& q, std::uint32_t walked, T final_T, T px, T py,
-              const T w[3], const T bg[3], Visit&& visit) {
+void walkBack(const std::vector<TileGaussian<T>>& q, std::uint32_t walked, T final_T, T px, T py, const T w[3],
+              const T bg[3], Visit&& visit) {
   T Tr = final_T;
   T accum[3] = {0, 0, 0}, last_alpha = 0, last_col[3] = {0, 0, 0};
   const T bg_dot = bg[0] * w[0] + bg[1] * w[1] + bg[2] * w[2];
@@ -513,8 +512,8 @@ void walkBack(const std::vector<TileGaussian<T>>& q, std::uint32_t walked, T fin
 template <typename T>
 void alphaToProjected(const TileGaussian<T>& q, T dx, T dy, T G, bool unclamped, T dL_dalpha, T* g2d) {
   if (!unclamped) return;
-  g2d[0] += G * dL_dalpha;  // opacity
-  const T dG = q.o * dL_dalpha * G;  // dL/dpower
+  g2d[0] += G * dL_dalpha;               // opacity
+  const T dG = q.o * dL_dalpha * G;      // dL/dpower
   g2d[1] += dG * (q.a * dx + q.b * dy);  // mean2d x (d power / d mean = -d power / d dx)
   g2d[2] += dG * (q.b * dx + q.c * dy);
   g2d[3] += dG * T(-0.5) * dx * dx;  // conic a
@@ -542,7 +541,6 @@ void walkAllPixels(const RasterStateT<T>& st, int W, int H, Weights&& weights, V
       }
   });
 }
-
 
 }  // namespace raster_stage
 }  // namespace saresgs

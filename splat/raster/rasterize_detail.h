@@ -31,9 +31,8 @@ RenderOutputT<T> rasterizeT(const GaussiansT<T>& g, const Camera& cam, const Ras
 // Adds dL/dparams to `grad` for dL/drgb (3 per pixel); grad_mean2d (2 per Gaussian,
 // pixels) is added to when given.
 template <typename T>
-void rasterizeBackwardT(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& s,
-                        const RenderOutputT<T>& fwd, const T* dL_drgb, GaussiansT<T>& grad,
-                        std::vector<T>* grad_mean2d = nullptr);
+void rasterizeBackwardT(const GaussiansT<T>& g, const Camera& cam, const RasterSettings& s, const RenderOutputT<T>& fwd,
+                        const T* dL_drgb, GaussiansT<T>& grad, std::vector<T>* grad_mean2d = nullptr);
 
 // Adds, per parameter, sum over pixels of (d(C_r + C_g + C_b)/dparam)^2 to `sq`
 // (FisherRF's diagonal information; rotations are left untouched).

@@ -35,7 +35,7 @@ Eigen::Matrix3d rotationOf(const double* q_in) {
   const double w = q[0] / n, x = q[1] / n, y = q[2] / n, z = q[3] / n;
   Eigen::Matrix3d R;
   R << 1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),  //
-      2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),    //
+      2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),   //
       2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y);
   return R;
 }
@@ -43,19 +43,18 @@ Eigen::Matrix3d rotationOf(const double* q_in) {
 // One Gaussian after rules 1-5.
 struct Projected {
   int index = 0;
-  double z = 0;                  // camera-frame depth of the mean
-  double mu_x = 0, mu_y = 0;     // 2D mean in pixels
-  double ca = 0, cb = 0, cc = 0; // inverse of Sigma2D: [[ca, cb], [cb, cc]]
-  double hx = 0, hy = 0;         // half sizes of the screen rectangle
+  double z = 0;                   // camera-frame depth of the mean
+  double mu_x = 0, mu_y = 0;      // 2D mean in pixels
+  double ca = 0, cb = 0, cc = 0;  // inverse of Sigma2D: [[ca, cb], [cb, cc]]
+  double hx = 0, hy = 0;          // half sizes of the screen rectangle
   double opacity = 0;
   double color[3] = {0, 0, 0};
 };
 
 void checkSize(const std::vector<double>& a, std::size_t expected, const char* name) {
   if (a.size() != expected)
-    throw std::invalid_argument(std::string("referenceRender: ") + name + " has " +
-                                std::to_string(a.size()) + " values, expected " +
-                                std::to_string(expected));
+    throw std::invalid_argument(std::string("referenceRender: ") + name + " has " + std::to_string(a.size()) +
+                                " values, expected " + std::to_string(expected));
 }
 
 }  // namespace
@@ -128,8 +127,7 @@ ReferenceImage referenceRender(const GaussiansD& g, const Camera& cam, const Ras
         detM += minor * minor;
       }
     const double det = detM + eps2d * (Mc(0, 0) + Mc(1, 1)) + eps2d * eps2d;
-    if (!(det > 0) || !std::isfinite(det) || !std::isfinite(a) || !std::isfinite(b) ||
-        !std::isfinite(c))
+    if (!(det > 0) || !std::isfinite(det) || !std::isfinite(a) || !std::isfinite(b) || !std::isfinite(c))
       continue;  // degenerate (eps2d = 0) or overflowed: nothing sensible to draw
 
     Projected P;
@@ -152,8 +150,7 @@ ReferenceImage referenceRender(const GaussiansD& g, const Camera& cam, const Ras
       const double lambda_max = mid + std::sqrt(std::max(mid * mid - det, 0.0));
       P.hx = P.hy = 3.0 * std::sqrt(lambda_max);
     }
-    if (!(P.mu_x + P.hx >= 0 && P.mu_x - P.hx <= W && P.mu_y + P.hy >= 0 &&
-          P.mu_y - P.hy <= H))
+    if (!(P.mu_x + P.hx >= 0 && P.mu_x - P.hx <= W && P.mu_y + P.hy >= 0 && P.mu_y - P.hy <= H))
       continue;  // the rectangle misses the image [0, W] x [0, H]
 
     // Rule 5, along the world-frame direction from the camera centre.
@@ -164,8 +161,7 @@ ReferenceImage referenceRender(const GaussiansD& g, const Camera& cam, const Ras
     shBasis<double>(s.sh_degree, d.x(), d.y(), d.z(), basis);
     for (int ch = 0; ch < 3; ++ch) {
       double v = 0.5;
-      for (int k = 0; k < shCoeffCount(s.sh_degree); ++k)
-        v += g.sh[(i * K + k) * 3 + ch] * basis[k];
+      for (int k = 0; k < shCoeffCount(s.sh_degree); ++k) v += g.sh[(i * K + k) * 3 + ch] * basis[k];
       P.color[ch] = std::max(v, 0.0);
     }
 

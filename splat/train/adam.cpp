@@ -35,8 +35,8 @@ inline void adamValue(float& p, float g, float& m, float& v, float step, const A
 
 // n contiguous values with one step (lr / bc1).
 // `clear`: each gradient value is set to zero once read (g is written only then).
-SARESGS_ADAM_CLONES void adamSpan(float* __restrict p, float* __restrict g, float* __restrict m,
-                                  float* __restrict v, std::size_t n, float step, const AdamCoeffs& c, bool clear) {
+SARESGS_ADAM_CLONES void adamSpan(float* __restrict p, float* __restrict g, float* __restrict m, float* __restrict v,
+                                  std::size_t n, float step, const AdamCoeffs& c, bool clear) {
   if (clear) {
     for (std::size_t i = 0; i < n; ++i) {
       adamValue(p[i], g[i], m[i], v[i], step, c);
@@ -50,9 +50,8 @@ SARESGS_ADAM_CLONES void adamSpan(float* __restrict p, float* __restrict g, floa
 // `rows` rows of kShPer values, value k of each with its own step steps[k] (the SH array:
 // DC and the higher bands): one loop over a row's values rather than two short ones.
 constexpr std::size_t kShPer = 48;
-SARESGS_ADAM_CLONES void adamRows(float* __restrict p, float* __restrict g, float* __restrict m,
-                                  float* __restrict v, std::size_t rows, const float* __restrict steps,
-                                  const AdamCoeffs& c, bool clear) {
+SARESGS_ADAM_CLONES void adamRows(float* __restrict p, float* __restrict g, float* __restrict m, float* __restrict v,
+                                  std::size_t rows, const float* __restrict steps, const AdamCoeffs& c, bool clear) {
   for (std::size_t r = 0; r < rows; ++r) {
     const std::size_t b = r * kShPer;
     for (std::size_t k = 0; k < kShPer; ++k) adamValue(p[b + k], g[b + k], m[b + k], v[b + k], steps[k], c);
@@ -100,22 +99,19 @@ void adamUpdate(Gaussians& params, const Gaussians& grad, AdamState& s, const Le
   // instead of five; each value sees the same operations).
   const float lr_scale = c.inv_bc1;
   const std::size_t per_sh = static_cast<std::size_t>(params.shCoeffs()) * 3;
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, params.size(), 1024),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      const FloatEnvGuard fenv;  // geometry/float_env.h
-                      const std::size_t b = r.begin(), e = r.end();
-                      const float sm = lr.means * lr_scale, ss = lr.log_scales * lr_scale;
-                      const float sr = lr.rotations * lr_scale, so = lr.opacities * lr_scale;
-                      adamBlock(params.means, grad.means, s.m.means, s.v.means, 3, 3, sm, sm, b, e, c, clear);
-                      adamBlock(params.log_scales, grad.log_scales, s.m.log_scales, s.v.log_scales, 3, 3, ss, ss, b,
-                                e, c, clear);
-                      adamBlock(params.rotations, grad.rotations, s.m.rotations, s.v.rotations, 4, 4, sr, sr, b, e, c,
-                                clear);
-                      adamBlock(params.opacities, grad.opacities, s.m.opacities, s.v.opacities, 1, 1, so, so, b, e, c,
-                                clear);
-                      adamBlock(params.sh, grad.sh, s.m.sh, s.v.sh, per_sh, 3, lr.sh_dc * lr_scale,
-                                lr.sh_rest * lr_scale, b, e, c, clear);
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, params.size(), 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+        const FloatEnvGuard fenv;  // geometry/float_env.h
+        const std::size_t b = r.begin(), e = r.end();
+        const float sm = lr.means * lr_scale, ss = lr.log_scales * lr_scale;
+        const float sr = lr.rotations * lr_scale, so = lr.opacities * lr_scale;
+        adamBlock(params.means, grad.means, s.m.means, s.v.means, 3, 3, sm, sm, b, e, c, clear);
+        adamBlock(params.log_scales, grad.log_scales, s.m.log_scales, s.v.log_scales, 3, 3, ss, ss, b, e, c, clear);
+        adamBlock(params.rotations, grad.rotations, s.m.rotations, s.v.rotations, 4, 4, sr, sr, b, e, c, clear);
+        adamBlock(params.opacities, grad.opacities, s.m.opacities, s.v.opacities, 1, 1, so, so, b, e, c, clear);
+        adamBlock(params.sh, grad.sh, s.m.sh, s.v.sh, per_sh, 3, lr.sh_dc * lr_scale, lr.sh_rest * lr_scale, b, e, c,
+                  clear);
+      });
 }
 
 }  // namespace

@@ -102,8 +102,8 @@ void accumulateDensifyStats(DensifyStats& st, const std::vector<float>& grad_mea
   });
 }
 
-DensifyReport densifyAndPrune(Gaussians& g, AdamState& adam, DensifyStats& st, const DensifyOptions& opt,
-                              double extent, bool prune_big, std::mt19937_64& rng) {
+DensifyReport densifyAndPrune(Gaussians& g, AdamState& adam, DensifyStats& st, const DensifyOptions& opt, double extent,
+                              bool prune_big, std::mt19937_64& rng) {
   DensifyReport rep;
   const std::size_t n = g.size();
   const float dense_limit = opt.percent_dense * static_cast<float>(extent);
@@ -150,11 +150,13 @@ DensifyReport densifyAndPrune(Gaussians& g, AdamState& adam, DensifyStats& st, c
   for (int s : split) drop[static_cast<std::size_t>(s)] = 1;
   for (std::size_t i = 0; i < idx.size(); ++i) {
     if (sigmoid(out.opacities[i]) < opt.min_opacity) drop[i] = 1;
-    if (prune_big && (radius[i] > opt.max_screen_radius || maxScale(out, i) > opt.max_world_scale * extent)) drop[i] = 1;
+    if (prune_big && (radius[i] > opt.max_screen_radius || maxScale(out, i) > opt.max_world_scale * extent))
+      drop[i] = 1;
     // A non-finite parameter can only come from a diverged step; such a Gaussian is dropped
     // rather than allowed to poison every render it touches.
     bool finite = std::isfinite(out.opacities[i]);
-    for (int a = 0; a < 3 && finite; ++a) finite = std::isfinite(out.means[3 * i + a]) && std::isfinite(out.log_scales[3 * i + a]);
+    for (int a = 0; a < 3 && finite; ++a)
+      finite = std::isfinite(out.means[3 * i + a]) && std::isfinite(out.log_scales[3 * i + a]);
     if (!finite) drop[i] = 1;
   }
   std::vector<int> keep;

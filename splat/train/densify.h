@@ -20,11 +20,11 @@ struct DensifyOptions {
   int until_iter = 15000;
   int interval = 100;
   int opacity_reset_interval = 3000;
-  float grad_threshold = 2e-4f;   // mean |dL/d mean2d| in NDC units
-  float percent_dense = 0.01f;    // clone below, split above this fraction of extent
-  float min_opacity = 0.005f;     // prune below
-  float max_screen_radius = 20;   // px; prunes only after the first opacity reset
-  float max_world_scale = 0.1f;   // fraction of extent; likewise
+  float grad_threshold = 2e-4f;  // mean |dL/d mean2d| in NDC units
+  float percent_dense = 0.01f;   // clone below, split above this fraction of extent
+  float min_opacity = 0.005f;    // prune below
+  float max_screen_radius = 20;  // px; prunes only after the first opacity reset
+  float max_world_scale = 0.1f;  // fraction of extent; likewise
   int split_count = 2;
   // 0: unlimited; otherwise no growth beyond it: when the candidates would exceed it, the
   // ones with the largest mean gradient are kept (keepLargestGradients).
@@ -39,9 +39,9 @@ struct DensifyOptions {
 
 // Per-Gaussian statistics gathered between densification steps.
 struct DensifyStats {
-  std::vector<float> grad_accum;   // sum of |2D-mean gradient| in NDC units
-  std::vector<std::int32_t> count; // iterations in which the Gaussian was visible
-  std::vector<float> max_radius;   // px
+  std::vector<float> grad_accum;    // sum of |2D-mean gradient| in NDC units
+  std::vector<std::int32_t> count;  // iterations in which the Gaussian was visible
+  std::vector<float> max_radius;    // px
   void resize(std::size_t n) {
     grad_accum.assign(n, 0.0f);
     count.assign(n, 0);
@@ -51,9 +51,8 @@ struct DensifyStats {
 
 // Adds one iteration's statistics. grad_mean2d is in pixels (2 per Gaussian); the NDC
 // gradient is that times (W/2, H/2), the unit 3DGS's threshold is given in.
-void accumulateDensifyStats(DensifyStats& st, const std::vector<float>& grad_mean2d,
-                            std::span<const float> radii, std::span<const std::uint8_t> visible, int width,
-                            int height);
+void accumulateDensifyStats(DensifyStats& st, const std::vector<float>& grad_mean2d, std::span<const float> radii,
+                            std::span<const std::uint8_t> visible, int width, int height);
 
 // Under the cap (opt.max_gaussians, the model holding n): keeps, of the clone and split
 // candidates, those with the largest mean 2D gradient (ties to the lower index) whose
@@ -70,8 +69,8 @@ struct DensifyReport {
 // Clones, splits, then prunes. New Gaussians get zero Adam moments (as 3DGS appends
 // them to the optimiser); the stats are reset for the new model. `prune_big` enables
 // the screen- and world-size pruning (3DGS: after the first opacity reset).
-DensifyReport densifyAndPrune(Gaussians& g, AdamState& adam, DensifyStats& st, const DensifyOptions& opt,
-                              double extent, bool prune_big, std::mt19937_64& rng);
+DensifyReport densifyAndPrune(Gaussians& g, AdamState& adam, DensifyStats& st, const DensifyOptions& opt, double extent,
+                              bool prune_big, std::mt19937_64& rng);
 
 // Opacity <- min(opacity, 0.01), with its Adam moments zeroed (3DGS's reset).
 void resetOpacity(Gaussians& g, AdamState& adam, float ceiling = 0.01f);

@@ -108,7 +108,8 @@ std::vector<double> meanSquaredKnnDistance(const std::vector<Eigen::Vector3d>& p
 
 Gaussians gaussiansFromPoints(const std::vector<ColoredPoint>& pts, int max_sh_degree, float initial_opacity) {
   if (pts.empty()) throw std::invalid_argument("gaussiansFromPoints: no points");
-  if (max_sh_degree < 0 || max_sh_degree > 3) throw std::invalid_argument("gaussiansFromPoints: SH degree must be 0..3");
+  if (max_sh_degree < 0 || max_sh_degree > 3)
+    throw std::invalid_argument("gaussiansFromPoints: SH degree must be 0..3");
   std::vector<Eigen::Vector3d> xyz(pts.size());
   for (std::size_t i = 0; i < pts.size(); ++i) xyz[i] = pts[i].xyz;
   const std::vector<double> d2 = meanSquaredKnnDistance(xyz);
@@ -130,7 +131,8 @@ Gaussians gaussiansFromPoints(const std::vector<ColoredPoint>& pts, int max_sh_d
   return g;
 }
 
-std::vector<ColoredPoint> randomPointsInBall(const Eigen::Vector3d& center, double radius, int n, std::mt19937_64& rng) {
+std::vector<ColoredPoint> randomPointsInBall(const Eigen::Vector3d& center, double radius, int n,
+                                             std::mt19937_64& rng) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   std::vector<ColoredPoint> out;
   out.reserve(static_cast<std::size_t>(std::max(n, 0)));

@@ -24,8 +24,7 @@ struct ColoredPoint {
 std::vector<double> meanSquaredKnnDistance(const std::vector<Eigen::Vector3d>& pts, int k = 3);
 
 // Throws std::invalid_argument for an empty point list or a negative degree.
-Gaussians gaussiansFromPoints(const std::vector<ColoredPoint>& pts, int max_sh_degree,
-                              float initial_opacity = 0.1f);
+Gaussians gaussiansFromPoints(const std::vector<ColoredPoint>& pts, int max_sh_degree, float initial_opacity = 0.1f);
 
 // n points uniform in the ball of `radius` about `center` (rejection sampling from its
 // cube), grey (0.5): 3DGS's synthetic-scene init draws its colours as SH coefficients in

@@ -21,7 +21,9 @@ struct MemoryEstimate {
   int views = 0, largest_width = 0, largest_height = 0;
 
   double fixedBytes() const { return image_bytes + buffer_bytes + process_bytes; }
-  double modelBytes(std::size_t gaussians) const { return models * bytes_per_gaussian * static_cast<double>(gaussians); }
+  double modelBytes(std::size_t gaussians) const {
+    return models * bytes_per_gaussian * static_cast<double>(gaussians);
+  }
   double bytesFor(std::size_t gaussians) const { return fixedBytes() + modelBytes(gaussians); }
   // The most Gaussians whose run fits in `budget` bytes (0 when the fixed part does not).
   std::size_t gaussiansWithin(double budget) const;

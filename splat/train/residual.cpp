@@ -25,10 +25,14 @@ UncertaintyRanking parseUncertaintyRanking(const std::string& s) {
 
 const char* toString(UncertaintyRanking r) {
   switch (r) {
-    case UncertaintyRanking::kBoth: return "both";
-    case UncertaintyRanking::kOpacity: return "opacity";
-    case UncertaintyRanking::kScale: return "scale";
-    case UncertaintyRanking::kRandom: return "random";
+    case UncertaintyRanking::kBoth:
+      return "both";
+    case UncertaintyRanking::kOpacity:
+      return "opacity";
+    case UncertaintyRanking::kScale:
+      return "scale";
+    case UncertaintyRanking::kRandom:
+      return "random";
   }
   return "?";
 }
@@ -150,14 +154,16 @@ float scaleKey(const Gaussians& g, int i) {
 std::vector<int> lowestOpacity(const Gaussians& g, double fraction) {
   SubsetScratch sc;
   std::vector<int> out;
-  topBy(g.size(), fraction, [&](int i) { return opacityKey(g, i); }, sc, out);
+  topBy(
+      g.size(), fraction, [&](int i) { return opacityKey(g, i); }, sc, out);
   return out;
 }
 
 std::vector<int> largestScale(const Gaussians& g, double fraction) {
   SubsetScratch sc;
   std::vector<int> out;
-  topBy(g.size(), fraction, [&](int i) { return scaleKey(g, i); }, sc, out);
+  topBy(
+      g.size(), fraction, [&](int i) { return scaleKey(g, i); }, sc, out);
   return out;
 }
 
@@ -167,8 +173,7 @@ ResidualSubset selectResidualSubset(const Gaussians& g, const ResidualOptions& o
   return out;
 }
 
-void selectResidualSubset(const Gaussians& g, const ResidualOptions& opt, std::mt19937_64& rng,
-                          ResidualSubset& out) {
+void selectResidualSubset(const Gaussians& g, const ResidualOptions& opt, std::mt19937_64& rng, ResidualSubset& out) {
   const std::size_t n = g.size();
   out.mask.assign(n, 0);
   out.random.clear();
@@ -197,9 +202,14 @@ void selectResidualSubset(const Gaussians& g, const ResidualOptions& opt, std::m
           topBy(n, opt.beta, scale, sc, sc.b);
           std::set_union(sc.a.begin(), sc.a.end(), sc.b.begin(), sc.b.end(), std::back_inserter(out.uncertain));
           break;
-        case UncertaintyRanking::kOpacity: topBy(n, 2 * opt.beta, opacity, sc, out.uncertain); break;
-        case UncertaintyRanking::kScale: topBy(n, 2 * opt.beta, scale, sc, out.uncertain); break;
-        case UncertaintyRanking::kRandom: break;  // above
+        case UncertaintyRanking::kOpacity:
+          topBy(n, 2 * opt.beta, opacity, sc, out.uncertain);
+          break;
+        case UncertaintyRanking::kScale:
+          topBy(n, 2 * opt.beta, scale, sc, out.uncertain);
+          break;
+        case UncertaintyRanking::kRandom:
+          break;  // above
       }
     });
   }

@@ -38,8 +38,7 @@ struct ResidualSubset {
 ResidualSubset selectResidualSubset(const Gaussians& g, const ResidualOptions& opt, std::mt19937_64& rng);
 // The same into `into`, whose arrays are reused (the ranking's scratch is kept per
 // thread): no allocation once the model's size has been seen.
-void selectResidualSubset(const Gaussians& g, const ResidualOptions& opt, std::mt19937_64& rng,
-                          ResidualSubset& into);
+void selectResidualSubset(const Gaussians& g, const ResidualOptions& opt, std::mt19937_64& rng, ResidualSubset& into);
 
 // The top round(fraction n) Gaussians of one ranking: lowest opacity logit, or largest
 // maximum log-scale.

@@ -68,7 +68,9 @@ constexpr char kMagic[8] = {'S', 'A', 'R', 'C', 'K', 'P', 'T', '1'};
 struct Writer {
   std::ostream& os;
   template <typename T>
-  void pod(const T& v) { os.write(reinterpret_cast<const char*>(&v), sizeof(T)); }
+  void pod(const T& v) {
+    os.write(reinterpret_cast<const char*>(&v), sizeof(T));
+  }
   template <typename T>
   void vec(const std::vector<T>& v) {
     pod<std::uint64_t>(v.size());
@@ -277,7 +279,8 @@ const ImageF& Trainer::randomBackgroundTarget(int view, RasterSettings& s) {
   random_target_ = composited;
   if (alpha) {
     float shift[3];
-    for (int c = 0; c < 3; ++c) shift[c] = s.background[static_cast<std::size_t>(c)] - scene_.load.background[static_cast<std::size_t>(c)];
+    for (int c = 0; c < 3; ++c)
+      shift[c] = s.background[static_cast<std::size_t>(c)] - scene_.load.background[static_cast<std::size_t>(c)];
     for (std::size_t p = 0; p < alpha->data.size(); ++p) {
       const float clear = 1.0f - alpha->data[p] * (1.0f / 255.0f);
       for (int c = 0; c < 3; ++c) random_target_.data[3 * p + static_cast<std::size_t>(c)] += clear * shift[c];
@@ -333,14 +336,15 @@ double Trainer::step(int view) {
   if (stats_.count.size() != g_.size()) stats_.resize(g_.size());
   // The gradient is zero here: the last step's Adam cleared it as it read it
   // (adamStepClearingGradient), unless that step stopped before Adam or the model changed.
-  if (grad_.size() != g_.size() || grad_.max_sh_degree != g_.max_sh_degree) grad_ = g_.zerosLike();
+  if (grad_.size() != g_.size() || grad_.max_sh_degree != g_.max_sh_degree)
+    grad_ = g_.zerosLike();
   else if (!grad_cleared_)
     grad_.forEachArray([](std::vector<float>& a, std::size_t) { std::fill(a.begin(), a.end(), 0.0f); });
   grad_cleared_ = false;
   grad2d_.assign(2 * g_.size(), 0.0f);
 
-  const ViewLoss vl =
-      viewLossAndGradient(g_, cam, s, gt, opt_.lambda_ssim, opt_.residual, rng_, grad_, grad2d_, seconds_, step_buffers_);
+  const ViewLoss vl = viewLossAndGradient(g_, cam, s, gt, opt_.lambda_ssim, opt_.residual, rng_, grad_, grad2d_,
+                                          seconds_, step_buffers_);
   const double loss = vl.loss;
   if (!std::isfinite(loss))
     throw TrainingDiverged(iteration_, view, scene_.views.at(static_cast<std::size_t>(view)).name, "loss",
@@ -439,8 +443,9 @@ void Trainer::loadCheckpoint(const std::string& path) {
   r.pos = sizeof(kMagic);
   const auto views = r.pod<std::uint64_t>("views");
   if (views != scene_.views.size())
-    throw InputError(path, "views", "written for a scene with " + std::to_string(views) + " views, this one has " +
-                                        std::to_string(scene_.views.size()));
+    throw InputError(path, "views",
+                     "written for a scene with " + std::to_string(views) + " views, this one has " +
+                         std::to_string(scene_.views.size()));
   const int iteration = r.pod<std::int32_t>("iteration");
   if (iteration < 0) throw InputError(path, "iteration", std::to_string(iteration) + " is negative");
   const double ema = r.pod<double>("loss_ema");
@@ -460,8 +465,9 @@ void Trainer::loadCheckpoint(const std::string& path) {
       v.max_sh_degree != g.max_sh_degree)
     throw InputError(path, "adam", "moments do not match the model's shape");
   if (g.max_sh_degree != opt_.max_sh_degree)
-    throw InputError(path, "gaussians", "SH degree " + std::to_string(g.max_sh_degree) + " differs from the trainer's " +
-                                            std::to_string(opt_.max_sh_degree));
+    throw InputError(path, "gaussians",
+                     "SH degree " + std::to_string(g.max_sh_degree) + " differs from the trainer's " +
+                         std::to_string(opt_.max_sh_degree));
   const auto step = r.pod<std::int64_t>("adam.step");
   if (step < 0) throw InputError(path, "adam.step", "negative");
   // NaN or infinity in the model or its moments would poison every later step.

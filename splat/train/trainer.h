@@ -39,7 +39,7 @@ struct TrainerOptions {
   int means_lr_steps = 30000;
   DensifyOptions densify;
   ResidualOptions residual;
-  RasterSettings raster;           // sh_degree is set by the schedule
+  RasterSettings raster;  // sh_degree is set by the schedule
   double lambda_ssim = 0.2;
   int random_init_points = 100000;  // used when the scene has no sparse points (3DGS's count)
   float initial_opacity = 0.1f;
@@ -59,7 +59,9 @@ class TrainingDiverged : public std::runtime_error {
       : std::runtime_error("training diverged at iteration " + std::to_string(iteration) + " (view " +
                            std::to_string(view) + ", " + view_name + "): " + what + " " + detail +
                            "; lower the learning rates (--schedule-scale, or the preset), or check the data"),
-        iteration(iteration), view(view), what_(what) {}
+        iteration(iteration),
+        view(view),
+        what_(what) {}
   int iteration, view;
   const std::string& quantity() const { return what_; }
 
@@ -73,7 +75,7 @@ struct StageSeconds {
 };
 
 struct TrainProgress {
-  int iteration = 0;  // since the last reset
+  int iteration = 0;        // since the last reset
   int done = 0, total = 0;  // within this train() call
   double loss = 0;          // this iteration's loss
   double loss_ema = 0;      // 0.4 / 0.6 moving average, as 3DGS displays it
@@ -118,9 +120,8 @@ struct ViewLoss {
   std::span<const std::uint8_t> visible;
 };
 ViewLoss viewLossAndGradient(const Gaussians& g, const Camera& cam, const RasterSettings& s, const ImageF& target,
-                             double lambda_ssim, const ResidualOptions& residual, std::mt19937_64& rng,
-                             Gaussians& grad, std::vector<float>& grad_mean2d, StageSeconds& seconds,
-                             StepBuffers& buffers);
+                             double lambda_ssim, const ResidualOptions& residual, std::mt19937_64& rng, Gaussians& grad,
+                             std::vector<float>& grad_mean2d, StageSeconds& seconds, StepBuffers& buffers);
 
 // 3DGS's position learning rate at `iteration`: log-linear from lr.means * extent to
 // means_lr_final * extent over means_lr_steps iterations, then constant.
@@ -194,8 +195,8 @@ class Trainer {
   DensifyReport last_densify_;
   std::mt19937_64 rng_;
   int iteration_ = 0;
-  int plan_end_ = 0;      // iteration at which the current training plan ends
-  int planned_until_ = 0; // planUntil()'s value; 0: none
+  int plan_end_ = 0;       // iteration at which the current training plan ends
+  int planned_until_ = 0;  // planUntil()'s value; 0: none
   double loss_ema_ = 0;
   std::vector<int> view_set_, view_stack_;
   // The current step's view as float, converted from the scene's 8-bit image into one

@@ -12,8 +12,8 @@
 #include "common/test_support.h"
 #include "geometry/image/image.h"
 
-using saresgs::test::TempDir;
 using saresgs::test::readBytes;
+using saresgs::test::TempDir;
 using saresgs::test::writeBytes;
 namespace fs = std::filesystem;
 
@@ -36,7 +36,8 @@ int count(const std::string& s, const std::string& what) {
 std::string writeGrid(const TempDir& d) {
   const std::string grid = d.file("grid.json");
   writeBytes(grid, R"({
-    "scenes": [{"name": "tiny", "dataset": ")" + d.file("tiny") + R"(", "layout": "object"}],
+    "scenes": [{"name": "tiny", "dataset": ")" +
+                       d.file("tiny") + R"(", "layout": "object"}],
     "methods": ["random", "fvs"],
     "seeds": [0, 1],
     "threads": 1,
@@ -62,9 +63,9 @@ TEST(AblateCli, TwoShardsAndAMergeMakeTablesAndPlots) {
   EXPECT_NE(r.output.find("saresgs active --dataset"), std::string::npos) << r.output;
 
   // Two processes at once, each writing its own folder, as two machines would.
-  r = shell(cli() + " ablate --config " + grid + " --out " + a + " --shard 0/2 > " + d.file("log0") + " 2>&1 & " + cli() +
-            " ablate --config " + grid + " --out " + b + " --shard 1/2 > " + d.file("log1") + " 2>&1; s1=$?; wait $!; s0=$?; " +
-            "exit $((s0 + s1))");
+  r = shell(cli() + " ablate --config " + grid + " --out " + a + " --shard 0/2 > " + d.file("log0") + " 2>&1 & " +
+            cli() + " ablate --config " + grid + " --out " + b + " --shard 1/2 > " + d.file("log1") +
+            " 2>&1; s1=$?; wait $!; s0=$?; " + "exit $((s0 + s1))");
   ASSERT_EQ(r.code, 0) << readBytes(d.file("log0")) << readBytes(d.file("log1"));
   EXPECT_NE(readBytes(d.file("log1")).find("ablate merge"), std::string::npos);  // the shard says what comes next
 
@@ -91,7 +92,8 @@ TEST(AblateCli, TwoShardsAndAMergeMakeTablesAndPlots) {
   EXPECT_EQ(count(sweep, "| tiny |"), 2 * 2 * 3) << sweep;  // sets x scores x encodings
   // The object layout sweeps the outdoor grid (m = 2), and says so with each hash's load.
   EXPECT_NE(sweep.find("| tiny | outdoor r64 m2, "), std::string::npos) << sweep;
-  for (const char* p : {"psnr", "final_fit_psnr", "final_fit_per_view", "psnr_vs_views", "psnr_vs_selection_time", "prefilter_sweep_tiny"}) {
+  for (const char* p : {"psnr", "final_fit_psnr", "final_fit_per_view", "psnr_vs_views", "psnr_vs_selection_time",
+                        "prefilter_sweep_tiny"}) {
     const saresgs::Image8 img = saresgs::readImage(a + "/plots/" + p + ".png");
     EXPECT_GT(img.width, 100) << p;
   }
@@ -104,8 +106,9 @@ TEST(AblateCli, AKilledRunnerRestartsWithoutRedoingFinishedJobs) {
   const std::string out = d.file("out");
   // Kill the runner (SIGKILL, no clean-up) as soon as its second job has finished.
   const std::string second = out + "/runs/tiny__random__default__s0/results.json";
-  Result r = shell(cli() + " ablate --config " + grid + " --out " + out + " > " + d.file("log") + " 2>&1 & pid=$!; " +
-                   "for i in $(seq 1 600); do [ -f " + second + " ] && break; sleep 0.1; done; kill -9 $pid; wait $pid; true");
+  Result r =
+      shell(cli() + " ablate --config " + grid + " --out " + out + " > " + d.file("log") + " 2>&1 & pid=$!; " +
+            "for i in $(seq 1 600); do [ -f " + second + " ] && break; sleep 0.1; done; kill -9 $pid; wait $pid; true");
   ASSERT_TRUE(fs::exists(second)) << readBytes(d.file("log"));
   const auto sweep_file = out + "/runs/tiny__prefilter-sweep/sweep.json";
   ASSERT_TRUE(fs::exists(sweep_file));
@@ -147,7 +150,9 @@ TEST(AblateCli, GnuParallelShardsIntoOneFolderThenMerge) {
     results += e.path().filename() == "results.json" || e.path().filename() == "sweep.json";
   EXPECT_EQ(results, 5);
   EXPECT_TRUE(fs::exists(out + "/tables/paired.csv"));
-  EXPECT_EQ(readBytes(out + "/tables/paired.csv").rfind("scene,method,baseline,metric,mean_diff,ci_low,ci_high,n,win_rate\n", 0), 0u);
+  EXPECT_EQ(readBytes(out + "/tables/paired.csv")
+                .rfind("scene,method,baseline,metric,mean_diff,ci_low,ci_high,n,win_rate\n", 0),
+            0u);
 }
 
 // Two runners of the whole grid on one folder at once (a shard started twice, an array
@@ -158,8 +163,8 @@ TEST(AblateCli, TwoRunnersOnOneFolderRunEachJobOnceWhileMergesRun) {
   TempDir d;
   const std::string grid = writeGrid(d);
   const std::string out = d.file("out"), clean = d.file("clean");
-  Result r = shell(cli() + " ablate --config " + grid + " --out " + out + " > " + d.file("logA") + " 2>&1 & a=$!; " + cli() +
-                   " ablate --config " + grid + " --out " + out + " > " + d.file("logB") + " 2>&1 & b=$!; " +
+  Result r = shell(cli() + " ablate --config " + grid + " --out " + out + " > " + d.file("logA") + " 2>&1 & a=$!; " +
+                   cli() + " ablate --config " + grid + " --out " + out + " > " + d.file("logB") + " 2>&1 & b=$!; " +
                    "while kill -0 $a 2>/dev/null || kill -0 $b 2>/dev/null; do " + cli() + " ablate merge --config " +
                    grid + " --out " + out + " --allow-partial > /dev/null 2>&1 || exit 9; sleep 0.3; done; " +
                    "wait $a; sa=$?; wait $b; exit $((sa + $?))");
@@ -189,10 +194,12 @@ TEST(AblateCli, JobArgumentsAreCheckedWhenTheConfigIsRead) {
            {R"("variants": [{"name": "v", "args": ["--iterations", "300"]}])", "variants[0].args", "--min-iterations"},
            {R"("method_args": {"fvs": ["--fisher-lambda", "-1"]})", "method_args.fvs", "--fisher-lambda"},
            {R"("method_args": {"random": ["--prefilter-set", "sphere"]})", "method_args.random", "sphere"},
-           {R"("variants": [{"name": "v", "methods": ["fvs"], "args": ["--residual-ranking", "colour"]}])", "variants[0].args", "colour"},
+           {R"("variants": [{"name": "v", "methods": ["fvs"], "args": ["--residual-ranking", "colour"]}])",
+            "variants[0].args", "colour"},
        }) {
     writeBytes(grid, R"({"scenes": [{"name": "s", "dataset": ")" + d.file("s") + R"(", "layout": "object"}],
-                        "methods": ["random", "fvs"], )" + extra + "}");
+                        "methods": ["random", "fvs"], )" +
+                         extra + "}");
     for (const std::string& cmd : {" ablate --config " + grid + " --out " + d.file("o"),
                                    " ablate --config " + grid + " --out " + d.file("o") + " --list",
                                    " ablate merge --config " + grid + " --out " + d.file("o")}) {
@@ -214,21 +221,26 @@ TEST(AblateCli, JobArgumentsAreCheckedWhenTheConfigIsRead) {
 TEST(AblateCli, AReplayVariantTrainsOnTheReplayedRunsViewsOnceThatRunIsFinished) {
   TempDir d;
   const std::string grid = d.file("grid.json");
-  const std::string small = R"("--max-views", "5", "--interval", "3", "--min-iterations", "30", "--final-iterations", "20")";
+  const std::string small =
+      R"("--max-views", "5", "--interval", "3", "--min-iterations", "30", "--final-iterations", "20")";
   writeBytes(grid, R"({
-    "scenes": [{"name": "tiny", "dataset": ")" + d.file("tiny") + R"(", "layout": "object"}],
+    "scenes": [{"name": "tiny", "dataset": ")" +
+                       d.file("tiny") + R"(", "layout": "object"}],
     "methods": ["resgs", "fisher"],
     "seeds": [0],
     "threads": 1,
-    "variants": [{"name": "default", "args": [)" + small + R"(]},
-                 {"name": "replay-fisher", "methods": ["resgs"], "replay": "fisher", "args": [)" + small + R"(]}]
+    "variants": [{"name": "default", "args": [)" +
+                       small + R"(]},
+                 {"name": "replay-fisher", "methods": ["resgs"], "replay": "fisher", "args": [)" +
+                       small + R"(]}]
   })");
   Result r = shell(cli() + " scene --layout object --views 12 --width 64 --height 48 --out " + d.file("tiny"));
   ASSERT_EQ(r.code, 0) << r.output;
   const std::string out = d.file("o");
   r = shell(cli() + " ablate --config " + grid + " --out " + out + " --list");
   ASSERT_EQ(r.code, 0) << r.output;
-  EXPECT_NE(r.output.find("--replay " + out + "/runs/tiny__fisher__default__s0/results.json"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("--replay " + out + "/runs/tiny__fisher__default__s0/results.json"), std::string::npos)
+      << r.output;
   r = shell(cli() + " ablate --config " + grid + " --out " + out + " 2>&1");
   ASSERT_EQ(r.code, 0) << r.output;
   // fisher ran before the replay, though listed after it.

@@ -49,8 +49,10 @@ TEST(Architecture, RoomsIncludeOnlyWhatIsBelowThem) {
   for (const auto& [room, forbidden] : std::vector<std::pair<std::string, std::vector<std::string>>>{
            {"geometry", {"splat/", "nbv/", "report/", "apps/", "python/", "fuzz/"}},
            {"splat", {"nbv/", "report/", "apps/", "python/", "fuzz/"}},
-           {"nbv", {"report/", "apps/", "python/", "fuzz/"}}, {"report", {"apps/", "python/", "fuzz/"}},
-           {"apps", {"python/"}}, {"python", {"apps/"}}})
+           {"nbv", {"report/", "apps/", "python/", "fuzz/"}},
+           {"report", {"apps/", "python/", "fuzz/"}},
+           {"apps", {"python/"}},
+           {"python", {"apps/"}}})
     for (const fs::path& f : sources(room))
       for (const std::string& i : includes(f)) {
         ++checked;
@@ -120,7 +122,7 @@ TEST(Architecture, DesignDocumentMapsThePaperToFilesThatExist) {
   }
   EXPECT_GT(paths, 20);
   for (const char* term : {"SA-Point", "triangulation", "upsampl", "dilat", "frustum", "visible", "hash", "XOR",
-                              "top-N", "Fisher", "residual", "AUSE", "protocol"})
+                           "top-N", "Fisher", "residual", "AUSE", "protocol"})
     EXPECT_NE(text.find(term), std::string::npos) << term;
 }
 

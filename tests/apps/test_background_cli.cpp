@@ -56,9 +56,21 @@ void toNerfstudio(const std::string& blender, const std::string& out, bool jpeg)
   fs::create_directories(fs::path(out) / "images");
   const saresgs::Scene b = saresgs::loadDataset(blender);
   const saresgs::Intrinsics& K = b.views[0].camera.K;
-  json ns = {{"camera_model", "OPENCV"}, {"k1", 0.0}, {"k2", 0.0}, {"p1", 0.0}, {"p2", 0.0}, {"fl_x", K.fx}, {"fl_y", K.fy},
-             {"cx", K.cx}, {"cy", K.cy}, {"w", K.width}, {"h", K.height}, {"ply_file_path", "sparse_pc.ply"},
-             {"frames", json::array()}, {"train_filenames", json::array()}, {"test_filenames", json::array()}};
+  json ns = {{"camera_model", "OPENCV"},
+             {"k1", 0.0},
+             {"k2", 0.0},
+             {"p1", 0.0},
+             {"p2", 0.0},
+             {"fl_x", K.fx},
+             {"fl_y", K.fy},
+             {"cx", K.cx},
+             {"cy", K.cy},
+             {"w", K.width},
+             {"h", K.height},
+             {"ply_file_path", "sparse_pc.ply"},
+             {"frames", json::array()},
+             {"train_filenames", json::array()},
+             {"test_filenames", json::array()}};
   const float white[3] = {1, 1, 1};
   for (const Frame& f : blenderFrames(blender)) {
     const std::string name = "images/" + fs::path(f.image).stem().string() + (jpeg ? ".jpg" : ".png");
@@ -135,10 +147,13 @@ TEST(BackgroundCli, AnObjectWrittenFourWaysTrainsToTheSamePsnr) {
   for (const Case& c : cases) {
     r = run("info --dataset " + d.file(c.folder) + " " + c.option);
     ASSERT_EQ(r.code, 0) << r.output;
-    EXPECT_NE(r.output.find("background: white (" + std::string(c.from) + ")"), std::string::npos) << c.folder << r.output;
-    EXPECT_EQ(r.output.find("the images have alpha but nothing says") != std::string::npos, c.warns) << c.folder << r.output;
+    EXPECT_NE(r.output.find("background: white (" + std::string(c.from) + ")"), std::string::npos)
+        << c.folder << r.output;
+    EXPECT_EQ(r.output.find("the images have alpha but nothing says") != std::string::npos, c.warns)
+        << c.folder << r.output;
     const std::string out = d.file(std::string("t_") + c.folder);
-    r = run("train --dataset " + d.file(c.folder) + " " + c.option + " --iterations 300 --seed 0 --threads 1 --out " + out);
+    r = run("train --dataset " + d.file(c.folder) + " " + c.option + " --iterations 300 --seed 0 --threads 1 --out " +
+            out);
     ASSERT_EQ(r.code, 0) << r.output;
     const json j = resultsOf(out);
     EXPECT_EQ(j["background"]["color"], json::array({1.0, 1.0, 1.0})) << c.folder;
@@ -150,7 +165,8 @@ TEST(BackgroundCli, AnObjectWrittenFourWaysTrainsToTheSamePsnr) {
               psnr["blender"], psnr["ns_rgba"], psnr["ns_jpeg"], psnr["colmap_rgba"]);
   EXPECT_GT(psnr["blender"], 20.0);
   for (const char* f : {"ns_rgba", "ns_jpeg", "colmap_rgba"})
-    EXPECT_NEAR(psnr[f], psnr["blender"], 0.3) << f << ": " << psnr[f] << " dB against the Blender folder's " << psnr["blender"];
+    EXPECT_NEAR(psnr[f], psnr["blender"], 0.3)
+        << f << ": " << psnr[f] << " dB against the Blender folder's " << psnr["blender"];
 
   // The bug this guards: the RGBA folder trained on black against targets on white. Said
   // black, the targets are composited on black too, and the run trains as well.
@@ -173,7 +189,8 @@ TEST(BackgroundCli, RandomBackgroundTrainsAnRgbaObjectNearlyAsWellAsWhite) {
   std::map<std::string, json> res;
   for (const char* bg : {"white", "random"}) {
     const std::string out = d.file(std::string("t_") + bg);
-    r = run("train --dataset " + d.file("blender") + " --background " + bg + " --iterations 300 --seed 0 --threads 1 --out " + out);
+    r = run("train --dataset " + d.file("blender") + " --background " + bg +
+            " --iterations 300 --seed 0 --threads 1 --out " + out);
     ASSERT_EQ(r.code, 0) << r.output;
     res[bg] = resultsOf(out);
   }
@@ -190,11 +207,13 @@ TEST(BackgroundCli, RandomBackgroundTrainsAnRgbaObjectNearlyAsWellAsWhite) {
 TEST(BackgroundCli, ABadBackgroundIsRefusedNamingTheOption) {
   TempDir d;
   for (const char* bad : {"purple", "1,1", "0.5,0.5,2", "0.5,,0.5", "nan,0,0", "1,1,1,1"}) {
-    for (const char* cmd : {"train --iterations 1 --out " , "active --out "}) {
-      const Result r = run(std::string(cmd) + d.file("o") + " --dataset " + d.file("none") + " --background '" + bad + "'");
+    for (const char* cmd : {"train --iterations 1 --out ", "active --out "}) {
+      const Result r =
+          run(std::string(cmd) + d.file("o") + " --dataset " + d.file("none") + " --background '" + bad + "'");
       EXPECT_NE(r.code, 0) << bad;
       EXPECT_NE(r.output.find("--background"), std::string::npos) << cmd << bad << ": " << r.output;
-      EXPECT_NE(r.output.find("expected white, black, random, or R,G,B"), std::string::npos) << cmd << bad << ": " << r.output;
+      EXPECT_NE(r.output.find("expected white, black, random, or R,G,B"), std::string::npos)
+          << cmd << bad << ": " << r.output;
     }
   }
   EXPECT_FALSE(fs::exists(d.file("o")));

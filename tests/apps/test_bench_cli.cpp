@@ -133,7 +133,8 @@ TEST(BenchCli, FisherKernelsFromTheEnvironment) {
 
 TEST(BenchCli, StepReportsAllocationsPageFaultsAndTheFloor) {
   nlohmann::json j;
-  ASSERT_TRUE(oneJsonLine(run("bench step --width 40 --height 32 --gaussians 300 --threads 1 --steps 3 --warmup 1"), j));
+  ASSERT_TRUE(
+      oneJsonLine(run("bench step --width 40 --height 32 --gaussians 300 --threads 1 --steps 3 --warmup 1"), j));
   EXPECT_GE(j.at("allocations_per_step").get<double>(), 0.0);
   EXPECT_GE(j.at("page_faults_per_step").get<double>(), 0.0);
   // Pairs are the contributors of every pixel; the floor is a positive time per pair and
@@ -186,7 +187,8 @@ TEST(BenchCli, TrainTimesRealIterationsByStageBesideTheSameSizeStep) {
   const nlohmann::json& p = j["plain"];
   for (const nlohmann::json* t : std::initializer_list<const nlohmann::json*>{&j, &p}) {
     double total = 0;
-    for (const char* k : {"render", "loss", "backward", "adam", "densify", "other"}) total += t->at("stage_ms").at(k).get<double>();
+    for (const char* k : {"render", "loss", "backward", "adam", "densify", "other"})
+      total += t->at("stage_ms").at(k).get<double>();
     EXPECT_NEAR(total, t->at("mean_iteration_ms").get<double>(), 1e-6 * (1 + total));
     EXPECT_GT(t->at("mean_iteration_ms").get<double>(), 0.0);
   }

@@ -102,18 +102,19 @@ TEST(Cli, TrainCoverageAndActiveOnASmallScene) {
   EXPECT_TRUE(fs::exists(d.path() / "t" / "test_renders" / "all.png"));
   ASSERT_TRUE(fs::exists(d.path() / "t" / "point_cloud.ply"));
 
-  r = run("coverage --dataset " + d.file("s") + " --views 0,3 --set visible --encoding exact --score new --resolution 32 --out " +
-          d.file("c"));
+  r = run("coverage --dataset " + d.file("s") +
+          " --views 0,3 --set visible --encoding exact --score new --resolution 32 --out " + d.file("c"));
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("observed"), std::string::npos) << r.output;
-  for (const char* f : {"coverage.json", "coverage.csv", "coverage.png"}) EXPECT_TRUE(fs::exists(d.path() / "c" / f)) << f;
+  for (const char* f : {"coverage.json", "coverage.csv", "coverage.png"})
+    EXPECT_TRUE(fs::exists(d.path() / "c" / f)) << f;
   // The trained model renders the extrapolated views just as well (datasets without truth).
-  r = run("coverage --dataset " + d.file("s") + " --views 0,3 --model " + d.file("t/point_cloud.ply") + " --resolution 32 --out " +
-          d.file("c2"));
+  r = run("coverage --dataset " + d.file("s") + " --views 0,3 --model " + d.file("t/point_cloud.ply") +
+          " --resolution 32 --out " + d.file("c2"));
   ASSERT_EQ(r.code, 0) << r.output;
 
-  r = run("active --dataset " + d.file("s") + " --method fvs --max-views 5 --interval 4 --min-iterations 40 --final-iterations 0 --out " +
-          d.file("a"));
+  r = run("active --dataset " + d.file("s") +
+          " --method fvs --max-views 5 --interval 4 --min-iterations 40 --final-iterations 0 --out " + d.file("a"));
   ASSERT_EQ(r.code, 0) << r.output;
   const std::string ar = saresgs::test::readBytes(d.file("a/results.json"));
   for (const char* key : {"\"psnr\"", "\"ssim\"", "\"ause\"", "\"selected_views\"", "\"seconds\""})
@@ -138,8 +139,8 @@ TEST(Cli, TrainCoverageAndActiveOnASmallScene) {
   }
   EXPECT_NE(r.output.find("peak resident memory"), std::string::npos) << r.output;
   // Running again into the same folder without --resume is refused (nothing overwritten).
-  r = run("active --dataset " + d.file("s") + " --method fvs --max-views 5 --interval 4 --min-iterations 40 --final-iterations 0 --out " +
-          d.file("a"));
+  r = run("active --dataset " + d.file("s") +
+          " --method fvs --max-views 5 --interval 4 --min-iterations 40 --final-iterations 0 --out " + d.file("a"));
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.output.find("--resume"), std::string::npos) << r.output;
 
@@ -235,7 +236,8 @@ TEST(Cli, FinalFitEqualsTrainOnTheChosenViews) {
   ASSERT_EQ(r.code, 0) << r.output;
   const nlohmann::json ftr = nlohmann::json::parse(saresgs::test::readBytes(d.file("ftr/results.json")));
   EXPECT_EQ(ftr["psnr"].get<double>(), fr["final_fit"]["psnr"].get<double>());
-  EXPECT_EQ(saresgs::test::readBytes(d.file("ftr/point_cloud.ply")), saresgs::test::readBytes(d.file("fr/final_fit.ply")));
+  EXPECT_EQ(saresgs::test::readBytes(d.file("ftr/point_cloud.ply")),
+            saresgs::test::readBytes(d.file("fr/final_fit.ply")));
   EXPECT_NE(fr["final_fit"]["psnr"].get<double>(), f["final_fit"]["psnr"].get<double>());
   // --no-plain-refit leaves the plain refit out (results.json, the table, the .ply) and
   // changes nothing else: the same views and the same final fit.

@@ -24,12 +24,15 @@ namespace {
 using Result = saresgs::test::CommandResult;
 
 // At most 60 s: a refusal is up front, so a timeout (exit 124) is a hang.
-Result run(const std::string& args) { return saresgs::test::runCommand("timeout 60 " + std::string(SARESGS_CLI) + " " + args); }
+Result run(const std::string& args) {
+  return saresgs::test::runCommand("timeout 60 " + std::string(SARESGS_CLI) + " " + args);
+}
 
 void expectRefused(const Result& r, const std::vector<std::string>& names, const std::string& what) {
   EXPECT_NE(r.code, 0) << what << ": " << r.output;
   EXPECT_NE(r.code, 124) << what << ": timed out";
-  for (const std::string& n : names) EXPECT_NE(r.output.find(n), std::string::npos) << what << ": no '" << n << "' in " << r.output;
+  for (const std::string& n : names)
+    EXPECT_NE(r.output.find(n), std::string::npos) << what << ": no '" << n << "' in " << r.output;
   for (const char* raw : {"type must be", "cannot use value()", "json.exception", "stoi", "stoll", "_M_range_check"})
     EXPECT_EQ(r.output.find(raw), std::string::npos) << what << ": " << r.output;
 }
@@ -52,7 +55,10 @@ std::string edited(const TempDir& d, const std::string& src, const std::string& 
 TEST(CliInputs, MalformedDatasetFilesNameTheFileAndField) {
   TempDir d;
   ASSERT_EQ(run("scene --layout object --views 12 --width 64 --height 48 --out " + d.file("s")).code, 0);
-  ASSERT_EQ(run("scene --layout object --views 12 --width 64 --height 48 --format blender --no-points --out " + d.file("b")).code, 0);
+  ASSERT_EQ(
+      run("scene --layout object --views 12 --width 64 --height 48 --format blender --no-points --out " + d.file("b"))
+          .code,
+      0);
 
   // Wrong JSON types (manifest, transforms).
   std::string ds = edited(d, "s", "m1", "manifest.json", [](json& j) { j["split"] = json::array({1, 2}); });
@@ -62,19 +68,21 @@ TEST(CliInputs, MalformedDatasetFilesNameTheFileAndField) {
   ds = edited(d, "b", "b1", "transforms_train.json", [](json& j) { j["camera_angle_x"] = "wide"; });
   expectRefused(run("info --dataset " + ds), {"transforms_train.json", "camera_angle_x"}, "camera_angle_x as a string");
   ds = edited(d, "b", "b2", "transforms_test.json", [](json& j) { j["frames"][0]["transform_matrix"][0] = "row"; });
-  expectRefused(run("info --dataset " + ds), {"transforms_test.json", "frames[0].transform_matrix[0]"}, "a matrix row as a string");
+  expectRefused(run("info --dataset " + ds), {"transforms_test.json", "frames[0].transform_matrix[0]"},
+                "a matrix row as a string");
 
   // Unbounded sizes: refused up front, with the limit.
   ds = edited(d, "s", "m3", "manifest.json", [](json& j) { j["num_views"] = 2e9; });
-  expectRefused(run("coverage --dataset " + ds + " --views 0,1 --out " + d.file("c")), {"manifest.json", "num_views", "100000"},
-                "num_views 2e9");
+  expectRefused(run("coverage --dataset " + ds + " --views 0,1 --out " + d.file("c")),
+                {"manifest.json", "num_views", "100000"}, "num_views 2e9");
   ds = edited(d, "s", "m4", "manifest.json", [](json& j) { j["height"] = 1e9; });
   expectRefused(run("info --dataset " + ds), {"manifest.json", "height", "65536"}, "height 1e9");
 
   // Silent acceptance: a size or count that disagrees with the cameras, a split name twice
   // or in both parts, an image listed twice in a Blender split, a width that would wrap.
   ds = edited(d, "s", "m5", "manifest.json", [](json& j) { j["width"] = 128; });
-  expectRefused(run("info --dataset " + ds), {"manifest.json", "width", "64 wide"}, "manifest width 128 for 64-wide cameras");
+  expectRefused(run("info --dataset " + ds), {"manifest.json", "width", "64 wide"},
+                "manifest width 128 for 64-wide cameras");
   ds = edited(d, "s", "m6", "manifest.json", [](json& j) { j["num_views"] = 11; });
   expectRefused(run("info --dataset " + ds), {"manifest.json", "num_views", "12 views"}, "num_views 11 for 12 views");
   ds = edited(d, "s", "m7", "manifest.json", [](json& j) { j["split"]["test"].push_back(j["split"]["train"][0]); });
@@ -113,18 +121,20 @@ TEST(CliInputs, OptionsAndCheckpointsNameTheOptionOrFieldAndTheRenamedIterations
   EXPECT_FALSE(fs::exists(d.path() / "t" / "results.json"));
 
   // The loop's least total was called --iterations, which read as an exact count.
-  expectRefused(run("active --dataset " + s + " --iterations 300 --out " + d.file("a")), {"--iterations", "--min-iterations"},
-                "--iterations");
+  expectRefused(run("active --dataset " + s + " --iterations 300 --out " + d.file("a")),
+                {"--iterations", "--min-iterations"}, "--iterations");
 
   // A corrupt active checkpoint: each field by name.
-  Result r = run("active --dataset " + s + " --method random --max-views 6 --interval 3 --min-iterations 10 --final-iterations 0 --out " +
-                 d.file("a"));
+  Result r =
+      run("active --dataset " + s +
+          " --method random --max-views 6 --interval 3 --min-iterations 10 --final-iterations 0 --out " + d.file("a"));
   ASSERT_EQ(r.code, 0) << r.output;
   const json results = readJson(d.file("a/results.json"));
   EXPECT_EQ(results["options"]["total_iterations"], 10);
   EXPECT_EQ(results["phase_iterations"], json::array({12, 15, 18}));  // 4, 5, 6 views x 3: more than 10
   EXPECT_EQ(results["iterations"], 45);
-  EXPECT_NE(r.output.find("45 iterations in the loop (12 + 15 + 18; at least 10 asked)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("45 iterations in the loop (12 + 15 + 18; at least 10 asked)"), std::string::npos)
+      << r.output;
   const json good = readJson(d.file("a/checkpoint.json"));
   for (const auto& [edit, field] : std::vector<std::pair<std::function<void(json&)>, std::string>>{
            {[](json& j) { j["selected"][2] = "7"; }, "selected[2]"},
@@ -136,8 +146,10 @@ TEST(CliInputs, OptionsAndCheckpointsNameTheOptionOrFieldAndTheRenamedIterations
     json j = good;
     edit(j);
     writeJson(d.file("a/checkpoint.json"), j);
-    expectRefused(run("active --dataset " + s + " --method random --max-views 6 --interval 3 --min-iterations 10 --final-iterations 0 "
-                      "--resume --out " + d.file("a")),
+    expectRefused(run("active --dataset " + s +
+                      " --method random --max-views 6 --interval 3 --min-iterations 10 --final-iterations 0 "
+                      "--resume --out " +
+                      d.file("a")),
                   {d.file("a/checkpoint.json"), field}, field);
   }
 }

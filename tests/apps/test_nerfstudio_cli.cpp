@@ -35,7 +35,8 @@ void toNerfstudio(const std::string& blender, const std::string& out) {
   json ns;
   ns["camera_model"] = "OPENCV";
   for (const char* k : {"k1", "k2", "p1", "p2"}) ns[k] = 0.0;
-  ns["applied_transform"] = json::array({json::array({1, 0, 0, 0}), json::array({0, 1, 0, 0}), json::array({0, 0, 1, 0})});
+  ns["applied_transform"] =
+      json::array({json::array({1, 0, 0, 0}), json::array({0, 1, 0, 0}), json::array({0, 0, 1, 0})});
   ns["ply_file_path"] = "sparse_pc.ply";
   ns["frames"] = json::array();
   const saresgs::Scene b = saresgs::loadDataset(blender);
@@ -58,7 +59,8 @@ void toNerfstudio(const std::string& blender, const std::string& out) {
       if (k++ % 2 == 1)  // per-frame intrinsics, as nerfstudio writes for several cameras
         for (const char* key : {"fl_x", "fl_y", "cx", "cy", "w", "h"}) g[key] = ns[key];
       ns["frames"].push_back(g);
-      ns[std::string(split) == "transforms_train.json" ? "train_filenames" : "test_filenames"].push_back("images/" + stem + ".jpg");
+      ns[std::string(split) == "transforms_train.json" ? "train_filenames" : "test_filenames"].push_back("images/" +
+                                                                                                         stem + ".jpg");
     }
   }
   fs::copy_file(fs::path(blender) / "points3d.ply", fs::path(out) / "sparse_pc.ply");
@@ -69,7 +71,8 @@ void toNerfstudio(const std::string& blender, const std::string& out) {
 
 TEST(NerfstudioCli, TransformsJsonTrainsAsTheBlenderFolderDoes) {
   TempDir d;
-  Result r = run("scene --layout room360 --views 24 --width 96 --height 72 --format blender --out " + d.file("blender"));
+  Result r =
+      run("scene --layout room360 --views 24 --width 96 --height 72 --format blender --out " + d.file("blender"));
   ASSERT_EQ(r.code, 0) << r.output;
   toNerfstudio(d.file("blender"), d.file("ns"));
 
@@ -91,7 +94,8 @@ TEST(NerfstudioCli, TransformsJsonTrainsAsTheBlenderFolderDoes) {
 
   // Trained the same way, the two reach the same PSNR (JPEG's loss aside).
   for (const char* which : {"blender", "ns"}) {
-    r = run("train --dataset " + d.file(which) + " --iterations 300 --seed 0 --threads 1 --out " + d.file(std::string("t_") + which));
+    r = run("train --dataset " + d.file(which) + " --iterations 300 --seed 0 --threads 1 --out " +
+            d.file(std::string("t_") + which));
     ASSERT_EQ(r.code, 0) << r.output;
   }
   // cameras.json beside the .ply: every view, named by its image.

@@ -23,9 +23,8 @@ class TempDir {
   TempDir() {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
     std::random_device rd;
-    path_ = std::filesystem::temp_directory_path() /
-            ("saresgs_" + std::string(info ? info->name() : "test") + "_" +
-             std::to_string(::getpid()) + "_" + std::to_string(rd()));
+    path_ = std::filesystem::temp_directory_path() / ("saresgs_" + std::string(info ? info->name() : "test") + "_" +
+                                                      std::to_string(::getpid()) + "_" + std::to_string(rd()));
     std::filesystem::create_directories(path_);
   }
   ~TempDir() {
@@ -63,8 +62,7 @@ inline std::string fuzzRegression(const std::string& path_in_tests) {
 // Success when `f` throws InputError whose message contains `file` and `field`.
 // Any other exception escapes and fails the test.
 template <typename F>
-::testing::AssertionResult throwsInputError(F&& f, const std::string& file,
-                                            const std::string& field) {
+::testing::AssertionResult throwsInputError(F&& f, const std::string& file, const std::string& field) {
   try {
     f();
   } catch (const InputError& e) {

@@ -112,7 +112,8 @@ TEST(ActiveRun, ResumedAfterAKillEqualsAnUninterruptedRun) {
       // Dies in the middle of the third phase, after two checkpoints.
       EXPECT_THROW(first.run([](const ActiveProgress& p) {
         if (p.iteration == 40) throw Killed{};
-      }), Killed);
+      }),
+                   Killed);
     }
     ASSERT_TRUE(std::filesystem::exists(d.file("ckpt.json")));
     ActiveRun resumed(s, tinyOptions(m), d.file("ckpt.json"));
@@ -148,7 +149,8 @@ TEST(ActiveRun, CorruptCheckpointFieldsAreRefusedByName) {
     struct Killed {};
     EXPECT_THROW(first.run([](const ActiveProgress& p) {
       if (p.iteration == 40) throw Killed{};
-    }), Killed);
+    }),
+                 Killed);
   }
   const nlohmann::json good = nlohmann::json::parse(test::readBytes(ckpt));
   const auto refused = [&](const std::function<void(nlohmann::json&)>& corrupt, const std::string& field,
@@ -161,7 +163,8 @@ TEST(ActiveRun, CorruptCheckpointFieldsAreRefusedByName) {
   };
   EXPECT_TRUE(refused([](nlohmann::json& j) { j["iterations_done"] = -1e9; }, "iterations_done"));
   EXPECT_TRUE(refused([](nlohmann::json& j) { j["iterations_done"] = 1e30; }, "iterations_done"));
-  EXPECT_TRUE(refused([](nlohmann::json& j) { j["iterations_done"] = j["iterations_done"].get<int>() + 1; }, "iterations_done"));
+  EXPECT_TRUE(refused([](nlohmann::json& j) { j["iterations_done"] = j["iterations_done"].get<int>() + 1; },
+                      "iterations_done"));
   EXPECT_TRUE(refused([](nlohmann::json& j) { j["selected"].back() = 100000; }, "selected"));
   EXPECT_TRUE(refused([](nlohmann::json& j) { j["selected"].back() = j["selected"][0]; }, "selected"));
   EXPECT_TRUE(refused([](nlohmann::json& j) { j["observed_upto"] = 99; }, "observed_upto"));
@@ -198,8 +201,10 @@ TEST(ActiveRun, CorruptCheckpointFieldsAreRefusedByName) {
   named([](nlohmann::json& j) { j["rng"] = "not a state"; }, "rng");
   named([](nlohmann::json& j) { j["tag"] = 3; }, "tag: expected a string");
   named([](nlohmann::json& j) { j["method"] = nlohmann::json::array(); }, "method: expected a string");
-  named([](nlohmann::json& j) { j["steps"][0]["seconds"]["fisher"] = "slow"; }, "steps[0].seconds.fisher: expected a number");
-  named([](nlohmann::json& j) { j["steps"][0]["views_before"] = 2.5; }, "steps[0].views_before: expected a whole number");
+  named([](nlohmann::json& j) { j["steps"][0]["seconds"]["fisher"] = "slow"; },
+        "steps[0].seconds.fisher: expected a number");
+  named([](nlohmann::json& j) { j["steps"][0]["views_before"] = 2.5; },
+        "steps[0].views_before: expected a whole number");
   named([](nlohmann::json& j) { j["steps"][0]["candidates"][0] = 7; }, "steps[0].candidates[0]: expected a string");
   named([](nlohmann::json& j) { j["steps"] = nlohmann::json::object(); }, "steps: expected an array");
   // The untouched checkpoint still resumes.
@@ -219,7 +224,8 @@ TEST(ActiveRun, NonFinitePrefilterStateIsRefusedByFile) {
     struct Killed {};
     EXPECT_THROW(first.run([](const ActiveProgress& p) {
       if (p.iteration == 40) throw Killed{};
-    }), Killed);
+    }),
+                 Killed);
   }
   const nlohmann::json j = nlohmann::json::parse(test::readBytes(ckpt));
   const std::string companion = ckpt + ".prefilter." + j["tag"].get<std::string>();
@@ -534,7 +540,8 @@ namespace {
 // fisher, view for view; with a pool of one it is the gate's own selector (`alone`); in
 // between every chosen view was in the logged pool, the pool is the top fraction by the
 // gate's score, and Fisher ranked exactly the pool.
-using GateScores = std::function<std::vector<double>(const Scene&, const std::vector<int>& held, const std::vector<int>& all)>;
+using GateScores =
+    std::function<std::vector<double>(const Scene&, const std::vector<int>& held, const std::vector<int>& all)>;
 void expectFisherOnTheGatesTopFraction(Method gated, Method alone, const GateScores& gate) {
   const Scene& s = tinyDataset();
   auto run = [&](Method m, double keep) {
@@ -569,8 +576,9 @@ TEST(ActiveRun, KmedianFisherIsFisherOnTheKmediansTopFraction) {
 }
 
 TEST(ActiveRun, FvsFisherIsFisherOnFarthestViewsTopFraction) {
-  expectFisherOnTheGatesTopFraction(Method::kFvsFisher, Method::kFvs,
-                                    [](const Scene& s, const auto& held, const auto& all) { return fvsScores(s, held, all); });
+  expectFisherOnTheGatesTopFraction(
+      Method::kFvsFisher, Method::kFvs,
+      [](const Scene& s, const auto& held, const auto& all) { return fvsScores(s, held, all); });
 }
 
 // fisher-kmedian scores every candidate by FisherRF (the first selection's scores are the
@@ -653,7 +661,8 @@ TEST(ActiveRun, OracleIsTheKmedianGainOverTheTestPosesAndTheFinalFitCoversThePat
     EXPECT_EQ(r.final_fit->path[i].view, static_cast<int>(i));
     EXPECT_TRUE(std::isfinite(r.final_fit->path[i].psnr));
   }
-  for (const ViewMetrics& m : r.final_fit->test.views) EXPECT_EQ(r.final_fit->path[static_cast<std::size_t>(m.view)].psnr, m.psnr);
+  for (const ViewMetrics& m : r.final_fit->test.views)
+    EXPECT_EQ(r.final_fit->path[static_cast<std::size_t>(m.view)].psnr, m.psnr);
 }
 
 }  // namespace

@@ -16,7 +16,8 @@ namespace {
 TEST(CoveragePrefilter, TextualOptionsParseAndNameRoundTrip) {
   for (CandidateSetKind k : {CandidateSetKind::kFrustum, CandidateSetKind::kVisible})
     EXPECT_EQ(parseCandidateSet(toString(k)), k);
-  for (LiftingSource l : {LiftingSource::kFlow, LiftingSource::kDepth, LiftingSource::kOracle}) EXPECT_EQ(parseLiftingSource(toString(l)), l);
+  for (LiftingSource l : {LiftingSource::kFlow, LiftingSource::kDepth, LiftingSource::kOracle})
+    EXPECT_EQ(parseLiftingSource(toString(l)), l);
   for (CoverageCriterion c : {CoverageCriterion::Hamming, CoverageCriterion::NewCount})
     EXPECT_EQ(parseCoverageCriterion(toString(c)), c);
   for (int bits = 11; bits <= 19; ++bits) {
@@ -111,13 +112,14 @@ TEST(CoveragePrefilter, TopFractionCountsTiesAndNaN) {
   const std::vector<double> scores = {1, 3, 3, NAN, 0.5};
   EXPECT_EQ(topFraction(scores, cand, 0.2), std::vector<int>({4}));  // tie 4/7 -> lower view
   EXPECT_EQ(topFraction(scores, cand, 0.4), std::vector<int>({4, 7}));
-  EXPECT_EQ(topFraction(scores, cand, 0.0), std::vector<int>({4}));  // at least one
+  EXPECT_EQ(topFraction(scores, cand, 0.0), std::vector<int>({4}));               // at least one
   EXPECT_EQ(topFraction(scores, cand, 1.0), std::vector<int>({2, 4, 7, 9, 10}));  // NaN last but kept
   // k = max(1, ceil(M x fraction)), exact for the paper's 20 % of 150.
   for (const auto& [m, f, k] : {std::tuple{150, 0.2, 30}, {7, 0.2, 2}, {1, 0.2, 1}, {3, 0.01, 1}, {10, 1.0, 10}}) {
     std::vector<int> c(static_cast<std::size_t>(m));
     std::iota(c.begin(), c.end(), 0);
-    EXPECT_EQ(topFraction(std::vector<double>(c.size(), 0.0), c, f).size(), static_cast<std::size_t>(k)) << m << " " << f;
+    EXPECT_EQ(topFraction(std::vector<double>(c.size(), 0.0), c, f).size(), static_cast<std::size_t>(k))
+        << m << " " << f;
   }
   // Against a full stable sort on random scores with many ties (views in index order).
   std::mt19937_64 rng(24);

@@ -23,11 +23,13 @@ TEST(Method, EveryMethodParsesFromItsNameAndNamesAreDistinct) {
 }
 
 TEST(Method, WhatEachMethodComputes) {
-  EXPECT_FALSE(needsOf(Method::kRandom).fisher || needsOf(Method::kRandom).coverage || needsOf(Method::kRandom).residual);
+  EXPECT_FALSE(needsOf(Method::kRandom).fisher || needsOf(Method::kRandom).coverage ||
+               needsOf(Method::kRandom).residual);
   EXPECT_FALSE(needsOf(Method::kFvs).fisher || needsOf(Method::kFvs).coverage);
   EXPECT_TRUE(needsOf(Method::kFisher).fisher && !needsOf(Method::kFisher).coverage);
   EXPECT_TRUE(needsOf(Method::kCoverage).coverage && !needsOf(Method::kCoverage).fisher);
-  EXPECT_TRUE(needsOf(Method::kSaHash).fisher && needsOf(Method::kSaHash).coverage && !needsOf(Method::kSaHash).residual);
+  EXPECT_TRUE(needsOf(Method::kSaHash).fisher && needsOf(Method::kSaHash).coverage &&
+              !needsOf(Method::kSaHash).residual);
   const MethodNeeds sa = needsOf(Method::kSaResgs);
   EXPECT_TRUE(sa.fisher && sa.coverage && sa.residual);
   EXPECT_TRUE(needsOf(Method::kResgs).residual && !needsOf(Method::kResgs).coverage);

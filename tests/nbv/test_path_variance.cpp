@@ -148,7 +148,7 @@ TEST(PathVariance, RelativeDampingIsKappaTimesEachGroupsMedianAboveTheFloor) {
   Gaussians H;
   H.resize(4);
   H.means = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11};  // nonzero median 6
-  H.opacities = {0, 0, 0, 0};                          // nothing seen: the floor
+  H.opacities = {0, 0, 0, 0};                        // nothing seen: the floor
   H.log_scales = {5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5};
   H.sh = {1e-12f, 1e-12f, 1e-12f, 1e-12f, 1e-12f, 1e-12f, 1e-12f, 1e-12f, 1e-12f, 1e-12f, 1e-12f, 1e-12f};
   const GroupDamping l = relativeDamping(H, 0.1, 1e-6);
@@ -187,7 +187,8 @@ TEST(PathVariance, ARingsLargestGapIsTaken) {
   for (int a = 0; a < 360; a += 15) deg.push_back(a);
   const Scene scene = ringScene(deg);
   std::vector<int> held, candidates;
-  for (int i = 0; i < static_cast<int>(deg.size()); ++i) (deg[static_cast<std::size_t>(i)] <= 150 ? held : candidates).push_back(i);
+  for (int i = 0; i < static_cast<int>(deg.size()); ++i)
+    (deg[static_cast<std::size_t>(i)] <= 150 ? held : candidates).push_back(i);
   RasterSettings s;
   s.sh_degree = 0;
   const Gaussians g = sphere(400, 0.8);
@@ -204,8 +205,8 @@ TEST(PathVariance, ARingsLargestGapIsTaken) {
 TEST(PathVariance, AClusteredPathGetsAViewInsideTheCluster) {
   // Held at 270 degrees; the cluster a quarter turn from it, the lone views across from it
   // (where the most is unseen: without the pool's weight W they win).
-  std::vector<double> deg{270};  // held
-  for (int a = 0; a <= 48; a += 4) deg.push_back(a);  // the cluster: 13 views
+  std::vector<double> deg{270};                             // held
+  for (int a = 0; a <= 48; a += 4) deg.push_back(a);        // the cluster: 13 views
   for (double a : {110.0, 140.0, 170.0}) deg.push_back(a);  // lone views
   const Scene scene = ringScene(deg);
   std::vector<int> candidates;

@@ -105,8 +105,7 @@ TEST(SceneFrames, TheLoadersUndoAChangeOfUnitOrARoundOffset) {
       EXPECT_TRUE(warnings.empty()) << formatWarnings(warnings);
     }
     ASSERT_EQ(s.points.size(), ref.points.size());
-    for (std::size_t i = 0; i < s.points.size(); ++i)
-      EXPECT_LT((s.points[i].xyz - ref.points[i].xyz).norm(), 1e-9);
+    for (std::size_t i = 0; i < s.points.size(); ++i) EXPECT_LT((s.points[i].xyz - ref.points[i].xyz).norm(), 1e-9);
   }
 }
 
@@ -194,8 +193,9 @@ TEST(SceneFrames, FiveFramesSelectAndCoverAlike) {
     SCOPED_TRACE(fiveFrames()[k].name);
     const Scene& s = scenes[k];
     Outcome o;
-    const std::vector<Method> methods = isTranslation(k) ? std::vector<Method>{Method::kFvs, Method::kKmedian}
-                                                         : std::vector<Method>{Method::kFvs, Method::kKmedian, Method::kFisher, Method::kSaHash};
+    const std::vector<Method> methods =
+        isTranslation(k) ? std::vector<Method>{Method::kFvs, Method::kKmedian}
+                         : std::vector<Method>{Method::kFvs, Method::kKmedian, Method::kFisher, Method::kSaHash};
     std::optional<Gaussians> fvs_model;
     std::vector<int> initial;
     for (Method m : methods) {
@@ -218,7 +218,8 @@ TEST(SceneFrames, FiveFramesSelectAndCoverAlike) {
     rs.sh_degree = ref_model.max_sh_degree;
     if (s.background) rs.background = *s.background;
     const CoverageAnalysis a = analyzeCoverage(
-        s, initial, smallRun(Method::kSaHash).prefilter, [&](const Camera& c) { return rasterize(ref_model, c, rs).rgb; },
+        s, initial, smallRun(Method::kSaHash).prefilter,
+        [&](const Camera& c) { return rasterize(ref_model, c, rs).rgb; },
         [&](const Camera& c) { return rasterize(ref_model, c, rs).depth; });
     o.scene_voxels = a.scene_voxels;
     o.observed_voxels = a.observed_voxels;
@@ -234,10 +235,11 @@ TEST(SceneFrames, FiveFramesSelectAndCoverAlike) {
       EXPECT_EQ(views, ref.views.at(m)) << toString(m);
       if (isTranslation(k)) {
         EXPECT_NEAR(out[k].psnr.at(m), ref.psnr.at(m), 0.2) << toString(m);
-      }
-      else EXPECT_EQ(out[k].psnr.at(m), ref.psnr.at(m)) << toString(m);
+      } else
+        EXPECT_EQ(out[k].psnr.at(m), ref.psnr.at(m)) << toString(m);
     }
-    EXPECT_NEAR(static_cast<double>(out[k].scene_voxels), static_cast<double>(ref.scene_voxels), 0.01 * ref.scene_voxels);
+    EXPECT_NEAR(static_cast<double>(out[k].scene_voxels), static_cast<double>(ref.scene_voxels),
+                0.01 * ref.scene_voxels);
     EXPECT_NEAR(static_cast<double>(out[k].observed_voxels), static_cast<double>(ref.observed_voxels),
                 0.01 * ref.observed_voxels);
     EXPECT_EQ(out[k].coverage_top, ref.coverage_top);

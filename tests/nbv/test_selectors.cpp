@@ -42,8 +42,10 @@ TEST(Selectors, FarthestViewPicksTheOppositeCamera) {
   for (ViewDistance m : {ViewDistance::kEuclidean, ViewDistance::kGreatCircle}) {
     const auto scores = farthestViewScores(s, chosen, cand, m, Eigen::Vector3d::Zero());
     EXPECT_EQ(cand[argmaxScore(scores, cand)], 7) << static_cast<int>(m);
-    if (m == ViewDistance::kGreatCircle) EXPECT_NEAR(scores[2], 5 * 2 * M_PI / 12, 1e-12);
-    else EXPECT_NEAR(scores[1], 2 * 4 * std::sin(4 * M_PI / 12), 1e-12);  // chord of 4 steps
+    if (m == ViewDistance::kGreatCircle)
+      EXPECT_NEAR(scores[2], 5 * 2 * M_PI / 12, 1e-12);
+    else
+      EXPECT_NEAR(scores[1], 2 * 4 * std::sin(4 * M_PI / 12), 1e-12);  // chord of 4 steps
   }
 }
 
@@ -54,8 +56,11 @@ TEST(Selectors, GreatCircleIgnoresRadius) {
   s.views[2].camera = Camera::lookAt(s.views[2].camera.K, Eigen::Vector3d(-0.5, 0, 0), Eigen::Vector3d(1, 0, 0),
                                      Eigen::Vector3d::UnitZ());
   const std::vector<int> cand = {1, 2};
-  EXPECT_EQ(cand[argmaxScore(farthestViewScores(s, {0}, cand, ViewDistance::kGreatCircle, Eigen::Vector3d::Zero()), cand)], 2);
-  EXPECT_EQ(cand[argmaxScore(farthestViewScores(s, {0}, cand, ViewDistance::kEuclidean, Eigen::Vector3d::Zero()), cand)], 1);
+  EXPECT_EQ(
+      cand[argmaxScore(farthestViewScores(s, {0}, cand, ViewDistance::kGreatCircle, Eigen::Vector3d::Zero()), cand)],
+      2);
+  EXPECT_EQ(
+      cand[argmaxScore(farthestViewScores(s, {0}, cand, ViewDistance::kEuclidean, Eigen::Vector3d::Zero()), cand)], 1);
 }
 
 TEST(Selectors, ArgmaxAndRandom) {
@@ -120,7 +125,7 @@ TEST(Selectors, KmedianFillsTheCrowdedGapWhereFarthestViewTakesTheLoner) {
   const std::vector<double> g = kmedianGains(s, {0}, cand, s.train, 1.0);
   const int pick = cand[argmaxScore(g, cand)];
   EXPECT_TRUE(pick == 6 || pick == 7) << pick;  // x = 4.95 or 5.05, the crowd's medians
-  EXPECT_NEAR(g[0], 7, 1e-12);                    // the loner only helps itself
+  EXPECT_NEAR(g[0], 7, 1e-12);                  // the loner only helps itself
 }
 
 // The gain is what its docstring says: the drop of the summed distance to the nearest held
@@ -208,7 +213,8 @@ TEST(Selectors, PoseDistanceAddsTheScaledAngleOfTheAxes) {
   EXPECT_NEAR(poseDistance(a, b, 2.0), 2.0 * M_PI / 2, 1e-12);
   EXPECT_NEAR(poseDistance(a, b, 2.0), poseDistance(b, a, 2.0), 1e-15);
   EXPECT_EQ(poseDistance(a, a, 2.0), 0.0);
-  const Camera c = Camera::lookAt(K, Eigen::Vector3d(1, 2, 3), Eigen::Vector3d(1 + 1e-7, 7, 3), Eigen::Vector3d::UnitZ());
+  const Camera c =
+      Camera::lookAt(K, Eigen::Vector3d(1, 2, 3), Eigen::Vector3d(1 + 1e-7, 7, 3), Eigen::Vector3d::UnitZ());
   EXPECT_NEAR(poseDistance(a, c, 1.0), 2e-8, 1e-14);  // acos would return 0 or 1e-4 here
   // The ring's radius is its angle scale; a single place falls back to 1.
   EXPECT_NEAR(poseAngleScale(ringScene(12)), 4, 1e-12);

@@ -30,7 +30,8 @@ TEST(HtmlPage, Base64MatchesRfc4648Vectors) {
 }
 
 TEST(HtmlPage, JsonForScriptCannotCloseTheElementAndParsesBack) {
-  const std::string hostile = "</script><script>alert(1)</script><!-- & \xe2\x80\xa8 \xe2\x80\xa9 \"quoted\" 'x' \xc3\xa9";
+  const std::string hostile =
+      "</script><script>alert(1)</script><!-- & \xe2\x80\xa8 \xe2\x80\xa9 \"quoted\" 'x' \xc3\xa9";
   const nlohmann::json j = {{"name", hostile}, {hostile, {1, 2.5, hostile}}};
   const std::string text = jsonForScript(j);
   for (const char c : text) {
@@ -61,8 +62,7 @@ TEST(HtmlPage, DataAndScriptsCannotEndTheirElements) {
   EXPECT_EQ(count(html, "</title>"), 1u);
   EXPECT_NE(html.find("&lt;/title&gt;&lt;script&gt;alert(1)&lt;/script&gt;"), std::string::npos);
   // the viewer's string keeps its meaning: "<\/script" is "</script" to JavaScript
-  EXPECT_NE(html.find("var s = \"<\\/script><b>3\"; var t = '<\\/SCRIPT >'; var u = '<\\!-- x';"),
-            std::string::npos);
+  EXPECT_NE(html.find("var s = \"<\\/script><b>3\"; var t = '<\\/SCRIPT >'; var u = '<\\!-- x';"), std::string::npos);
   // nothing leaves the file
   EXPECT_NE(html.find("default-src 'none'"), std::string::npos);
 }

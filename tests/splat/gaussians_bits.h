@@ -37,8 +37,7 @@ inline ::testing::AssertionResult arraysBitEqual(const Gaussians& got, const Gau
     }
     for (std::size_t k = 0; k < a.size(); ++k)
       if (std::bit_cast<std::uint32_t>(a[k]) != std::bit_cast<std::uint32_t>(b[k])) {
-        result = ::testing::AssertionFailure()
-                 << "array " << index << " entry " << k << ": " << a[k] << " vs " << b[k];
+        result = ::testing::AssertionFailure() << "array " << index << " entry " << k << ": " << a[k] << " vs " << b[k];
         failed = true;
         return;
       }
@@ -58,12 +57,11 @@ inline std::vector<float> flattened(std::vector<float> head, const Gaussians& g)
 // difference, the two values named `got_name` and `want_name`.
 inline ::testing::AssertionResult valuesBitEqual(const std::vector<float>& got, const std::vector<float>& want,
                                                  const char* got_name = "got", const char* want_name = "want") {
-  if (got.size() != want.size())
-    return ::testing::AssertionFailure() << "size " << got.size() << " vs " << want.size();
+  if (got.size() != want.size()) return ::testing::AssertionFailure() << "size " << got.size() << " vs " << want.size();
   for (std::size_t k = 0; k < got.size(); ++k)
     if (std::bit_cast<std::uint32_t>(got[k]) != std::bit_cast<std::uint32_t>(want[k]))
-      return ::testing::AssertionFailure() << "entry " << k << ": " << got_name << " " << got[k] << ", " << want_name
-                                           << " " << want[k];
+      return ::testing::AssertionFailure()
+             << "entry " << k << ": " << got_name << " " << got[k] << ", " << want_name << " " << want[k];
   return ::testing::AssertionSuccess();
 }
 

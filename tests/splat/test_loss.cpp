@@ -34,8 +34,7 @@ ImageF smoothImage(int w, int h, float phase) {
   ImageF img(w, h, 3);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
-      for (int c = 0; c < 3; ++c)
-        img.at(x, y, c) = 0.5f + 0.3f * std::sin(0.15f * x + 0.1f * y + c + phase);
+      for (int c = 0; c < 3; ++c) img.at(x, y, c) = 0.5f + 0.3f * std::sin(0.15f * x + 0.1f * y + c + phase);
   return img;
 }
 
@@ -48,8 +47,7 @@ ImageF sceneImage(int w, int h) {
       for (int c = 0; c < 3; ++c) {
         float v = 1.0f;
         if (std::sqrt(cx * cx + cy * cy) < 0.3f * h)
-          v = 0.3f + 0.2f * std::sin(0.2f * x + c) * std::cos(0.25f * y) +
-              0.05f * std::sin(0.9f * x + 0.7f * y);
+          v = 0.3f + 0.2f * std::sin(0.2f * x + c) * std::cos(0.25f * y) + 0.05f * std::sin(0.9f * x + 0.7f * y);
         else if (x > 0.75f * w && y > 0.6f * h)
           v = 0.6f + 0.1f * c;
         img.at(x, y, c) = v;
@@ -59,8 +57,7 @@ ImageF sceneImage(int w, int h) {
 }
 
 // img * gain + offset + N(0, sigma) noise.
-ImageF perturbed(const ImageF& img, std::uint64_t seed, float sigma, float offset = 0.0f,
-                 float gain = 1.0f) {
+ImageF perturbed(const ImageF& img, std::uint64_t seed, float sigma, float offset = 0.0f, float gain = 1.0f) {
   std::mt19937_64 rng(seed);
   std::normal_distribution<float> n(0.0f, 1.0f);
   ImageF out = img;
@@ -128,8 +125,7 @@ RefLoss referenceLoss(const ImageF& x, const ImageF& y, double lambda) {
             const int qx = px + dx, qy = py + dy;
             if (qx < 0 || qx >= w || qy < 0 || qy >= h) continue;
             const double g = k[dx + 5] * k[dy + 5];
-            R.grad[x.index(qx, qy, c)] +=
-                scale * g * (dmx + 2 * x.at(qx, qy, c) * dsxx + y.at(qx, qy, c) * dsxy);
+            R.grad[x.index(qx, qy, c)] += scale * g * (dmx + 2 * x.at(qx, qy, c) * dsxx + y.at(qx, qy, c) * dsxy);
           }
       }
   R.l1 = l1 / count;
@@ -147,8 +143,8 @@ double maxAbs(const std::vector<double>& v) {
 // The fast loss against the double reference: loss within `value_rel` relative, the SSIM
 // mean within 5e-7 absolute (observed <= 5e-8; ~1e-7 where FMA contraction is on, as with
 // SARESGS_NATIVE), and every gradient value within `grad_rel` of the largest.
-void expectMatchesReference(const ImageF& render, const ImageF& target, double lambda,
-                            double value_rel, double grad_rel, const char* what) {
+void expectMatchesReference(const ImageF& render, const ImageF& target, double lambda, double value_rel,
+                            double grad_rel, const char* what) {
   SCOPED_TRACE(what);
   const RefLoss ref = referenceLoss(render, target, lambda);
   const LossResult r = photometricLoss(render, target, lambda, true);
@@ -159,17 +155,14 @@ void expectMatchesReference(const ImageF& render, const ImageF& target, double l
   const double gmax = maxAbs(ref.grad);
   ASSERT_GT(gmax, 0.0);
   double worst = 0;
-  for (std::size_t i = 0; i < ref.grad.size(); ++i)
-    worst = std::max(worst, std::abs(r.grad.data[i] - ref.grad[i]));
+  for (std::size_t i = 0; i < ref.grad.size(); ++i) worst = std::max(worst, std::abs(r.grad.data[i] - ref.grad[i]));
   EXPECT_LE(worst, grad_rel * gmax) << "lambda " << lambda << ", largest gradient " << gmax;
 }
 
 // Pixels to probe: the four corners, points on each border, a few interior ones.
 std::vector<std::pair<int, int>> probePixels(int w, int h, std::uint64_t seed) {
-  std::vector<std::pair<int, int>> px = {{0, 0},         {w - 1, 0},     {0, h - 1},
-                                         {w - 1, h - 1}, {w / 2, 0},     {w / 3, h - 1},
-                                         {0, h / 2},     {w - 1, h / 3}, {1, 1},
-                                         {w - 2, h - 2}};
+  std::vector<std::pair<int, int>> px = {{0, 0},         {w - 1, 0}, {0, h - 1},     {w - 1, h - 1}, {w / 2, 0},
+                                         {w / 3, h - 1}, {0, h / 2}, {w - 1, h / 3}, {1, 1},         {w - 2, h - 2}};
   std::mt19937_64 rng(seed);
   for (int i = 0; i < 6; ++i)
     px.emplace_back(std::uniform_int_distribution<int>(0, w - 1)(rng),
@@ -180,8 +173,8 @@ std::vector<std::pair<int, int>> probePixels(int w, int h, std::uint64_t seed) {
 // Central finite differences of a loss against an analytic gradient at probe pixels:
 // |analytic - fd| <= rel * |fd| + rel * max|gradient|.
 template <typename LossFn>
-void checkFiniteDifferences(const ImageF& render, const std::vector<double>& grad,
-                            LossFn&& loss, double rel, std::uint64_t seed, const char* what) {
+void checkFiniteDifferences(const ImageF& render, const std::vector<double>& grad, LossFn&& loss, double rel,
+                            std::uint64_t seed, const char* what) {
   SCOPED_TRACE(what);
   const float step = 1e-3f;
   const double max_grad = maxAbs(grad);
@@ -191,18 +184,14 @@ void checkFiniteDifferences(const ImageF& render, const std::vector<double>& gra
       ImageF plus = render, minus = render;
       plus.at(px, py, c) += step;
       minus.at(px, py, c) -= step;
-      const double delta =
-          static_cast<double>(plus.at(px, py, c)) - static_cast<double>(minus.at(px, py, c));
+      const double delta = static_cast<double>(plus.at(px, py, c)) - static_cast<double>(minus.at(px, py, c));
       const double fd = (loss(plus) - loss(minus)) / delta;
       const double an = grad[render.index(px, py, c)];
-      EXPECT_NEAR(an, fd, rel * std::abs(fd) + rel * max_grad)
-          << "pixel (" << px << "," << py << ") channel " << c;
+      EXPECT_NEAR(an, fd, rel * std::abs(fd) + rel * max_grad) << "pixel (" << px << "," << py << ") channel " << c;
     }
 }
 
-std::vector<double> toDouble(const ImageF& img) {
-  return std::vector<double>(img.data.begin(), img.data.end());
-}
+std::vector<double> toDouble(const ImageF& img) { return std::vector<double>(img.data.begin(), img.data.end()); }
 
 // Analytic gradients against finite differences, for both implementations: the double
 // reference tightly (1e-4, as the original double loss was tested), and the float loss
@@ -212,13 +201,12 @@ std::vector<double> toDouble(const ImageF& img) {
 void checkGradient(const ImageF& render, const ImageF& target, double lambda, std::uint64_t seed) {
   const RefLoss ref = referenceLoss(render, target, lambda);
   checkFiniteDifferences(
-      render, ref.grad, [&](const ImageF& r) { return referenceLoss(r, target, lambda).loss; },
-      1e-4, seed, "double reference vs finite differences");
+      render, ref.grad, [&](const ImageF& r) { return referenceLoss(r, target, lambda).loss; }, 1e-4, seed,
+      "double reference vs finite differences");
   const LossResult fast = photometricLoss(render, target, lambda, true);
   checkFiniteDifferences(
-      render, toDouble(fast.grad),
-      [&](const ImageF& r) { return photometricLoss(r, target, lambda, false).loss; }, 2e-3,
-      seed, "float loss vs finite differences");
+      render, toDouble(fast.grad), [&](const ImageF& r) { return photometricLoss(r, target, lambda, false).loss; },
+      2e-3, seed, "float loss vs finite differences");
   expectMatchesReference(render, target, lambda, 1e-6, 5e-5, "float loss vs double reference");
 }
 
@@ -296,8 +284,7 @@ TEST(PhotometricLoss, MatchesTheDoubleReference) {
       {"render outside [0,1]", randomImage(w, h, 107, -0.3f, 1.3f), scene, 2e-6},
   };
   for (const Case& c : cases)
-    for (double lambda : {0.2, 1.0})
-      expectMatchesReference(c.render, c.target, lambda, 1e-6, c.grad_rel, c.what);
+    for (double lambda : {0.2, 1.0}) expectMatchesReference(c.render, c.target, lambda, 1e-6, c.grad_rel, c.what);
 }
 
 TEST(PhotometricLoss, SsimTermEqualsTheMetricForImagesInTheUnitRange) {
@@ -366,8 +353,8 @@ TEST(PhotometricLoss, DeterministicAcrossCallsAndThreadCounts) {
       ASSERT_EQ(a.grad.data.size(), r.grad.data.size());
       // (memcmp of an empty buffer would pass it null pointers: undefined behaviour.)
       if (!a.grad.data.empty()) {
-  EXPECT_EQ(std::memcmp(a.grad.data.data(), r.grad.data.data(), a.grad.data.size() * sizeof(float)), 0);
-}
+        EXPECT_EQ(std::memcmp(a.grad.data.data(), r.grad.data.data(), a.grad.data.size() * sizeof(float)), 0);
+      }
     }
   }
 }
@@ -392,8 +379,10 @@ TEST(PhotometricLoss, KeptBuffersLeakNothingBetweenCallsOrThreads) {
   EXPECT_TRUE(sameBits(photometricLoss(small, small_t, 0.2, false), photometricLoss(small, small_t, 0.2, false)));
   EXPECT_TRUE(sameBits(photometricLoss(small, small_t, 0.2, true), s1));
   std::vector<LossResult> at_once(24);
-  tbb::parallel_for(0, 24, [&](int i) { at_once[static_cast<std::size_t>(i)] = i % 2 ? photometricLoss(big, big_t, 0.2, true)
-                                                                                      : photometricLoss(small, small_t, 0.2, true); });
+  tbb::parallel_for(0, 24, [&](int i) {
+    at_once[static_cast<std::size_t>(i)] =
+        i % 2 ? photometricLoss(big, big_t, 0.2, true) : photometricLoss(small, small_t, 0.2, true);
+  });
   for (int i = 0; i < 24; ++i) EXPECT_TRUE(sameBits(at_once[static_cast<std::size_t>(i)], i % 2 ? b1 : s1)) << i;
 }
 
@@ -429,8 +418,7 @@ TEST(PhotometricLoss, EveryVectorWidthGivesIdenticalBits) {
 TEST(PhotometricLoss, TinyAndConstantImagesAreFinite) {
   // Images smaller than the window (down to one pixel), thin strips, and constant images
   // (zero variance everywhere, so only C1 and C2 keep the denominators away from zero).
-  const std::vector<std::pair<int, int>> sizes = {{1, 1}, {5, 3}, {3, 5}, {1, 12},
-                                                  {12, 1}, {2, 2}, {11, 11}, {17, 6}};
+  const std::vector<std::pair<int, int>> sizes = {{1, 1}, {5, 3}, {3, 5}, {1, 12}, {12, 1}, {2, 2}, {11, 11}, {17, 6}};
   for (const auto& [w, h] : sizes) {
     SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h));
     const ImageF render = randomImage(w, h, 91 + w), target = randomImage(w, h, 92 + h);
@@ -469,8 +457,7 @@ TEST(PhotometricLoss, HandlesOtherChannelCounts) {
     std::uniform_real_distribution<float> u(0, 1);
     for (auto& v : render.data) v = u(rng);
     for (auto& v : target.data) v = u(rng);
-    expectMatchesReference(render, target, 0.2, 1e-6, 1e-5,
-                           channels == 1 ? "one channel" : "four channels");
+    expectMatchesReference(render, target, 0.2, 1e-6, 1e-5, channels == 1 ? "one channel" : "four channels");
   }
 }
 

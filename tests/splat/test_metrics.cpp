@@ -22,7 +22,6 @@ ImageF randomImage(int w, int h, std::uint64_t seed) {
   return img;
 }
 
-
 }  // namespace
 
 TEST(Metrics, PsnrOfAConstantOffset) {
@@ -53,8 +52,7 @@ TEST(Metrics, SsimMatchesAnIndependentImplementation) {
 TEST(Metrics, SsimMatchesTheOracleAtSeveralSizes) {
   // The metric shares the training loss's float kernel; against OpenCV's double blur it
   // agrees to ~1e-8. Sizes below the window, thin strips and a training-sized image.
-  for (const auto& [w, h] : std::vector<std::pair<int, int>>{
-           {1, 1}, {5, 3}, {3, 9}, {17, 1}, {33, 21}, {256, 192}}) {
+  for (const auto& [w, h] : std::vector<std::pair<int, int>>{{1, 1}, {5, 3}, {3, 9}, {17, 1}, {33, 21}, {256, 192}}) {
     const ImageF a = randomImage(w, h, 10 + w);
     ImageF b = a;
     std::mt19937_64 rng(11 + h);

@@ -41,8 +41,7 @@ void expectBitEqual(const Gaussians& a, const Gaussians& b) {
   b.forEachArray([&](const std::vector<float>& v, std::size_t) { bv.push_back(&v); });
   for (std::size_t k = 0; k < av.size(); ++k) {
     ASSERT_EQ(av[k]->size(), bv[k]->size()) << "array " << k;
-    EXPECT_EQ(std::memcmp(av[k]->data(), bv[k]->data(), av[k]->size() * sizeof(float)), 0)
-        << "array " << k;
+    EXPECT_EQ(std::memcmp(av[k]->data(), bv[k]->data(), av[k]->size() * sizeof(float)), 0) << "array " << k;
   }
 }
 
@@ -62,8 +61,7 @@ void put(std::string& out, T v) {
 }
 
 std::string makePly(const std::vector<Column>& cols, std::size_t n,
-                    const std::string& format = "binary_little_endian 1.0",
-                    const std::string& extra_header = "") {
+                    const std::string& format = "binary_little_endian 1.0", const std::string& extra_header = "") {
   std::string s = "ply\nformat " + format + "\n" + extra_header;
   s += "element vertex " + std::to_string(n) + "\n";
   for (const auto& c : cols) s += "property " + c.type + " " + c.name + "\n";
@@ -71,11 +69,16 @@ std::string makePly(const std::vector<Column>& cols, std::size_t n,
   for (std::size_t i = 0; i < n; ++i)
     for (const auto& c : cols) {
       const double v = c.value(i);
-      if (c.type == "float") put(s, static_cast<float>(v));
-      else if (c.type == "double") put(s, v);
-      else if (c.type == "uchar") put(s, static_cast<std::uint8_t>(v));
-      else if (c.type == "int") put(s, static_cast<std::int32_t>(v));
-      else ADD_FAILURE() << "test writer: type " << c.type;
+      if (c.type == "float")
+        put(s, static_cast<float>(v));
+      else if (c.type == "double")
+        put(s, v);
+      else if (c.type == "uchar")
+        put(s, static_cast<std::uint8_t>(v));
+      else if (c.type == "int")
+        put(s, static_cast<std::int32_t>(v));
+      else
+        ADD_FAILURE() << "test writer: type " << c.type;
     }
   return s;
 }
@@ -87,19 +90,16 @@ std::vector<Column> modelColumns(const Gaussians& g) {
   for (int a = 0; a < 3; ++a)
     cols.push_back({std::string(1, "xyz"[a]), "float", [&g, a](std::size_t i) { return g.means[3 * i + a]; }});
   for (int c = 0; c < 3; ++c)
-    cols.push_back({"f_dc_" + std::to_string(c), "float",
-                    [&g, c, K](std::size_t i) { return g.sh[(i * K) * 3 + c]; }});
+    cols.push_back({"f_dc_" + std::to_string(c), "float", [&g, c, K](std::size_t i) { return g.sh[(i * K) * 3 + c]; }});
   for (int c = 0; c < 3; ++c)
     for (int k = 1; k < K; ++k)
       cols.push_back({"f_rest_" + std::to_string(c * (K - 1) + k - 1), "float",
                       [&g, c, k, K](std::size_t i) { return g.sh[(i * K + k) * 3 + c]; }});
   cols.push_back({"opacity", "float", [&g](std::size_t i) { return g.opacities[i]; }});
   for (int a = 0; a < 3; ++a)
-    cols.push_back({"scale_" + std::to_string(a), "float",
-                    [&g, a](std::size_t i) { return g.log_scales[3 * i + a]; }});
+    cols.push_back({"scale_" + std::to_string(a), "float", [&g, a](std::size_t i) { return g.log_scales[3 * i + a]; }});
   for (int a = 0; a < 4; ++a)
-    cols.push_back({"rot_" + std::to_string(a), "float",
-                    [&g, a](std::size_t i) { return g.rotations[4 * i + a]; }});
+    cols.push_back({"rot_" + std::to_string(a), "float", [&g, a](std::size_t i) { return g.rotations[4 * i + a]; }});
   return cols;
 }
 
@@ -225,8 +225,8 @@ TEST(GaussiansPly, ReadsPropertiesByNameInAnyOrderFloatOrDoubleWithExtras) {
     cols.push_back({"segment", "int", [](std::size_t i) { return -double(i); }});
     cols.insert(cols.begin() + 5, {"nx", "double", [](std::size_t) { return 0.25; }});
     const std::string path = dir.file("shuffled" + std::to_string(degree) + ".ply");
-    saresgs::test::writeBytes(path, makePly(cols, g.size(), "binary_little_endian 1.0",
-                                            "comment hand-made\nobj_info test\n"));
+    saresgs::test::writeBytes(
+        path, makePly(cols, g.size(), "binary_little_endian 1.0", "comment hand-made\nobj_info test\n"));
     expectBitEqual(g, readGaussiansPly(path));
   }
 }
@@ -239,8 +239,7 @@ TEST(GaussiansPly, SkipsFixedSizeElementsBeforeTheVertices) {
   const std::string head = "ply\nformat binary_little_endian 1.0\n";
   ASSERT_EQ(body.rfind(head, 0), 0u);
   const std::size_t end = body.find("end_header\n") + 11;
-  std::string file = head + "element camera 2\nproperty double f\n" +
-                     body.substr(head.size(), end - head.size());
+  std::string file = head + "element camera 2\nproperty double f\n" + body.substr(head.size(), end - head.size());
   put(file, 1.5);
   put(file, 2.5);
   file += body.substr(end);
@@ -267,8 +266,7 @@ TEST(GaussiansPly, MalformedFilesGiveInputErrorsNamingFileAndField) {
   EXPECT_TRUE(throwsInputError([&] { readGaussiansPly(notply); }, notply, "header"));
 
   const std::string ascii = dir.file("ascii.ply");
-  saresgs::test::writeBytes(ascii,
-                            "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n1\n");
+  saresgs::test::writeBytes(ascii, "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n1\n");
   EXPECT_TRUE(throwsInputError([&] { readGaussiansPly(ascii); }, ascii, "format"));
   try {
     readGaussiansPly(ascii);
@@ -297,10 +295,9 @@ TEST(GaussiansPly, MalformedFilesGiveInputErrorsNamingFileAndField) {
   {
     // Degree 1 has 9 f_rest; keep only 5.
     auto c = cols;
-    c.erase(std::remove_if(c.begin(), c.end(),
-                           [](const Column& x) {
-                             return x.name.rfind("f_rest_", 0) == 0 && std::stoi(x.name.substr(7)) >= 5;
-                           }),
+    c.erase(std::remove_if(
+                c.begin(), c.end(),
+                [](const Column& x) { return x.name.rfind("f_rest_", 0) == 0 && std::stoi(x.name.substr(7)) >= 5; }),
             c.end());
     const std::string p = dir.file("rest5.ply");
     saresgs::test::writeBytes(p, makePly(c, g.size()));
@@ -360,5 +357,6 @@ TEST(Ply, AFileWithoutVerticesReadsAsAnEmptyModel) {
   ASSERT_NE(bytes.find(line), std::string::npos);
   bytes.erase(bytes.find(line), line.size());
   saresgs::test::writeBytes(d.file("no_opacity.ply"), bytes);
-  EXPECT_TRUE(throwsInputError([&] { readGaussiansPly(d.file("no_opacity.ply")); }, d.file("no_opacity.ply"), "opacity"));
+  EXPECT_TRUE(
+      throwsInputError([&] { readGaussiansPly(d.file("no_opacity.ply")); }, d.file("no_opacity.ply"), "opacity"));
 }

@@ -125,16 +125,14 @@ TEST(SplatTransform, SpzRoundTripKeepsCountAndPositions) {
     for (std::size_t i = 0; i < g.size(); ++i) {
       for (int a = 0; a < 3; ++a) {
         max_pos = std::max(max_pos, std::abs(double(b.means[3 * i + a]) - g.means[3 * i + a]));
-        max_scale =
-            std::max(max_scale, std::abs(double(b.log_scales[3 * i + a]) - g.log_scales[3 * i + a]));
+        max_scale = std::max(max_scale, std::abs(double(b.log_scales[3 * i + a]) - g.log_scales[3 * i + a]));
       }
       max_alpha = std::max(max_alpha, std::abs(sigmoid(b.opacities[i]) - sigmoid(g.opacities[i])));
       for (int c = 0; c < 3; ++c)
         max_dc = std::max(max_dc, std::abs(double(b.sh[i * K * 3 + c]) - g.sh[i * K * 3 + c]));
       for (int k = 1; k < K; ++k)
         for (int c = 0; c < 3; ++c)
-          max_rest = std::max(max_rest, std::abs(double(b.sh[(i * K + k) * 3 + c]) -
-                                                 g.sh[(i * K + k) * 3 + c]));
+          max_rest = std::max(max_rest, std::abs(double(b.sh[(i * K + k) * 3 + c]) - g.sh[(i * K + k) * 3 + c]));
       // Quaternions: SPZ stores them normalised, up to sign; w first in both of ours.
       double na = 0, nb = 0, dot = 0;
       for (int a = 0; a < 4; ++a) {
@@ -154,9 +152,10 @@ TEST(SplatTransform, SpzRoundTripKeepsCountAndPositions) {
     EXPECT_LE(max_dc, 0.02);
     EXPECT_LE(max_rest, 0.07);
     EXPECT_GE(min_dot, 0.99);
-    std::printf("  degree %d: max position error %.3g (limit %.3g), log-scale %.3g, opacity %.3g, "
-                "dc %.3g, rest %.3g, min |cos| quaternion %.6f\n",
-                degree, max_pos, tol, max_scale, max_alpha, max_dc, max_rest, min_dot);
+    std::printf(
+        "  degree %d: max position error %.3g (limit %.3g), log-scale %.3g, opacity %.3g, "
+        "dc %.3g, rest %.3g, min |cos| quaternion %.6f\n",
+        degree, max_pos, tol, max_scale, max_alpha, max_dc, max_rest, min_dot);
   }
 }
 

@@ -82,8 +82,7 @@ TEST(Camera, FrustumPlanesHoldExactlyThePointsThatProjectInside) {
       bool by_projection = false;
       if (pc.z() >= near && pc.z() <= far) {
         const auto uv = c.project(X);
-        by_projection = uv && uv->x() >= 0 && uv->x() <= c.K.width && uv->y() >= 0 &&
-                        uv->y() <= c.K.height;
+        by_projection = uv && uv->x() >= 0 && uv->x() <= c.K.width && uv->y() >= 0 && uv->y() <= c.K.height;
       }
       // Points within 1e-9 of a plane may go either way.
       double margin = 1e300;
@@ -99,8 +98,8 @@ TEST(Camera, FrustumPlanesHoldExactlyThePointsThatProjectInside) {
 }
 
 TEST(Camera, LookAtLooksAtTargetWithImageUpAlongUp) {
-  const Camera c = Camera::lookAt(makeK(), Eigen::Vector3d(3, 0, 1), Eigen::Vector3d(0, 0, 1),
-                                  Eigen::Vector3d::UnitZ());
+  const Camera c =
+      Camera::lookAt(makeK(), Eigen::Vector3d(3, 0, 1), Eigen::Vector3d(0, 0, 1), Eigen::Vector3d::UnitZ());
   EXPECT_NEAR((c.viewDirection() - Eigen::Vector3d(-1, 0, 0)).norm(), 0, 1e-12);
   EXPECT_NEAR(c.R.determinant(), 1.0, 1e-12);
   // A point above the target appears above the principal point (smaller v).
@@ -108,8 +107,7 @@ TEST(Camera, LookAtLooksAtTargetWithImageUpAlongUp) {
   ASSERT_TRUE(uv);
   EXPECT_LT(uv->y(), c.K.cy);
   // Degenerate up (parallel to the view) still gives a rotation, not NaN.
-  const Camera d = Camera::lookAt(makeK(), Eigen::Vector3d(0, 0, 5), Eigen::Vector3d::Zero(),
-                                  Eigen::Vector3d::UnitZ());
+  const Camera d = Camera::lookAt(makeK(), Eigen::Vector3d(0, 0, 5), Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ());
   EXPECT_TRUE(d.R.allFinite());
   EXPECT_NEAR(d.R.determinant(), 1.0, 1e-12);
 }
@@ -173,7 +171,8 @@ std::vector<Camera> hemisphere(const Eigen::Vector3d& target, double radius, int
   std::vector<Camera> cams;
   for (int i = 0; i < n; ++i) {
     const double phi = 2 * M_PI * u(rng), z = 0.1 + 0.85 * u(rng), r = std::sqrt(1 - z * z);
-    cams.push_back(Camera::lookAt(makeK(), target + radius * Eigen::Vector3d(r * std::cos(phi), r * std::sin(phi), z), target));
+    cams.push_back(
+        Camera::lookAt(makeK(), target + radius * Eigen::Vector3d(r * std::cos(phi), r * std::sin(phi), z), target));
   }
   return cams;
 }

@@ -62,7 +62,8 @@ TEST(ImageIO, FloatConversionClampsAndRounds) {
 // image held before (larger, smaller, another channel count).
 TEST(ImageIO, FloatConversionIntoAReusedImageEqualsAFreshOne) {
   ImageF out;
-  for (const auto& [w, h, c] : {std::tuple{31, 17, 3}, std::tuple{5, 4, 3}, std::tuple{40, 20, 4}, std::tuple{3, 2, 1}}) {
+  for (const auto& [w, h, c] :
+       {std::tuple{31, 17, 3}, std::tuple{5, 4, 3}, std::tuple{40, 20, 4}, std::tuple{3, 2, 1}}) {
     const Image8 img = randomImage(w, h, c, static_cast<std::uint64_t>(w * 100 + c));
     toFloatInto(img, out);
     const ImageF fresh = toFloat(img);
@@ -70,7 +71,8 @@ TEST(ImageIO, FloatConversionIntoAReusedImageEqualsAFreshOne) {
     EXPECT_EQ(out.height, h);
     EXPECT_EQ(out.channels, c);
     EXPECT_EQ(out.data, fresh.data);
-    for (std::size_t i = 0; i < img.data.size(); ++i) ASSERT_NEAR(out.data[i], img.data[i] / 255.0, 1.2e-7);  // within two ulps
+    for (std::size_t i = 0; i < img.data.size(); ++i)
+      ASSERT_NEAR(out.data[i], img.data[i] / 255.0, 1.2e-7);  // within two ulps
   }
 }
 

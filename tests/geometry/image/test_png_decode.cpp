@@ -70,25 +70,29 @@ Bytes zlibStored(const Bytes& raw) {
 
 int predict(int type, int a, int b, int c) {
   switch (type) {
-    case 1: return a;
-    case 2: return b;
-    case 3: return (a + b) / 2;
+    case 1:
+      return a;
+    case 2:
+      return b;
+    case 3:
+      return (a + b) / 2;
     case 4: {
       const int p = a + b - c, pa = std::abs(p - a), pb = std::abs(p - b), pc = std::abs(p - c);
       return pa <= pb && pa <= pc ? a : pb <= pc ? b : c;
     }
-    default: return 0;
+    default:
+      return 0;
   }
 }
 
 struct PngSpec {
-  int colour = 2;        // 2 RGB, 6 RGBA, anything else written as given
+  int colour = 2;  // 2 RGB, 6 RGBA, anything else written as given
   int depth = 8;
   int interlace = 0;
-  bool trns = false;     // a tRNS chunk before the data
-  bool text = true;      // an ancillary tEXt chunk (skipped) between IHDR and IDAT
-  int idat_chunks = 1;   // the zlib stream split over this many IDATs
-  int filter = -1;       // every row's filter; -1: row y uses y % 5
+  bool trns = false;    // a tRNS chunk before the data
+  bool text = true;     // an ancillary tEXt chunk (skipped) between IHDR and IDAT
+  int idat_chunks = 1;  // the zlib stream split over this many IDATs
+  int filter = -1;      // every row's filter; -1: row y uses y % 5
 };
 
 // Writes img (RGB or RGBA bytes) as a PNG with the spec's chunks and row filters.
@@ -119,7 +123,8 @@ Bytes encodePng(const Image8& img, const PngSpec& s) {
   const Bytes z = zlibStored(raw);
   const std::size_t part = (z.size() + s.idat_chunks - 1) / s.idat_chunks;
   for (std::size_t p = 0; p < z.size(); p += part)
-    chunk(out, "IDAT", Bytes(z.begin() + static_cast<long>(p), z.begin() + static_cast<long>(std::min(z.size(), p + part))));
+    chunk(out, "IDAT",
+          Bytes(z.begin() + static_cast<long>(p), z.begin() + static_cast<long>(std::min(z.size(), p + part))));
   chunk(out, "IEND", {});
   return out;
 }

@@ -22,8 +22,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-void addCamera(ColmapModel& m, std::uint32_t id, const std::string& model, std::uint64_t w,
-               std::uint64_t h, std::vector<double> params) {
+void addCamera(ColmapModel& m, std::uint32_t id, const std::string& model, std::uint64_t w, std::uint64_t h,
+               std::vector<double> params) {
   ColmapCamera c;
   c.id = id;
   c.model = model;
@@ -41,13 +41,12 @@ ColmapModel randomModel(std::uint64_t seed) {
   std::normal_distribution<double> n(0, 1);
   ColmapModel m;
   addCamera(m, 1, "SIMPLE_PINHOLE", 640, 480, {500 + 50 * u(rng), 320 + u(rng), 240 + u(rng)});
-  addCamera(m, 2, "PINHOLE", 1920, 1080,
-            {1400 * u(rng) + 1, 1400 * u(rng) + 1, 960 * u(rng), 540 * u(rng)});
+  addCamera(m, 2, "PINHOLE", 1920, 1080, {1400 * u(rng) + 1, 1400 * u(rng) + 1, 960 * u(rng), 540 * u(rng)});
   addCamera(m, 7, "PINHOLE", 800, 600, {600 + u(rng), 601 + u(rng), 400.5, 300.25});
   addCamera(m, 4000000000u, "SIMPLE_PINHOLE", 3, 5, {1e-3 * u(rng), -1e10 * u(rng), 1e-300});
   addCamera(m, 9, "OPENCV", 1280, 720,
-            {900 + u(rng), 905 + u(rng), 640 + u(rng), 360 + u(rng), -0.1 * u(rng), 0.01 * u(rng),
-             1e-4 * n(rng), -1e-4 * n(rng)});
+            {900 + u(rng), 905 + u(rng), 640 + u(rng), 360 + u(rng), -0.1 * u(rng), 0.01 * u(rng), 1e-4 * n(rng),
+             -1e-4 * n(rng)});
   std::vector<std::uint32_t> camera_ids;
   for (const auto& [id, c] : m.cameras) camera_ids.push_back(id);
 
@@ -73,8 +72,7 @@ ColmapModel randomModel(std::uint64_t seed) {
 
   std::vector<std::pair<std::uint32_t, std::uint32_t>> slots;
   for (const auto& [id, img] : m.images)
-    for (size_t i = 0; i < img.xys.size(); ++i)
-      slots.emplace_back(id, static_cast<std::uint32_t>(i));
+    for (size_t i = 0; i < img.xys.size(); ++i) slots.emplace_back(id, static_cast<std::uint32_t>(i));
   std::shuffle(slots.begin(), slots.end(), rng);
   std::uint64_t pid = 5;
   while (slots.size() > 6) {  // leave a few 2D points without a 3D point
@@ -150,8 +148,7 @@ void expectSameModel(const ColmapModel& a, const ColmapModel& b) {
     const ColmapPoint3D& y = ib->second;
     EXPECT_EQ(ia->first, ib->first);
     EXPECT_EQ(x.id, y.id);
-    EXPECT_EQ(bits({x.xyz.x(), x.xyz.y(), x.xyz.z(), x.error}),
-              bits({y.xyz.x(), y.xyz.y(), y.xyz.z(), y.error}));
+    EXPECT_EQ(bits({x.xyz.x(), x.xyz.y(), x.xyz.z(), x.error}), bits({y.xyz.x(), y.xyz.y(), y.xyz.z(), y.error}));
     EXPECT_EQ(x.rgb, y.rgb);
     EXPECT_EQ(x.track, y.track);
   }
@@ -176,8 +173,7 @@ ColmapModel tinyModel() {
   return m;
 }
 
-void writeText(const TempDir& dir, const std::string& cameras, const std::string& images,
-               const std::string& points) {
+void writeText(const TempDir& dir, const std::string& cameras, const std::string& images, const std::string& points) {
   writeBytes(dir.file("cameras.txt"), cameras);
   writeBytes(dir.file("images.txt"), images);
   writeBytes(dir.file("points3D.txt"), points);
@@ -245,8 +241,7 @@ TEST(ColmapIo, TextBinaryTextRoundTripIsExact) {
   writeColmapText(dir.file("text2"), readColmapBinary(dir.file("bin")));
   expectSameModel(m, readColmapText(dir.file("text2")));
   for (const char* name : {"cameras.txt", "images.txt", "points3D.txt"})
-    EXPECT_EQ(readBytes(dir.file(std::string("text1/") + name)),
-              readBytes(dir.file(std::string("text2/") + name)))
+    EXPECT_EQ(readBytes(dir.file(std::string("text1/") + name)), readBytes(dir.file(std::string("text2/") + name)))
         << name;
 }
 
@@ -257,11 +252,10 @@ TEST(ColmapIo, WritersLeaveOnlyTheModelFiles) {
   writeColmapBinary(dir.str(), m);
   writeColmapBinary(dir.str(), m);  // overwriting works too
   std::vector<std::string> names;
-  for (const auto& e : fs::directory_iterator(dir.str()))
-    names.push_back(e.path().filename().string());
+  for (const auto& e : fs::directory_iterator(dir.str())) names.push_back(e.path().filename().string());
   std::sort(names.begin(), names.end());
-  EXPECT_EQ(names, (std::vector<std::string>{"cameras.bin", "cameras.txt", "images.bin",
-                                             "images.txt", "points3D.bin", "points3D.txt"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"cameras.bin", "cameras.txt", "images.bin", "images.txt", "points3D.bin",
+                                             "points3D.txt"}));
 }
 
 TEST(ColmapIo, TextHeaderHasColmapComments) {
@@ -378,8 +372,7 @@ TEST(ColmapErrors, MissingFile) {
   writeColmapBinary(dir.str(), tinyModel());
   fs::remove(dir.file("images.bin"));
   EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "images.bin", "file"));
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapText(dir.file("nothing")); }, "cameras.txt", "file"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapText(dir.file("nothing")); }, "cameras.txt", "file"));
 }
 
 TEST(ColmapErrors, TruncatedBinaryAtEveryOffset) {
@@ -406,8 +399,7 @@ TEST(ColmapErrors, TruncatedBinaryAtEveryOffset) {
 TEST(ColmapErrors, TextCountDoesNotParse) {
   TempDir dir;
   writeText(dir, "# Number of cameras: three\n" + kCameras, kImages, kPoints);
-  EXPECT_TRUE(throwsInputError([&] { readColmapText(dir.str()); }, "cameras.txt",
-                               "line 1: Number of cameras"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapText(dir.str()); }, "cameras.txt", "line 1: Number of cameras"));
 }
 
 TEST(ColmapErrors, TextCountDisagreesWithRecords) {
@@ -417,8 +409,7 @@ TEST(ColmapErrors, TextCountDisagreesWithRecords) {
   std::string points = readBytes(dir.file("points3D.txt"));
   points.erase(points.rfind('\n', points.size() - 2) + 1);
   writeBytes(dir.file("points3D.txt"), points);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapText(dir.str()); }, "points3D.txt", "Number of points"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapText(dir.str()); }, "points3D.txt", "Number of points"));
 }
 
 TEST(ColmapErrors, BinaryCountLargerThanData) {
@@ -433,15 +424,12 @@ TEST(ColmapErrors, BinaryCountLargerThanData) {
 
   writeColmapBinary(dir.str(), tinyModel());
   const size_t num_points2d = 8 + 4 + 7 * 8 + 4 + std::string("a.png").size() + 1;
-  patch<std::uint64_t>(dir.file("images.bin"), num_points2d,
-                       std::numeric_limits<std::uint64_t>::max());
-  EXPECT_TRUE(throwsInputError([&] { readColmapBinary(dir.str()); }, "images.bin",
-                               "image 1: num_points2D"));
+  patch<std::uint64_t>(dir.file("images.bin"), num_points2d, std::numeric_limits<std::uint64_t>::max());
+  EXPECT_TRUE(throwsInputError([&] { readColmapBinary(dir.str()); }, "images.bin", "image 1: num_points2D"));
 
   writeColmapBinary(dir.str(), tinyModel());
   patch<std::uint64_t>(dir.file("points3D.bin"), 8 + 8 + 3 * 8 + 3 + 8, 1ull << 40);
-  EXPECT_TRUE(throwsInputError([&] { readColmapBinary(dir.str()); }, "points3D.bin",
-                               "point 1: track_length"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapBinary(dir.str()); }, "points3D.bin", "point 1: track_length"));
 }
 
 TEST(ColmapErrors, BinaryCountSmallerThanData) {
@@ -456,22 +444,18 @@ TEST(ColmapErrors, BinaryCountSmallerThanData) {
 TEST(ColmapErrors, NanOrInfInPose) {
   TempDir dir;
   writeText(dir, kCameras, "1 nan 0 0 0 0 0 0 1 a.png\n\n", kPoints);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "images.txt", "line 1: quaternion"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "images.txt", "line 1: quaternion"));
   writeText(dir, kCameras, "# c\n1 1 0 0 0 0 inf 0 1 a.png\n\n", kPoints);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "images.txt", "line 2: translation"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "images.txt", "line 2: translation"));
 
   ColmapModel m = tinyModel();
   m.images[1].q.x() = std::numeric_limits<double>::quiet_NaN();
   writeColmapBinary(dir.str(), m);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "images.bin", "image 1: quaternion"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "images.bin", "image 1: quaternion"));
   m = tinyModel();
   m.images[1].t.z() = -std::numeric_limits<double>::infinity();
   writeColmapBinary(dir.str(), m);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "images.bin", "image 1: translation"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "images.bin", "image 1: translation"));
 }
 
 TEST(ColmapErrors, NanOrInfInPoint) {
@@ -479,24 +463,20 @@ TEST(ColmapErrors, NanOrInfInPoint) {
   writeText(dir, kCameras, "1 1 0 0 0 0 0 0 1 a.png\n10 20 4\n", "4 1 NaN 3 0 0 0 0.5 1 0\n");
   EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "points3D.txt", "line 1: xyz"));
   writeText(dir, kCameras, "1 1 0 0 0 0 0 0 1 a.png\n10 inf -1\n", "");
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "images.txt", "line 2: points2D"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "images.txt", "line 2: points2D"));
 
   ColmapModel m = tinyModel();
   m.points[1].xyz.y() = std::numeric_limits<double>::infinity();
   writeColmapBinary(dir.str(), m);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "points3D.bin", "point 1: xyz"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "points3D.bin", "point 1: xyz"));
 }
 
 TEST(ColmapErrors, NonUnitQuaternion) {
   TempDir dir;
   writeText(dir, kCameras, "1 1.002 0 0 0 0 0 0 1 a.png\n\n", kPoints);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "images.txt", "line 1: quaternion"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "images.txt", "line 1: quaternion"));
   writeText(dir, kCameras, "1 0 0 0 0 0 0 0 1 a.png\n\n", kPoints);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "images.txt", "line 1: quaternion"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "images.txt", "line 1: quaternion"));
   // Within the 1e-3 tolerance: rounding in other tools must not be refused.
   writeText(dir, kCameras, "1 0.9995 0 0 0 0 0 0 1 a.png\n\n", kPoints);
   EXPECT_NO_THROW(readColmapModel(dir.str()));
@@ -504,94 +484,75 @@ TEST(ColmapErrors, NonUnitQuaternion) {
   ColmapModel m = tinyModel();
   m.images[1].q = Eigen::Quaterniond(0.5, 0.5, 0.5, 0.4);
   writeColmapBinary(dir.str(), m);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "images.bin", "image 1: quaternion"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "images.bin", "image 1: quaternion"));
   m.images[1].q = Eigen::Quaterniond(0, 0, 0, 0);
   writeColmapBinary(dir.str(), m);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "images.bin", "image 1: quaternion"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "images.bin", "image 1: quaternion"));
 }
 
 TEST(ColmapErrors, UnknownCameraModel) {
   TempDir dir;
   writeText(dir, "1 PINHOLE_X 640 480 500 500 320 240\n", kImages, kPoints);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.txt", "line 1: model"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.txt", "line 1: model"));
 
   writeColmapBinary(dir.str(), tinyModel());
   patch<std::int32_t>(dir.file("cameras.bin"), 8 + 4, 42);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.bin", "camera 1: model_id"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.bin", "camera 1: model_id"));
   patch<std::int32_t>(dir.file("cameras.bin"), 8 + 4, -1);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.bin", "camera 1: model_id"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.bin", "camera 1: model_id"));
 }
 
 TEST(ColmapErrors, WrongParameterCount) {
   TempDir dir;
   writeText(dir, "1 PINHOLE 640 480 500 320 240\n", kImages, kPoints);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.txt", "line 1: params"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.txt", "line 1: params"));
   writeText(dir, "1 OPENCV 640 480 500 500 320 240 0 0 0 0 0\n", kImages, kPoints);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.txt", "line 1: params"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.txt", "line 1: params"));
 }
 
 TEST(ColmapErrors, NonPositiveFocalLengthOrSize) {
   TempDir dir;
   writeText(dir, "1 SIMPLE_PINHOLE 640 480 0 320 240\n", kImages, kPoints);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.txt", "line 1: focal length"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.txt", "line 1: focal length"));
   writeText(dir, "1 PINHOLE 640 480 500 -500 320 240\n", kImages, kPoints);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.txt", "line 1: focal length"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.txt", "line 1: focal length"));
   writeText(dir, "1 OPENCV 640 480 -1 500 320 240 0 0 0 0\n", kImages, kPoints);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.txt", "line 1: focal length"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.txt", "line 1: focal length"));
   writeText(dir, "1 PINHOLE 0 480 500 500 320 240\n", kImages, kPoints);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.txt", "line 1: width"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.txt", "line 1: width"));
   writeText(dir, "1 PINHOLE 640 0 500 500 320 240\n", kImages, kPoints);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.txt", "line 1: height"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.txt", "line 1: height"));
   writeText(dir, "1 PINHOLE -640 480 500 500 320 240\n", kImages, kPoints);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.txt", "line 1: WIDTH"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.txt", "line 1: WIDTH"));
 
   ColmapModel m = tinyModel();
   m.cameras[1].width = 0;
   writeColmapBinary(dir.str(), m);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.bin", "camera 1: width"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.bin", "camera 1: width"));
   m = tinyModel();
   m.cameras[1].params[1] = -2;
   writeColmapBinary(dir.str(), m);
-  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.bin",
-                               "camera 1: focal length"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.bin", "camera 1: focal length"));
 }
 
 TEST(ColmapErrors, ImageReferencesMissingCamera) {
   TempDir dir;
   writeText(dir, kCameras, "1 1 0 0 0 0 0 0 1 a.png\n\n2 1 0 0 0 0 0 0 5 b.png\n\n", kPoints);
   EXPECT_NO_THROW(readColmapText(dir.str()));  // the per-file reader does not cross-check
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, dir.str(), "image 2: camera_id"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, dir.str(), "image 2: camera_id"));
   ColmapModel m = tinyModel();
   m.images[1].camera_id = 3;
-  EXPECT_TRUE(throwsInputError([&] { validateColmapModel(m, "somewhere"); }, "somewhere",
-                               "image 1: camera_id"));
+  EXPECT_TRUE(throwsInputError([&] { validateColmapModel(m, "somewhere"); }, "somewhere", "image 1: camera_id"));
 }
 
 TEST(ColmapErrors, ImageReferencesMissingPoint) {
   TempDir dir;
   writeText(dir, kCameras, "1 1 0 0 0 0 0 0 1 a.png\n10 20 -1 30 40 12\n", kPoints);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, dir.str(), "image 1: point3D_id"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, dir.str(), "image 1: point3D_id"));
   ColmapModel m = tinyModel();
   m.images[1].point3d_ids[1] = 99;
   writeColmapBinary(dir.str(), m);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, dir.str(), "image 1: point3D_id"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, dir.str(), "image 1: point3D_id"));
 }
 
 TEST(ColmapErrors, TrackReferencesMissingImage) {
@@ -612,52 +573,41 @@ TEST(ColmapErrors, TrackIndexOutOfRange) {
 
 TEST(ColmapErrors, TextValuesThatDoNotParse) {
   TempDir dir;
-  writeText(dir, kCameras, "# a\n\n# b\n1 1 0 0 0 0 0 0 1 a.png\n\n2 x 0 0 0 0 0 0 1 b.png\n\n",
-            kPoints);
+  writeText(dir, kCameras, "# a\n\n# b\n1 1 0 0 0 0 0 0 1 a.png\n\n2 x 0 0 0 0 0 0 1 b.png\n\n", kPoints);
   EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "images.txt", "line 6: QW"));
   writeText(dir, kCameras, "1 1 0 0 0 0 0 0\n\n", kPoints);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "images.txt", "line 1: CAMERA_ID"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "images.txt", "line 1: CAMERA_ID"));
   writeText(dir, kCameras, "1 1 0 0 0 0 0 0 1\n\n", kPoints);
   EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "images.txt", "line 1: NAME"));
   writeText(dir, kCameras, "1 1 0 0 0 0 0 0 1 a.png\n10 20\n", kPoints);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "images.txt", "line 2: POINTS2D"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "images.txt", "line 2: POINTS2D"));
   writeText(dir, kCameras, "1 1 0 0 0 0 0 0 1 a.png\n10 20 -2\n", kPoints);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "images.txt", "line 2: POINT3D_ID"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "images.txt", "line 2: POINT3D_ID"));
   writeText(dir, kCameras, "1 1 0 0 0 0 0 0 1 a.png\n1 1 0 0 0 0 0 0 1 b.png\n\n", kPoints);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "images.txt", "line 2: POINTS2D"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "images.txt", "line 2: POINTS2D"));
   writeText(dir, "-1 PINHOLE 640 480 500 500 320 240\n", kImages, kPoints);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.txt", "line 1: CAMERA_ID"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.txt", "line 1: CAMERA_ID"));
   writeText(dir, "1 PINHOLE 640 480 500 500 320 240x\n", kImages, kPoints);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.txt", "line 1: PARAMS"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.txt", "line 1: PARAMS"));
   writeText(dir, kCameras, "1 1 0 0 0 0 0 0 1 a.png\n10 20 4\n", "4 1 2 3 256 0 0 0.5 1 0\n");
   EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "points3D.txt", "line 1: R"));
   writeText(dir, kCameras, "1 1 0 0 0 0 0 0 1 a.png\n10 20 4\n", "4 1 2 3 0 0 0 0.5 1\n");
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "points3D.txt", "line 1: TRACK"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "points3D.txt", "line 1: TRACK"));
 }
 
 TEST(ColmapErrors, DuplicateIds) {
   TempDir dir;
   writeText(dir, kCameras + kCameras, kImages, kPoints);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.txt", "line 2: CAMERA_ID"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "cameras.txt", "line 2: CAMERA_ID"));
   writeText(dir, kCameras, kImages + kImages, kPoints);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "images.txt", "line 3: IMAGE_ID"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "images.txt", "line 3: IMAGE_ID"));
 
   ColmapModel m = tinyModel();
   m.points[2] = m.points[1];
   m.points[2].id = 2;
   writeColmapBinary(dir.str(), m);
   patch<std::uint64_t>(dir.file("points3D.bin"), 8 + 59, 1);  // second point's id := 1
-  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "points3D.bin",
-                               "point record 1: point3D_id"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "points3D.bin", "point record 1: point3D_id"));
 }
 
 TEST(ColmapErrors, BinaryNegativePointId) {
@@ -665,16 +615,14 @@ TEST(ColmapErrors, BinaryNegativePointId) {
   writeColmapBinary(dir.str(), tinyModel());
   const size_t first_id = 8 + 4 + 7 * 8 + 4 + std::string("a.png").size() + 1 + 8 + 16;
   patch<std::int64_t>(dir.file("images.bin"), first_id, -2);
-  EXPECT_TRUE(
-      throwsInputError([&] { readColmapModel(dir.str()); }, "images.bin", "image 1: point3D_id"));
+  EXPECT_TRUE(throwsInputError([&] { readColmapModel(dir.str()); }, "images.bin", "image 1: point3D_id"));
 }
 
 TEST(ColmapErrors, ValidateChecksRecordsBuiltInCode) {
   ColmapModel m = tinyModel();
   EXPECT_NO_THROW(validateColmapModel(m, "dir"));
   m.cameras[1].id = 2;
-  EXPECT_TRUE(
-      throwsInputError([&] { validateColmapModel(m, "dir"); }, "dir", "camera 1: camera_id"));
+  EXPECT_TRUE(throwsInputError([&] { validateColmapModel(m, "dir"); }, "dir", "camera 1: camera_id"));
   m = tinyModel();
   m.images[1].point3d_ids.pop_back();
   EXPECT_TRUE(throwsInputError([&] { validateColmapModel(m, "dir"); }, "dir", "image 1: points2D"));
@@ -687,15 +635,12 @@ TEST(ColmapErrors, WritersRefuseWhatTheFormatCannotHold) {
   TempDir dir;
   ColmapModel m = tinyModel();
   m.cameras[1].model = "FISHEYE_9000";
-  EXPECT_TRUE(
-      throwsInputError([&] { writeColmapBinary(dir.str(), m); }, "cameras.bin", "camera 1: model"));
+  EXPECT_TRUE(throwsInputError([&] { writeColmapBinary(dir.str(), m); }, "cameras.bin", "camera 1: model"));
   m = tinyModel();
   m.cameras[1].params.pop_back();
-  EXPECT_TRUE(throwsInputError([&] { writeColmapBinary(dir.str(), m); }, "cameras.bin",
-                               "camera 1: params"));
+  EXPECT_TRUE(throwsInputError([&] { writeColmapBinary(dir.str(), m); }, "cameras.bin", "camera 1: params"));
   m = tinyModel();
   m.images[1].name = "two\nlines.png";
-  EXPECT_TRUE(
-      throwsInputError([&] { writeColmapText(dir.str(), m); }, "images.txt", "image 1: name"));
+  EXPECT_TRUE(throwsInputError([&] { writeColmapText(dir.str(), m); }, "images.txt", "image 1: name"));
   EXPECT_TRUE(fs::is_empty(dir.str()));  // nothing half-written
 }

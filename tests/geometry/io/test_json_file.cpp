@@ -23,7 +23,8 @@ std::string messageOf(F&& f) {
 }  // namespace
 
 TEST(JsonFields, ReturnsValuesOfTheRightType) {
-  const json j = json::parse(R"({"n": 2.5, "i": 7, "big": 2e9, "s": "x", "b": true, "a": [1, 2], "names": ["p", "q"]})");
+  const json j =
+      json::parse(R"({"n": 2.5, "i": 7, "big": 2e9, "s": "x", "b": true, "a": [1, 2], "names": ["p", "q"]})");
   EXPECT_EQ(jsonNumber(jsonMember(j, "n", "f.json", ""), "f.json", "n"), 2.5);
   EXPECT_EQ(jsonInteger(j["i"], "f.json", "i", 0, 10), 7);
   EXPECT_EQ(jsonInteger(j["big"], "f.json", "big", 0, 3'000'000'000LL), 2'000'000'000LL);
@@ -45,7 +46,8 @@ TEST(JsonFields, WrongTypesAndRangesNameFileAndField) {
   m = messageOf([&] { jsonInteger(j["i"], f, "num_views", 0, 100); });
   EXPECT_NE(m.find("num_views: expected a whole number in 0..100, got 1.5"), std::string::npos) << m;
   EXPECT_TRUE(test::throwsInputError([&] { jsonInteger(j["neg"], f, "seed", 0, 10); }, f, "seed"));
-  EXPECT_TRUE(test::throwsInputError([&] { jsonInteger(j["huge"], f, "seed", 0, std::numeric_limits<long long>::max()); }, f, "seed"));
+  EXPECT_TRUE(test::throwsInputError(
+      [&] { jsonInteger(j["huge"], f, "seed", 0, std::numeric_limits<long long>::max()); }, f, "seed"));
   EXPECT_TRUE(test::throwsInputError([&] { jsonNumberIn(j["huge"], f, "keep", 0, 1); }, f, "keep"));
   m = messageOf([&] { jsonIntegers(j["arr"], f, "seeds", 0, 10); });
   EXPECT_NE(m.find("seeds[1]: expected a whole number"), std::string::npos) << m;

@@ -38,14 +38,12 @@ std::vector<std::uint32_t> bits(const std::vector<float>& v) {
 
 std::string bigEndian(float f) {
   const auto u = std::bit_cast<std::uint32_t>(f);
-  return {static_cast<char>(u >> 24), static_cast<char>(u >> 16), static_cast<char>(u >> 8),
-          static_cast<char>(u)};
+  return {static_cast<char>(u >> 24), static_cast<char>(u >> 16), static_cast<char>(u >> 8), static_cast<char>(u)};
 }
 
 std::string littleEndian(float f) {
   const auto u = std::bit_cast<std::uint32_t>(f);
-  return {static_cast<char>(u), static_cast<char>(u >> 8), static_cast<char>(u >> 16),
-          static_cast<char>(u >> 24)};
+  return {static_cast<char>(u), static_cast<char>(u >> 8), static_cast<char>(u >> 16), static_cast<char>(u >> 24)};
 }
 
 void expectSameImage(const ImageF& a, const ImageF& b) {
@@ -153,10 +151,8 @@ TEST(Pfm, TruncatedAtEveryOffset) {
 
 TEST(Pfm, WriteRefusesUnsupportedImages) {
   TempDir dir;
-  EXPECT_TRUE(
-      throwsInputError([&] { writePfm(dir.file("a.pfm"), ImageF(2, 2, 2)); }, "a.pfm", "channels"));
-  EXPECT_TRUE(
-      throwsInputError([&] { writePfm(dir.file("a.pfm"), ImageF()); }, "a.pfm", "channels"));
+  EXPECT_TRUE(throwsInputError([&] { writePfm(dir.file("a.pfm"), ImageF(2, 2, 2)); }, "a.pfm", "channels"));
+  EXPECT_TRUE(throwsInputError([&] { writePfm(dir.file("a.pfm"), ImageF()); }, "a.pfm", "channels"));
   ImageF broken(2, 2, 1);
   broken.data.pop_back();
   EXPECT_TRUE(throwsInputError([&] { writePfm(dir.file("a.pfm"), broken); }, "a.pfm", "image"));

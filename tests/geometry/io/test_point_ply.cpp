@@ -29,7 +29,8 @@ TEST(PointPly, RoundTripAndAscii) {
 
 TEST(PointPly, BadFilesNameTheField) {
   test::TempDir d;
-  const std::string head = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+  const std::string head =
+      "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
   test::writeBytes(d.file("nan.ply"), head + "1 nan 3\n");
   EXPECT_TRUE(test::throwsInputError([&] { readPointsPly(d.file("nan.ply")); }, "nan.ply", "vertex 0"));
   test::writeBytes(d.file("inf.ply"), head + "1 2 inf\n");
@@ -37,15 +38,18 @@ TEST(PointPly, BadFilesNameTheField) {
   test::writeBytes(d.file("short.ply"), head + "1 2\n");
   EXPECT_TRUE(test::throwsInputError([&] { readPointsPly(d.file("short.ply")); }, "short.ply", "vertex"));
   // A count the file cannot hold is refused before anything is allocated.
-  test::writeBytes(d.file("huge.ply"),
-                   "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000000\nproperty float x\nproperty float y\n"
-                   "property float z\nend_header\n0123456789ab");
+  test::writeBytes(
+      d.file("huge.ply"),
+      "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000000\nproperty float x\nproperty float y\n"
+      "property float z\nend_header\n0123456789ab");
   EXPECT_TRUE(test::throwsInputError([&] { readPointsPly(d.file("huge.ply")); }, "huge.ply", "element vertex"));
-  test::writeBytes(d.file("nox.ply"), "ply\nformat ascii 1.0\nelement vertex 1\nproperty float y\nproperty float z\nend_header\n1 2\n");
+  test::writeBytes(d.file("nox.ply"),
+                   "ply\nformat ascii 1.0\nelement vertex 1\nproperty float y\nproperty float z\nend_header\n1 2\n");
   EXPECT_TRUE(test::throwsInputError([&] { readPointsPly(d.file("nox.ply")); }, "nox.ply", "property x"));
   test::writeBytes(d.file("be.ply"), "ply\nformat binary_big_endian 1.0\nelement vertex 0\nend_header\n");
   EXPECT_TRUE(test::throwsInputError([&] { readPointsPly(d.file("be.ply")); }, "be.ply", "format"));
-  test::writeBytes(d.file("rgb.ply"), "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
-                                      "property float red\nend_header\n1 2 3 0.5\n");
+  test::writeBytes(d.file("rgb.ply"),
+                   "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+                   "property float red\nend_header\n1 2 3 0.5\n");
   EXPECT_TRUE(test::throwsInputError([&] { readPointsPly(d.file("rgb.ply")); }, "rgb.ply", "property red"));
 }

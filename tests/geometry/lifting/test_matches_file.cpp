@@ -54,17 +54,17 @@ TEST(MatchesFile, MalformedFilesNameFileAndLine) {
   const std::vector<Case> cases = {
       {"", "header"},
       {"# only comments\n\n", "header"},
-      {"1,2,3,4\n", "line 1"},                        // no header
-      {"x0,y0,x1\n1,2,3\n", "line 1"},                // wrong header
+      {"1,2,3,4\n", "line 1"},                           // no header
+      {"x0,y0,x1\n1,2,3\n", "line 1"},                   // wrong header
       {"# c\nx0,y0,x1,y1\n1,2,3,4\n1,2,3\n", "line 4"},  // three fields
-      {"x0,y0,x1,y1\n1,2,3,4,5\n", "line 2"},         // five fields
-      {"x0,y0,x1,y1\n1,,3,4\n", "line 2"},            // empty field
-      {"x0,y0,x1,y1\n1,2,3,4,\n", "line 2"},          // trailing comma
-      {"x0,y0,x1,y1\n1,2,abc,4\n", "line 2"},         // not a number
-      {"x0,y0,x1,y1\n1,2,3px,4\n", "line 2"},         // trailing junk
-      {"x0,y0,x1,y1\n1,2,nan,4\n", "line 2"},         // not finite
+      {"x0,y0,x1,y1\n1,2,3,4,5\n", "line 2"},            // five fields
+      {"x0,y0,x1,y1\n1,,3,4\n", "line 2"},               // empty field
+      {"x0,y0,x1,y1\n1,2,3,4,\n", "line 2"},             // trailing comma
+      {"x0,y0,x1,y1\n1,2,abc,4\n", "line 2"},            // not a number
+      {"x0,y0,x1,y1\n1,2,3px,4\n", "line 2"},            // trailing junk
+      {"x0,y0,x1,y1\n1,2,nan,4\n", "line 2"},            // not finite
       {"x0,y0,x1,y1\n1,2,inf,4\n", "line 2"},
-      {"x0,y0,x1,y1\n1,2,1e999,4\n", "line 2"},       // overflows
+      {"x0,y0,x1,y1\n1,2,1e999,4\n", "line 2"},  // overflows
   };
   for (std::size_t i = 0; i < cases.size(); ++i) {
     const std::string path = dir.file("bad" + std::to_string(i) + ".csv");
@@ -72,8 +72,7 @@ TEST(MatchesFile, MalformedFilesNameFileAndLine) {
     EXPECT_TRUE(throwsInputError([&] { readMatches(path); }, path, cases[i].field))
         << "case " << i << ": " << cases[i].text;
   }
-  EXPECT_TRUE(throwsInputError([&] { readMatches(dir.file("missing.csv")); },
-                               dir.file("missing.csv"), "file"));
+  EXPECT_TRUE(throwsInputError([&] { readMatches(dir.file("missing.csv")); }, dir.file("missing.csv"), "file"));
 }
 
 TEST(Subsample, DenseInputGivesTheStrideGrid) {
@@ -95,13 +94,13 @@ TEST(Subsample, DenseInputGivesTheStrideGrid) {
 TEST(Subsample, SparseInputKeepsTheMatchNearestEachAnchorAndDropsOutsiders) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const std::vector<Correspondence> ms = {
-      {{3.9, 3.9}, {0, 0}},   // cell (0,0), far from its anchor (0.5, 0.5)
-      {{1.0, 0.7}, {1, 1}},   // cell (0,0), nearer: wins
-      {{7.0, 1.0}, {2, 2}},   // cell (1,0), alone
-      {{1.0, 0.7}, {3, 3}},   // the same x0 as the winner: the earlier one stays
-      {{-0.1, 2}, {4, 4}},    // outside
-      {{10.0, 2}, {5, 5}},    // x == width: outside
-      {{nan, 2}, {6, 6}},     // not finite
+      {{3.9, 3.9}, {0, 0}},  // cell (0,0), far from its anchor (0.5, 0.5)
+      {{1.0, 0.7}, {1, 1}},  // cell (0,0), nearer: wins
+      {{7.0, 1.0}, {2, 2}},  // cell (1,0), alone
+      {{1.0, 0.7}, {3, 3}},  // the same x0 as the winner: the earlier one stays
+      {{-0.1, 2}, {4, 4}},   // outside
+      {{10.0, 2}, {5, 5}},   // x == width: outside
+      {{nan, 2}, {6, 6}},    // not finite
   };
   const auto sub = subsampleByStride(ms, 5, 10, 10);
   ASSERT_EQ(sub.size(), 2u);

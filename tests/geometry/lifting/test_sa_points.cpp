@@ -109,8 +109,7 @@ struct Accuracy {
   double fraction() const { return points ? static_cast<double>(within) / points : 0.0; }
 };
 
-Accuracy accuracy(const World& w, const Camera& cam, const std::vector<SAPoint>& pts,
-                  double voxels = 2) {
+Accuracy accuracy(const World& w, const Camera& cam, const std::vector<SAPoint>& pts, double voxels = 2) {
   Accuracy a;
   for (const auto& p : pts) {
     ++a.points;
@@ -132,8 +131,8 @@ struct LiftRun {
   std::vector<double> medians;
 };
 
-LiftRun liftAll(const World& w, const LiftingModule& module, const std::string& label,
-               bool cached = true, const LiftingOptions& opts = {}) {
+LiftRun liftAll(const World& w, const LiftingModule& module, const std::string& label, bool cached = true,
+                const LiftingOptions& opts = {}) {
   LiftRun run;
   for (int v : w.views) {
     const Camera& cam = w.scene.cameras[v];
@@ -146,11 +145,11 @@ LiftRun liftAll(const World& w, const LiftingModule& module, const std::string& 
     std::cout << "[ " << label << " ] " << r.report.toJson().dump() << "\n";
   }
   std::ostringstream s;
-  s << label << ": " << run.acc.within << " of " << run.acc.points << " points ("
-    << 100.0 * run.acc.fraction() << " %) within 2 voxels (" << 2 * w.voxel << ")"
-    << ", subsampled " << run.total.subsampled << ", seconds render "
-    << run.total.seconds_render << " correspondence " << run.total.seconds_correspondence
-    << " triangulation " << run.total.seconds_triangulation << ", median reprojection px per view";
+  s << label << ": " << run.acc.within << " of " << run.acc.points << " points (" << 100.0 * run.acc.fraction()
+    << " %) within 2 voxels (" << 2 * w.voxel << ")"
+    << ", subsampled " << run.total.subsampled << ", seconds render " << run.total.seconds_render << " correspondence "
+    << run.total.seconds_correspondence << " triangulation " << run.total.seconds_triangulation
+    << ", median reprojection px per view";
   for (double m : run.medians) s << " " << m;
   std::cout << "[ " << label << " ] " << s.str() << "\n";
   ::testing::Test::RecordProperty(label, s.str());
@@ -269,8 +268,8 @@ TEST(SAPoints, MatchesFilesRoundTrip) {
 
   // A malformed file stops the lifting with the file and the line.
   writeBytes(file, "x0,y0,x1,y1\n10,10,12,12\n10,10,12\n");
-  EXPECT_TRUE(throwsInputError(
-      [&] { liftView(cam, image, w.extent, nullptr, matchesModule(pattern), {}, v); }, file, "line 3"));
+  EXPECT_TRUE(throwsInputError([&] { liftView(cam, image, w.extent, nullptr, matchesModule(pattern), {}, v); }, file,
+                               "line 3"));
 }
 
 TEST(SAPoints, SameInputsGiveIdenticalPoints) {
@@ -319,20 +318,18 @@ TEST(SAPoints, BadArgumentsRaiseInputError) {
   const ImageF& image = w.render(cam);
   const auto r = groundTruth(w);
   EXPECT_TRUE(throwsInputError([&] { liftView(cam, image, 0.0, r, flowModule()); }, "lifting", "extent"));
-  EXPECT_TRUE(throwsInputError(
-      [&] { liftView(cam, image, std::numeric_limits<double>::quiet_NaN(), r, flowModule()); },
-      "lifting", "extent"));
+  EXPECT_TRUE(throwsInputError([&] { liftView(cam, image, std::numeric_limits<double>::quiet_NaN(), r, flowModule()); },
+                               "lifting", "extent"));
   LiftingOptions o;
   o.stride = 0;
-  EXPECT_TRUE(throwsInputError([&] { liftView(cam, image, w.extent, r, flowModule(), o); },
-                               "lifting options", "stride"));
-  EXPECT_TRUE(throwsInputError([&] { liftView(cam, image, w.extent, nullptr, flowModule()); },
-                               "lifting", "renderer"));
-  EXPECT_TRUE(throwsInputError([&] { liftView(cam, ImageF(10, 10, 3), w.extent, r, flowModule()); },
-                               "lifting", "real image"));
+  EXPECT_TRUE(
+      throwsInputError([&] { liftView(cam, image, w.extent, r, flowModule(), o); }, "lifting options", "stride"));
+  EXPECT_TRUE(throwsInputError([&] { liftView(cam, image, w.extent, nullptr, flowModule()); }, "lifting", "renderer"));
+  EXPECT_TRUE(
+      throwsInputError([&] { liftView(cam, ImageF(10, 10, 3), w.extent, r, flowModule()); }, "lifting", "real image"));
   const ViewRenderer small = [](const Camera&) { return ImageF(8, 8, 3); };
-  EXPECT_TRUE(throwsInputError([&] { liftView(cam, image, w.extent, small, flowModule()); },
-                               "lifting", "extrapolated render"));
+  EXPECT_TRUE(
+      throwsInputError([&] { liftView(cam, image, w.extent, small, flowModule()); }, "lifting", "extrapolated render"));
   EXPECT_TRUE(throwsInputError([] { parseFlowPreset("slow"); }, "flow preset", "slow"));
   EXPECT_EQ(parseFlowPreset("ultrafast"), FlowPreset::kUltrafast);
   EXPECT_EQ(parseFlowPreset(flowPresetName(FlowPreset::kFast)), FlowPreset::kFast);
@@ -347,9 +344,8 @@ TEST(SAPoints, FlowPresetsAllWork) {
     f.preset = p;
     const LiftingResult r = liftView(cam, image, w.extent, groundTruth(w), flowModule(f), {}, 0);
     const Accuracy a = accuracy(w, cam, r.points);
-    std::cout << "[ preset " << flowPresetName(p) << " ] " << a.points << " points, "
-              << 100.0 * a.fraction() << " % within 2 voxels, correspondence "
-              << r.report.seconds_correspondence << " s\n";
+    std::cout << "[ preset " << flowPresetName(p) << " ] " << a.points << " points, " << 100.0 * a.fraction()
+              << " % within 2 voxels, correspondence " << r.report.seconds_correspondence << " s\n";
     EXPECT_GT(a.points, 100u);
     EXPECT_GE(a.fraction(), 0.8);
   }

@@ -53,8 +53,8 @@ TEST(Extrapolation, MovesTheCentreAlongTheCameraAxesAndKeepsRotation) {
   const Camera e = extrapolatedCamera(c, 0.3, -0.2, 0.5);
   EXPECT_EQ(e.K, c.K);
   EXPECT_TRUE(e.R.isApprox(c.R, 0.0));
-  const Eigen::Vector3d expected = c.center() + 0.3 * c.R.row(0).transpose() -
-                                   0.2 * c.R.row(1).transpose() - 0.5 * c.viewDirection();
+  const Eigen::Vector3d expected =
+      c.center() + 0.3 * c.R.row(0).transpose() - 0.2 * c.R.row(1).transpose() - 0.5 * c.viewDirection();
   EXPECT_NEAR((e.center() - expected).norm(), 0.0, 1e-12);
   // In camera coordinates the step is (0.3, -0.2, -0.5): backward is -z.
   EXPECT_NEAR((c.toCamera(e.center()) - Eigen::Vector3d(0.3, -0.2, -0.5)).norm(), 0.0, 1e-12);
@@ -164,8 +164,10 @@ TEST(Triangulation, PixelNoiseGivesTheExpectedReprojectionStatistics) {
     m.x1 += Eigen::Vector2d(noise(rng), noise(rng));
     const TriangulatedPoint p = triangulate(c0, c1, m, o);
     expectNoNaN(p);
-    if (p.rejection == Rejection::kReprojection) ++rejected_reprojection;
-    else if (!p.kept()) ++other;
+    if (p.rejection == Rejection::kReprojection)
+      ++rejected_reprojection;
+    else if (!p.kept())
+      ++other;
     if (p.reprojection_px >= 0) eps.push_back(p.reprojection_px);
   }
   ASSERT_EQ(static_cast<int>(eps.size()), n);
@@ -184,9 +186,9 @@ TEST(Triangulation, PixelNoiseGivesTheExpectedReprojectionStatistics) {
   const double frac = static_cast<double>(rejected_reprojection) / n;
   // Expected ~0.47 % = 93 points; the Poisson spread is ~10 points.
   EXPECT_NEAR(frac, p_reject, 0.4 * p_reject);
-  std::cout << "[ noise ] sigma " << sigma << " px: mean " << mean << " (expected " << mean_expected
-            << "), median " << median << " (expected " << median_expected
-            << "), rejected by 1 px " << frac << " (expected " << p_reject << ")\n";
+  std::cout << "[ noise ] sigma " << sigma << " px: mean " << mean << " (expected " << mean_expected << "), median "
+            << median << " (expected " << median_expected << "), rejected by 1 px " << frac << " (expected " << p_reject
+            << ")\n";
 }
 
 TEST(Triangulation, NearParallelRaysAreRejected) {
@@ -288,11 +290,11 @@ TEST(Triangulation, CorrespondencesOnOrOutsideTheBorderAreRejected) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
   const std::vector<Correspondence> bad = {
-      {{0.5, 100}, good.x1},                 // within 1 px of the left edge
-      {good.x0, {100, 479.5}},               // within 1 px of the bottom edge
-      {{640, 100}, good.x1},                 // on the right edge
-      {good.x0, {-3, 100}},                  // outside
-      {{nan, 100}, good.x1},                 // not a number
+      {{0.5, 100}, good.x1},    // within 1 px of the left edge
+      {good.x0, {100, 479.5}},  // within 1 px of the bottom edge
+      {{640, 100}, good.x1},    // on the right edge
+      {good.x0, {-3, 100}},     // outside
+      {{nan, 100}, good.x1},    // not a number
       {good.x0, {inf, 100}},
   };
   for (const auto& m : bad) {

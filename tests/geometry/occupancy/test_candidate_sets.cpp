@@ -56,12 +56,18 @@ std::vector<Camera> probeCameras(std::mt19937_64& rng, const AABB& box, int coun
     dir.normalize();
     Eigen::Vector3d eye, target;
     switch (i % 3) {
-      case 0: eye = c + (0.7 + 0.6 * u(rng)) * r * dir; target = c; break;  // outside
-      case 1:  // inside the box, looking somewhere
+      case 0:
+        eye = c + (0.7 + 0.6 * u(rng)) * r * dir;
+        target = c;
+        break;  // outside
+      case 1:   // inside the box, looking somewhere
         eye = box.min + Eigen::Vector3d(u(rng), u(rng), u(rng)).cwiseProduct(box.size());
         target = eye + Eigen::Vector3d(n(rng), n(rng), n(rng));
         break;
-      default: eye = c + 0.4 * r * dir; target = c + 0.2 * r * Eigen::Vector3d(n(rng), n(rng), n(rng)); break;
+      default:
+        eye = c + 0.4 * r * dir;
+        target = c + 0.2 * r * Eigen::Vector3d(n(rng), n(rng), n(rng));
+        break;
     }
     cams.push_back(Camera::lookAt(makeK(), eye, target, Eigen::Vector3d(n(rng), n(rng), n(rng))));
   }
@@ -76,8 +82,7 @@ std::set<Voxel> bruteFrustum(const OccupancyGrids& g, const Camera& cam, const D
     const double z = cam.toCamera(x).z();
     if (!(z >= r.near && z <= r.far)) continue;
     const auto uv = cam.project(x);
-    if (uv && uv->x() >= 0 && uv->y() >= 0 && uv->x() <= cam.K.width && uv->y() <= cam.K.height)
-      out.insert(v);
+    if (uv && uv->x() >= 0 && uv->y() >= 0 && uv->x() <= cam.K.width && uv->y() <= cam.K.height) out.insert(v);
   }
   return out;
 }
@@ -152,8 +157,8 @@ struct Agreement {
   double rate() const { return rays ? static_cast<double>(agree) / rays : 1.0; }
 };
 
-void compareWithOracle(const OccupancyGrids& g, const VisibilityTracer& tracer, const Camera& cam,
-                       int stride, Agreement& acc) {
+void compareWithOracle(const OccupancyGrids& g, const VisibilityTracer& tracer, const Camera& cam, int stride,
+                       Agreement& acc) {
   const DdaOracle oracle(g);
   const auto uv = samplePixels(cam.K, stride);
   const auto hits = tracer.tracePixels(cam, stride);
@@ -161,8 +166,7 @@ void compareWithOracle(const OccupancyGrids& g, const VisibilityTracer& tracer, 
   const auto& keys = g.sceneVoxels().keys();
   for (std::size_t i = 0; i < uv.size(); ++i) {
     const auto want = oracle.firstHit(cam.center(), cam.rayDirection(uv[i]));
-    const std::optional<Voxel> got =
-        hits[i] >= 0 ? std::optional<Voxel>(unpackVoxel(keys[hits[i]])) : std::nullopt;
+    const std::optional<Voxel> got = hits[i] >= 0 ? std::optional<Voxel>(unpackVoxel(keys[hits[i]])) : std::nullopt;
     ++acc.rays;
     acc.agree += (want == got);
     acc.hits += got.has_value();
@@ -232,8 +236,8 @@ TEST(VisibleSet, EmbreeAgreesWithDdaOracleOnRandomGrids) {
       all.agree += a.agree;
       all.hits += a.hits;
     }
-  std::printf("[ visible vs DDA, random grids ] %zu rays, %zu hits, agreement %.5f %%\n", all.rays,
-              all.hits, 100.0 * all.rate());
+  std::printf("[ visible vs DDA, random grids ] %zu rays, %zu hits, agreement %.5f %%\n", all.rays, all.hits,
+              100.0 * all.rate());
   EXPECT_GE(all.rate(), 0.999);
 }
 
@@ -248,8 +252,7 @@ TEST(VisibleSet, EmbreeAgreesWithDdaOracleOnRoom360) {
   const VisibilityTracer tracer(g);
   Agreement a;
   for (std::size_t i = 0; i < s.scene.cameras.size(); i += 5) compareWithOracle(g, tracer, s.scene.cameras[i], 2, a);
-  std::printf("[ visible vs DDA, room360 ] %zu rays, %zu hits, agreement %.5f %%\n", a.rays, a.hits,
-              100.0 * a.rate());
+  std::printf("[ visible vs DDA, room360 ] %zu rays, %zu hits, agreement %.5f %%\n", a.rays, a.hits, 100.0 * a.rate());
   EXPECT_GE(a.rate(), 0.999);
   // Sparse SfM leaves holes in the walls (most wall voxels hold fewer than m points), so
   // many rays leave the room; enough hit for the agreement to mean something.
@@ -329,8 +332,7 @@ TEST(CandidateSets, CameraThatSeesNothingAndDegenerateCameras) {
   bad = away;
   bad.R(0, 0) = 2;
   EXPECT_TRUE(test::throwsInputError([&] { sceneDepthRange(g, bad); }, "candidate camera", "K/R/t"));
-  EXPECT_TRUE(test::throwsInputError(
-      [&] { frustumSet(g, away, DepthRange{NAN, 1}); }, "candidate camera", "near/far"));
+  EXPECT_TRUE(test::throwsInputError([&] { frustumSet(g, away, DepthRange{NAN, 1}); }, "candidate camera", "near/far"));
   // A 1x1 image and a camera inside a voxel work.
   const Camera tiny = Camera::lookAt(makeK(1, 1), Eigen::Vector3d(12, -30, 6), g.box().center());
   EXPECT_LE(tracer.visibleSet(tiny, 4).size(), 1u);

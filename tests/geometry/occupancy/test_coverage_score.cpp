@@ -73,8 +73,8 @@ TEST(SpatialHash, FormulaAndRange) {
   EXPECT_EQ(spatialHash({-1, 0, 0}, 1u << 13), (1u << 13) - 1);
   EXPECT_TRUE(test::throwsInputError([] { HashedBits b(1000); }, "hash encoding", "table_size"));
   EXPECT_TRUE(test::throwsInputError([] { HashedBits b(1); }, "hash encoding", "table_size"));
-  EXPECT_TRUE(test::throwsInputError([] { scoreHashed(HashedBits(64), HashedBits(128)); },
-                                     "hash encoding", "table_size"));
+  EXPECT_TRUE(
+      test::throwsInputError([] { scoreHashed(HashedBits(64), HashedBits(128)); }, "hash encoding", "table_size"));
 }
 
 TEST(Scores, ExactScoresAreSetSizes) {
@@ -187,8 +187,8 @@ TEST(HashCollisions, Room360ScoresDeviateFromExactAsTheoryPredicts) {
       sum_err_new += static_cast<double>(ex.new_count) - hs.new_count;
       sum_pred_new += static_cast<double>(ex.new_count) - ex_new;
       if (j == 0)
-        std::printf("  %5d  %4zu  %9zu  %10zu  %12.1f  %9zu  %10zu  %12.1f\n", log2T, j, ex.differing,
-                    hs.differing, ex_xor, ex.new_count, hs.new_count, ex_new);
+        std::printf("  %5d  %4zu  %9zu  %10zu  %12.1f  %9zu  %10zu  %12.1f\n", log2T, j, ex.differing, hs.differing,
+                    ex_xor, ex.new_count, hs.new_count, ex_new);
     }
     std::printf("  log2T %d: total xor loss measured %.0f, predicted %.0f; new loss measured %.0f, predicted %.0f\n",
                 log2T, sum_err_xor, sum_pred_xor, sum_err_new, sum_pred_new);
@@ -301,7 +301,7 @@ TEST(HashLoad, TableSizeForALoadOfAtMostAHalf) {
   EXPECT_EQ(hashTableSizeFor(0), std::size_t{1} << 11);
   EXPECT_EQ(hashTableSizeFor(1024), std::size_t{1} << 11);  // exactly 0.5
   EXPECT_EQ(hashTableSizeFor(1025), std::size_t{1} << 12);
-  EXPECT_EQ(hashTableSizeFor(24112), std::size_t{1} << 16);  // room360's scene voxels at grid 64, m = 2
+  EXPECT_EQ(hashTableSizeFor(24112), std::size_t{1} << 16);       // room360's scene voxels at grid 64, m = 2
   EXPECT_EQ(hashTableSizeFor(10'000'000), std::size_t{1} << 19);  // beyond the paper's range: its largest
   EXPECT_EQ(hashTableSizeFor(300, 0.1, 11, 19), std::size_t{1} << 12);
 }

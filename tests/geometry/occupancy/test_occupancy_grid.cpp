@@ -52,9 +52,7 @@ std::set<Voxel> randomVoxels(std::mt19937_64& rng, int L, double density) {
 
 // Two points at the box corners fix a box [0, 10]^3; with resolution 10 the coarse
 // voxels are unit cubes.
-std::vector<Eigen::Vector3d> unitBoxFrame() {
-  return {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(10, 10, 10)};
-}
+std::vector<Eigen::Vector3d> unitBoxFrame() { return {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(10, 10, 10)}; }
 
 }  // namespace
 
@@ -65,17 +63,19 @@ TEST(VoxelKey, PackUnpackRoundTripAndBlockOrder) {
     const Voxel v{c(rng), c(rng), c(rng)};
     ASSERT_EQ(unpackVoxel(packVoxel(v)), v);
   }
-  for (const Voxel& v : {Voxel{-kVoxelCoordLimit, -kVoxelCoordLimit, -kVoxelCoordLimit},
-                         Voxel{kVoxelCoordLimit - 1, kVoxelCoordLimit - 1, kVoxelCoordLimit - 1},
-                         Voxel{-1, 0, 7}, Voxel{-8, -9, 8}})
+  for (const Voxel& v :
+       {Voxel{-kVoxelCoordLimit, -kVoxelCoordLimit, -kVoxelCoordLimit},
+        Voxel{kVoxelCoordLimit - 1, kVoxelCoordLimit - 1, kVoxelCoordLimit - 1}, Voxel{-1, 0, 7}, Voxel{-8, -9, 8}})
     EXPECT_EQ(unpackVoxel(packVoxel(v)), v);
   // Keys of one 8^3 block (floor division, negative too) share blockOfKey.
   EXPECT_EQ(blockOfKey(packVoxel({-8, 0, 0})), blockOfKey(packVoxel({-1, 7, 7})));
   EXPECT_NE(blockOfKey(packVoxel({-1, 0, 0})), blockOfKey(packVoxel({0, 0, 0})));
   EXPECT_FALSE(voxelRepresentable({kVoxelCoordLimit, 0, 0}));
   EXPECT_TRUE(test::throwsInputError(
-      [] { VoxelSet::fromVoxels(std::vector<Voxel>{{kVoxelCoordLimit, 0, 0}}); }, "voxel set",
-      "voxel 0"));
+      [] {
+        VoxelSet::fromVoxels(std::vector<Voxel>{{kVoxelCoordLimit, 0, 0}});
+      },
+      "voxel set", "voxel 0"));
 }
 
 TEST(VoxelSet, SetOperationsMatchStdSet) {
@@ -109,8 +109,8 @@ TEST(Dilation, OpenVdbEqualsBruteForceOnRandomSparseGrids) {
       for (int r : {0, 1, 2, 3}) {
         const std::set<Voxel> expect = bruteDilate(in, r, shape);
         const VoxelSet got = dilateVoxels(vin, r, shape);
-        EXPECT_EQ(asSet(got), expect) << "density " << density << " radius " << r
-                                      << " shape " << static_cast<int>(shape);
+        EXPECT_EQ(asSet(got), expect) << "density " << density << " radius " << r << " shape "
+                                      << static_cast<int>(shape);
         if (density > 0 && r > 0) {
           EXPECT_GT(got.size(), vin.size());  // the check is not vacuous
         }
@@ -137,8 +137,7 @@ TEST(OccupancyGrids, ThresholdMAndUpsamplingN) {
       // edge), one point in each of 8 others; the frame points add one to (0,0,0) and
       // (9,9,9) (the max corner belongs to the last voxel).
       auto fill = [&](Eigen::Vector3i c, int k) {
-        for (int i = 0; i < k; ++i)
-          pts.emplace_back(c.x() + inside(rng), c.y() + inside(rng), c.z() + inside(rng));
+        for (int i = 0; i < k; ++i) pts.emplace_back(c.x() + inside(rng), c.y() + inside(rng), c.z() + inside(rng));
       };
       fill({3, 4, 5}, m - 1);
       fill({6, 2, 1}, m);
@@ -261,10 +260,16 @@ TEST(OccupancyGrids, BadInputRaisesInputError) {
   const auto pts = unitBoxFrame();
   auto build = [](std::vector<Eigen::Vector3d> p, OccupancyOptions o) { return OccupancyGrids::fromSfm(p, o); };
   EXPECT_TRUE(test::throwsInputError([&] { build({}, {}); }, "SfM points", "points"));
-  EXPECT_TRUE(test::throwsInputError([&] { build({Eigen::Vector3d(1, 2, 3), Eigen::Vector3d(1, 2, 3)}, {}); },
-                                     "SfM points", "points"));
-  EXPECT_TRUE(test::throwsInputError([&] { build({Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(NAN, 0, 0)}, {}); },
-                                     "SfM points", "point 1"));
+  EXPECT_TRUE(test::throwsInputError(
+      [&] {
+        build({Eigen::Vector3d(1, 2, 3), Eigen::Vector3d(1, 2, 3)}, {});
+      },
+      "SfM points", "points"));
+  EXPECT_TRUE(test::throwsInputError(
+      [&] {
+        build({Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(NAN, 0, 0)}, {});
+      },
+      "SfM points", "point 1"));
   OccupancyOptions o;
   o.resolution = 0;
   EXPECT_TRUE(test::throwsInputError([&] { build(pts, o); }, "SfM points", "resolution"));

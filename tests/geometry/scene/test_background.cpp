@@ -14,9 +14,9 @@
 #include "geometry/scene/scene.h"
 
 using namespace saresgs;
-using saresgs::test::TempDir;
-using saresgs::test::glPose;
 using nlohmann::json;
+using saresgs::test::glPose;
+using saresgs::test::TempDir;
 
 TEST(Background, ParsesTheNamedColoursRandomAndRgb) {
   EXPECT_EQ(parseBackground("white", "--background"), (BackgroundChoice{false, {1, 1, 1}}));
@@ -29,8 +29,8 @@ TEST(Background, ParsesTheNamedColoursRandomAndRgb) {
 }
 
 TEST(Background, RefusesAnythingElseNamingTheOption) {
-  for (const char* bad : {"", "White", "grey", "1,1", "1,1,1,1", "0.5,,0.5", "-0.1,0,0", "0,0,1.5", "nan,0,0", "inf,0,0",
-                          "0x1,0,0 ", "1;1;1", "1, 1, 1x"}) {
+  for (const char* bad : {"", "White", "grey", "1,1", "1,1,1,1", "0.5,,0.5", "-0.1,0,0", "0,0,1.5", "nan,0,0",
+                          "inf,0,0", "0x1,0,0 ", "1;1;1", "1, 1, 1x"}) {
     try {
       parseBackground(bad, "--background");
       ADD_FAILURE() << "accepted '" << bad << "'";
@@ -75,7 +75,8 @@ void writeNerfstudio(const TempDir& d, std::uint8_t a, bool rgb) {
       if (!rgb) img.data[4 * p + 3] = a;
     }
     writeImage(d.file(name), img);
-    j["frames"].push_back({{"file_path", name}, {"transform_matrix", glPose(Eigen::Vector3d(4 * std::cos(i), 4 * std::sin(i), 1))}});
+    j["frames"].push_back(
+        {{"file_path", name}, {"transform_matrix", glPose(Eigen::Vector3d(4 * std::cos(i), 4 * std::sin(i), 1))}});
   }
   std::ofstream(d.file("transforms.json")) << j.dump();
 }

@@ -12,9 +12,9 @@
 #include "geometry/scene/scene.h"
 
 using namespace saresgs;
-using saresgs::test::TempDir;
-using saresgs::test::glPose;
 using nlohmann::json;
+using saresgs::test::glPose;
+using saresgs::test::TempDir;
 
 namespace {
 
@@ -138,17 +138,33 @@ TEST(BlenderDataset, MistypedFieldsRepeatsAndSizesAreRefusedByField) {
     std::string file, field;
   };
   const std::vector<Case> cases{
-      {[](json& t, json&) { t["camera_angle_x"] = "wide"; }, "transforms_train.json", "camera_angle_x: expected a number"},
+      {[](json& t, json&) { t["camera_angle_x"] = "wide"; }, "transforms_train.json",
+       "camera_angle_x: expected a number"},
       {[](json& t, json&) { t["frames"] = json::object(); }, "transforms_train.json", "frames: expected an array"},
-      {[](json& t, json&) { t["frames"][1] = json::array({1, 2}); }, "transforms_train.json", "frames[1]: expected an object"},
-      {[](json& t, json&) { t["frames"][1]["file_path"] = 7; }, "transforms_train.json", "frames[1].file_path: expected a string"},
+      {[](json& t, json&) {
+         t["frames"][1] = json::array({1, 2});
+       },
+       "transforms_train.json", "frames[1]: expected an object"},
+      {[](json& t, json&) { t["frames"][1]["file_path"] = 7; }, "transforms_train.json",
+       "frames[1].file_path: expected a string"},
       {[](json& t, json&) { t["frames"][2]["transform_matrix"][1][2] = "x"; }, "transforms_train.json",
        "frames[2].transform_matrix[1][2]: expected a number"},
-      {[](json& t, json&) { t["frames"][0]["transform_matrix"] = 3; }, "transforms_train.json", "frames[0].transform_matrix"},
-      {[](json&, json& s) { s["frames"][0]["cx"] = json::array(); }, "transforms_test.json", "frames[0].cx: expected a number"},
-      {[](json& t, json&) { t["w"] = "40"; t["h"] = 30; }, "transforms_train.json", "w: expected a whole number"},
-      {[](json& t, json&) { t["w"] = 4294967336.0; t["h"] = 30; }, "transforms_train.json", "w: expected a whole number in 1..65536"},
-      {[](json& t, json&) { t["frames"][2]["file_path"] = "./train/r_0"; }, "transforms_train.json", "frames[2].file_path"},
+      {[](json& t, json&) { t["frames"][0]["transform_matrix"] = 3; }, "transforms_train.json",
+       "frames[0].transform_matrix"},
+      {[](json&, json& s) { s["frames"][0]["cx"] = json::array(); }, "transforms_test.json",
+       "frames[0].cx: expected a number"},
+      {[](json& t, json&) {
+         t["w"] = "40";
+         t["h"] = 30;
+       },
+       "transforms_train.json", "w: expected a whole number"},
+      {[](json& t, json&) {
+         t["w"] = 4294967336.0;
+         t["h"] = 30;
+       },
+       "transforms_train.json", "w: expected a whole number in 1..65536"},
+      {[](json& t, json&) { t["frames"][2]["file_path"] = "./train/r_0"; }, "transforms_train.json",
+       "frames[2].file_path"},
       {[](json& t, json& s) { s["frames"][1]["file_path"] = t["frames"][0]["file_path"]; }, "transforms_test.json",
        "frames[1].file_path"},
   };
@@ -166,7 +182,8 @@ TEST(BlenderDataset, MistypedFieldsRepeatsAndSizesAreRefusedByField) {
   }
   // The repeat names where the image was first listed.
   const auto d = edited([](json& t, json& s) { s["frames"][1]["file_path"] = t["frames"][0]["file_path"]; });
-  EXPECT_TRUE(test::throwsInputError([&] { loadDataset(d->str()); }, "listed twice", "transforms_train.json frames[0]"));
+  EXPECT_TRUE(
+      test::throwsInputError([&] { loadDataset(d->str()); }, "listed twice", "transforms_train.json frames[0]"));
 }
 
 // A manifest beside the transforms (`saresgs scene --format blender`) must agree with the
@@ -182,7 +199,8 @@ TEST(BlenderDataset, ManifestSizesMustMatchAndNullMeansNoBackground) {
   test::writeBytes(d.file("manifest.json"), R"({"num_views": 4})");
   EXPECT_TRUE(test::throwsInputError([&] { loadDataset(d.str()); }, "manifest.json", "num_views"));
   test::writeBytes(d.file("manifest.json"), R"({"num_views": 2e9})");
-  EXPECT_TRUE(test::throwsInputError([&] { loadDataset(d.str()); }, "manifest.json", "num_views: expected a whole number in 1..100000"));
+  EXPECT_TRUE(test::throwsInputError([&] { loadDataset(d.str()); }, "manifest.json",
+                                     "num_views: expected a whole number in 1..100000"));
   // With --downscale the manifest is compared with the full-size cameras.
   test::writeBytes(d.file("manifest.json"), R"({"width": 40, "height": 30})");
   DatasetOptions half;
@@ -210,12 +228,13 @@ TEST(BlenderDataset, SizesAndCentresOfTheWrongTypeOrRangeNameTheirField) {
 TEST(BlenderDataset, PreloadReadsWhatImageReadsAndNamesTheFirstBadViewAsked) {
   TempDir d;
   writeSplit(d, "transforms_train.json", "train", 6);
-  for (int i = 0; i < 6; ++i) writeRgba(d.file("train/r_" + std::to_string(i) + ".png"), 40, 30, static_cast<std::uint8_t>(30 * i + 10));
+  for (int i = 0; i < 6; ++i)
+    writeRgba(d.file("train/r_" + std::to_string(i) + ".png"), 40, 30, static_cast<std::uint8_t>(30 * i + 10));
   const Scene one_by_one = loadDataset(d.str());
   const Scene preloaded = loadDataset(d.str());
   std::vector<int> all(preloaded.views.size());
   for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int>(i);
-  EXPECT_EQ(preloaded.preloadImages({5, 1, 3, 1}), 3u);  // repeats, out of order, some views first
+  EXPECT_EQ(preloaded.preloadImages({5, 1, 3, 1}), 3u);     // repeats, out of order, some views first
   EXPECT_EQ(preloaded.preloadImages(all), all.size() - 3);  // the kept ones are not read again
   for (int v : all) {
     EXPECT_EQ(preloaded.image(v).data, one_by_one.image(v).data) << "view " << v;

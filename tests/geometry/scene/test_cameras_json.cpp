@@ -20,8 +20,8 @@ TEST(CamerasJson, PositionAndRotationMapTheWorldIntoEachCamera) {
   for (int i = 0; i < 3; ++i) {
     SceneView v;
     v.name = "img_" + std::to_string(i) + ".png";
-    v.camera = Camera::lookAt(K, Eigen::Vector3d(3 * std::cos(i), 3 * std::sin(i), 1.0 + i), Eigen::Vector3d(0.1, -0.2, 0.3),
-                              Eigen::Vector3d::UnitZ());
+    v.camera = Camera::lookAt(K, Eigen::Vector3d(3 * std::cos(i), 3 * std::sin(i), 1.0 + i),
+                              Eigen::Vector3d(0.1, -0.2, 0.3), Eigen::Vector3d::UnitZ());
     s.views.push_back(v);
   }
   const nlohmann::json j = camerasJson(s);

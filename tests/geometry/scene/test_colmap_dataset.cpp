@@ -16,8 +16,7 @@ namespace fs = std::filesystem;
 namespace {
 
 // A small COLMAP dataset: `n` images of 32x24 on a circle, a few points.
-ColmapModel writeDataset(const TempDir& d, int n, const std::string& model = "PINHOLE",
-                         bool binary = false) {
+ColmapModel writeDataset(const TempDir& d, int n, const std::string& model = "PINHOLE", bool binary = false) {
   ColmapModel m;
   ColmapCamera c;
   c.id = 3;
@@ -49,8 +48,10 @@ ColmapModel writeDataset(const TempDir& d, int n, const std::string& model = "PI
     p.rgb = {static_cast<std::uint8_t>(k), 2, 3};
     m.points[p.id] = p;
   }
-  if (binary) writeColmapBinary(d.file("sparse/0"), m);
-  else writeColmapText(d.file("sparse/0"), m);
+  if (binary)
+    writeColmapBinary(d.file("sparse/0"), m);
+  else
+    writeColmapText(d.file("sparse/0"), m);
   return m;
 }
 
@@ -155,8 +156,9 @@ TEST(ColmapDataset, MissingModelSaysWhatWasExpected) {
 TEST(ColmapDataset, ManifestSplitWinsOverTheEveryEighthRule) {
   TempDir d;
   writeDataset(d, 6);
-  test::writeBytes(d.file("manifest.json"),
-                   R"({"split": {"train": ["img_1000.png", "img_1002.png", "img_1003.png", "img_1004.png", "img_1005.png"], "test": ["img_1001.png"]}})");
+  test::writeBytes(
+      d.file("manifest.json"),
+      R"({"split": {"train": ["img_1000.png", "img_1002.png", "img_1003.png", "img_1004.png", "img_1005.png"], "test": ["img_1001.png"]}})");
   const Scene s = loadDataset(d.str());
   EXPECT_EQ(s.test, (std::vector<int>{1}));
   EXPECT_EQ(s.train, (std::vector<int>{0, 2, 3, 4, 5}));
@@ -169,7 +171,8 @@ TEST(ColmapDataset, ManifestSplitWinsOverTheEveryEighthRule) {
 TEST(ColmapDataset, ManifestFieldsAreTypedBoundedAndMatchTheModel) {
   TempDir d;
   writeDataset(d, 6);
-  const std::string train = R"("train": ["img_1000.png", "img_1002.png", "img_1003.png", "img_1004.png", "img_1005.png"])";
+  const std::string train =
+      R"("train": ["img_1000.png", "img_1002.png", "img_1003.png", "img_1004.png", "img_1005.png"])";
   struct Case {
     std::string manifest, field;
   };
@@ -236,6 +239,7 @@ TEST(ColmapDataset, AManifestSplitThatIsNotAnObjectNamesTheField) {
   writeSyntheticDataset(makeSyntheticScene(o), d.file("ds"), w);
   ASSERT_NO_THROW(loadDataset(d.file("ds")));
   const std::string manifest = d.file("ds/manifest.json");
-  test::writeBytes(manifest, test::readBytes(test::fuzzRegression("geometry/scene/fuzz_regressions/manifest/split_array.json")));
+  test::writeBytes(manifest,
+                   test::readBytes(test::fuzzRegression("geometry/scene/fuzz_regressions/manifest/split_array.json")));
   EXPECT_TRUE(test::throwsInputError([&] { loadDataset(d.file("ds")); }, manifest, "split"));
 }

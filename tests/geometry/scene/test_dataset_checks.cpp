@@ -24,12 +24,13 @@ Scene ring(const Intrinsics& odd) {
   for (int i = 0; i < 4; ++i) {
     SceneView v;
     v.name = "v" + std::to_string(i) + ".jpg";
-    v.camera = Camera::lookAt(i == 1 ? odd : K, Eigen::Vector3d(4 * std::cos(1.5 * i), 4 * std::sin(1.5 * i), 1), Eigen::Vector3d::Zero(),
-                              Eigen::Vector3d::UnitZ());
+    v.camera = Camera::lookAt(i == 1 ? odd : K, Eigen::Vector3d(4 * std::cos(1.5 * i), 4 * std::sin(1.5 * i), 1),
+                              Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ());
     s.views.push_back(v);
     (i == 3 ? s.test : s.train).push_back(i);
   }
-  for (int k = 0; k < 50; ++k) s.points.push_back({Eigen::Vector3d(0.02 * k - 0.5, 0.3 * std::sin(k), 0.2 * std::cos(k)), {1, 2, 3}});
+  for (int k = 0; k < 50; ++k)
+    s.points.push_back({Eigen::Vector3d(0.02 * k - 0.5, 0.3 * std::sin(k), 0.2 * std::cos(k)), {1, 2, 3}});
   return s;
 }
 

@@ -15,22 +15,33 @@
 #include "geometry/scene/scene.h"
 
 using namespace saresgs;
-using saresgs::test::TempDir;
-using saresgs::test::glPose;
 using nlohmann::json;
+using saresgs::test::glPose;
+using saresgs::test::TempDir;
 
 namespace {
 
 // n frames named frame_00001.jpg ... (JPEG, 40x30) with top-level intrinsics.
 json writeFolder(const TempDir& d, int n) {
   std::filesystem::create_directories(d.path() / "images");
-  json j = {{"fl_x", 50.0}, {"fl_y", 52.0}, {"cx", 19.0}, {"cy", 16.0}, {"w", 40}, {"h", 30}, {"camera_model", "OPENCV"},
-            {"k1", 0.0}, {"k2", 0.0}, {"p1", 0.0}, {"p2", 0.0}, {"frames", json::array()}};
+  json j = {{"fl_x", 50.0},
+            {"fl_y", 52.0},
+            {"cx", 19.0},
+            {"cy", 16.0},
+            {"w", 40},
+            {"h", 30},
+            {"camera_model", "OPENCV"},
+            {"k1", 0.0},
+            {"k2", 0.0},
+            {"p1", 0.0},
+            {"p2", 0.0},
+            {"frames", json::array()}};
   for (int i = 0; i < n; ++i) {
     char name[32];
     std::snprintf(name, sizeof name, "images/frame_%05d.jpg", i + 1);
     const double a = 0.5 * i;
-    j["frames"].push_back({{"file_path", name}, {"transform_matrix", glPose(Eigen::Vector3d(4 * std::cos(a), 4 * std::sin(a), 1))}});
+    j["frames"].push_back(
+        {{"file_path", name}, {"transform_matrix", glPose(Eigen::Vector3d(4 * std::cos(a), 4 * std::sin(a), 1))}});
     Image8 img(40, 30, 3);
     for (auto& v : img.data) v = static_cast<std::uint8_t>(40 + 10 * i);
     writeImage(d.file(name), img);
@@ -74,7 +85,8 @@ TEST(NerfstudioDataset, IntrinsicsPerFileOrFrameAndEveryEighthViewByNameIsATestV
 TEST(NerfstudioDataset, PlyFilePathGivesThePointsAndFilenamesGiveTheSplit) {
   TempDir d;
   json j = writeFolder(d, 6);
-  writePointsPly(d.file("sparse_pc.ply"), {{Eigen::Vector3d(0.1, 0.2, 0.3), {10, 20, 30}}, {Eigen::Vector3d(-1, 0, 1), {1, 2, 3}}});
+  writePointsPly(d.file("sparse_pc.ply"),
+                 {{Eigen::Vector3d(0.1, 0.2, 0.3), {10, 20, 30}}, {Eigen::Vector3d(-1, 0, 1), {1, 2, 3}}});
   j["ply_file_path"] = "sparse_pc.ply";
   j["train_filenames"] = {"images/frame_00002.jpg", "images/frame_00003.jpg", "images/frame_00005.jpg"};
   j["val_filenames"] = {"images/frame_00006.jpg"};
@@ -93,7 +105,10 @@ TEST(NerfstudioDataset, DistortionFisheyesAndBadFieldsAreRefusedByField) {
       {[](json& j) { j["camera_model"] = "OPENCV_FISHEYE"; }, "camera_model"},
       {[](json& j) { j["frames"][1]["camera_model"] = "EQUIRECTANGULAR"; }, "frames[1].camera_model"},
       {[](json& j) { j["ply_file_path"] = "nowhere.ply"; }, "ply_file_path"},
-      {[](json& j) { j["applied_transform"] = json::array({json::array({1, 0, 0}), json::array({0, 1, 0, 0}), json::array({0, 0, 1, 0})}); },
+      {[](json& j) {
+         j["applied_transform"] =
+             json::array({json::array({1, 0, 0}), json::array({0, 1, 0, 0}), json::array({0, 0, 1, 0})});
+       },
        "applied_transform[0]"},
       {[](json& j) { j["train_filenames"] = {"images/frame_00001.jpg"}; }, "test_filenames"},
       {[](json& j) {

@@ -51,7 +51,8 @@ TEST(SceneFrame, CamerasProjectTheSameInBothFrames) {
   const Camera internal = f.toInternal(world);
   EXPECT_LT((internal.center() - f.toInternal(eye)).norm(), 1e-9);
   EXPECT_LT((f.toWorld(internal).t - world.t).norm(), 1e-9 * world.t.norm());
-  for (const Eigen::Vector3d& x : {Eigen::Vector3d(f.center), Eigen::Vector3d(f.center + Eigen::Vector3d(300, 200, -100))}) {
+  for (const Eigen::Vector3d& x :
+       {Eigen::Vector3d(f.center), Eigen::Vector3d(f.center + Eigen::Vector3d(300, 200, -100))}) {
     const auto a = world.project(x), b = internal.project(f.toInternal(x));
     ASSERT_TRUE(a && b);
     EXPECT_LT((*a - *b).norm(), 1e-6);
@@ -112,8 +113,8 @@ TEST(SceneFrame, TheBuiltInCapturesKeepTheirWorldFrame) {
       }
       mean /= static_cast<double>(train.size());
       const double extent = sceneExtent(train);
-      EXPECT_TRUE(chooseSceneFrame(extent, mean).identity()) << layout << " seed " << seed << ": extent " << extent
-                                                             << ", centre " << mean.transpose();
+      EXPECT_TRUE(chooseSceneFrame(extent, mean).identity())
+          << layout << " seed " << seed << ": extent " << extent << ", centre " << mean.transpose();
     }
 }
 
@@ -128,7 +129,8 @@ TEST(SceneFrame, JsonRoundTripAndErrorsNameTheField) {
   bad = toJson(f);
   bad["center"] = {1, 2};
   EXPECT_TRUE(test::throwsInputError([&] { sceneFrameFromJson(bad, "r.json", "frame"); }, "r.json", "frame.center"));
-  EXPECT_TRUE(test::throwsInputError([&] { sceneFrameFromJson(nlohmann::json(3), "r.json", "frame"); }, "r.json", "frame"));
+  EXPECT_TRUE(
+      test::throwsInputError([&] { sceneFrameFromJson(nlohmann::json(3), "r.json", "frame"); }, "r.json", "frame"));
 }
 
 }  // namespace

@@ -16,7 +16,7 @@ TEST(Assets, CgalMeshIsExtractedIntoTheCacheAndReadable) {
   const std::string path = resolveAsset("cgal:bunny00");
   EXPECT_EQ(path.rfind(d.str(), 0), 0u) << path;
   const TriangleMesh m = readMeshFile(path);
-  EXPECT_GT(m.faces.size(), 1000u);  // the Stanford bunny, not a placeholder
+  EXPECT_GT(m.faces.size(), 1000u);               // the Stanford bunny, not a placeholder
   EXPECT_EQ(resolveAsset("cgal:bunny00"), path);  // cached
   EXPECT_THROW(resolveAsset("cgal:no_such_mesh"), InputError);
   EXPECT_THROW(resolveAsset("cgal:../etc/passwd"), InputError);

@@ -19,8 +19,7 @@ constexpr double kPi = std::numbers::pi;
 double signedVolume(const TriangleMesh& m) {
   double v = 0;
   for (const auto& f : m.faces)
-    v += m.vertices[f[0]].cast<double>().dot(
-             m.vertices[f[1]].cast<double>().cross(m.vertices[f[2]].cast<double>())) /
+    v += m.vertices[f[0]].cast<double>().dot(m.vertices[f[1]].cast<double>().cross(m.vertices[f[2]].cast<double>())) /
          6.0;
   return v;
 }
@@ -61,8 +60,7 @@ TEST(ProceduralMeshes, SmoothShapesAreClosedAndConsistentlyOriented) {
 TEST(ProceduralMeshes, SphereNormalsPointOutwardAndRadially) {
   const TriangleMesh s = makeSphere(2.0f, 64, 32);
   const auto n = vertexNormals(s);
-  for (std::size_t i = 0; i < s.vertices.size(); ++i)
-    EXPECT_GT(n[i].dot(s.vertices[i].normalized()), 0.999f) << i;
+  for (std::size_t i = 0; i < s.vertices.size(); ++i) EXPECT_GT(n[i].dot(s.vertices[i].normalized()), 0.999f) << i;
 }
 
 TEST(ProceduralMeshes, BoxNormalsStayFlatAtEdges) {
@@ -76,9 +74,8 @@ TEST(ProceduralMeshes, RoomFacesPointInward) {
   const RoomFaces r = makeRoom({-4, -4, 0}, {4, 4, 4});
   auto faceNormal = [](const TriangleMesh& m) {
     const auto& f = m.faces[0];
-    return Eigen::Vector3f((m.vertices[f[1]] - m.vertices[f[0]])
-                               .cross(m.vertices[f[2]] - m.vertices[f[0]])
-                               .normalized());
+    return Eigen::Vector3f(
+        (m.vertices[f[1]] - m.vertices[f[0]]).cross(m.vertices[f[2]] - m.vertices[f[0]]).normalized());
   };
   EXPECT_GT(faceNormal(r.floor).z(), 0.99f);
   EXPECT_LT(faceNormal(r.ceiling).z(), -0.99f);

@@ -40,8 +40,10 @@ TEST(SimulatedSfm, NoiseOutliersAndTracksAreAsSpecified) {
     }
     err /= p.track.size();
     EXPECT_NEAR(err, p.error, 1e-9 * (1 + err));
-    if (err > 5.0) ++outliers;
-    else errors.push_back(err);
+    if (err > 5.0)
+      ++outliers;
+    else
+      errors.push_back(err);
   }
   // About 3 % outliers (a few land near the surface by chance and pass as inliers).
   const double outlier_fraction = static_cast<double>(outliers) / model.points.size();

@@ -56,7 +56,8 @@ void expectSameModel(const ColmapModel& a, const ColmapModel& b, double q_tol = 
     EXPECT_EQ(im.t, jm.t);
     ASSERT_EQ(im.xys.size(), jm.xys.size());
     for (size_t k = 0; k < im.xys.size(); ++k)
-      EXPECT_EQ(im.xys[k], jm.xys[k]) << std::setprecision(17) << im.xys[k].transpose() << " vs " << jm.xys[k].transpose();
+      EXPECT_EQ(im.xys[k], jm.xys[k]) << std::setprecision(17) << im.xys[k].transpose() << " vs "
+                                      << jm.xys[k].transpose();
     EXPECT_EQ(im.point3d_ids, jm.point3d_ids);
   }
   ASSERT_EQ(a.points.size(), b.points.size());
@@ -93,8 +94,7 @@ double depthAgreement(const Scene& s, const SyntheticScene& world, int i, int j,
       const int u0 = static_cast<int>(std::floor(fx)), v0 = static_cast<int>(std::floor(fy));
       if (u0 < 0 || v0 < 0 || u0 + 1 >= dj.width || v0 + 1 >= dj.height) continue;
       const double a = fx - u0, b = fy - v0;
-      const double z00 = dj.at(u0, v0), z10 = dj.at(u0 + 1, v0), z01 = dj.at(u0, v0 + 1),
-                   z11 = dj.at(u0 + 1, v0 + 1);
+      const double z00 = dj.at(u0, v0), z10 = dj.at(u0 + 1, v0), z01 = dj.at(u0, v0 + 1), z11 = dj.at(u0 + 1, v0 + 1);
       const double zmin = std::min({z00, z10, z01, z11}), zmax = std::max({z00, z10, z01, z11});
       if (!(zmin > 0) || zmax > 1.1 * zmin) continue;
       const double inv = (1 - a) * (1 - b) / z00 + a * (1 - b) / z10 + (1 - a) * b / z01 + a * b / z11;
@@ -120,8 +120,8 @@ TEST_P(SyntheticDataset, ReadsBackIdenticallyAndColmapAgrees) {
   EXPECT_EQ(r.views, 24);
   EXPECT_GT(r.points, 200u);
   EXPECT_GE(r.mean_track_length, 2.0);
-  for (const char* f : {"manifest.json", "contact_sheet.png", "sparse/0/cameras.txt",
-                        "sparse/0/images.txt", "sparse/0/points3D.txt"})
+  for (const char* f :
+       {"manifest.json", "contact_sheet.png", "sparse/0/cameras.txt", "sparse/0/images.txt", "sparse/0/points3D.txt"})
     EXPECT_TRUE(fs::exists(d.path() / "ds" / f)) << f;
   EXPECT_FALSE(fs::exists(d.file("ds.partial-" + std::to_string(::getpid()))));
 
@@ -154,9 +154,8 @@ TEST_P(SyntheticDataset, ReadsBackIdenticallyAndColmapAgrees) {
   EXPECT_EQ(s.points.size(), expected.points.size());
 
   // (b) COLMAP's own converter turns the text model into binary; we read it identically.
-  const std::string cmd = "colmap model_converter --input_path " + d.file("ds/sparse/0") +
-                          " --output_path " + d.file("bin") + " --output_type BIN > " +
-                          d.file("colmap.log") + " 2>&1";
+  const std::string cmd = "colmap model_converter --input_path " + d.file("ds/sparse/0") + " --output_path " +
+                          d.file("bin") + " --output_type BIN > " + d.file("colmap.log") + " 2>&1";
   fs::create_directories(d.path() / "bin");
   ASSERT_EQ(std::system(cmd.c_str()), 0)
       << "colmap model_converter failed (is colmap installed? bash scripts/install_deps.sh)";
@@ -177,8 +176,7 @@ TEST_P(SyntheticDataset, ReadsBackIdenticallyAndColmapAgrees) {
     const double frac = depthAgreement(s, scene, i, j, &covisible);
     if (covisible < 200) continue;  // too little overlap to judge
     ++pairs;
-    EXPECT_GE(frac, 0.97) << GetParam() << " views " << i << " -> " << j << ", " << covisible
-                          << " co-visible pixels";
+    EXPECT_GE(frac, 0.97) << GetParam() << " views " << i << " -> " << j << ", " << covisible << " co-visible pixels";
   }
   EXPECT_GE(pairs, 3);
 }
@@ -233,7 +231,8 @@ TEST(SyntheticDatasetBlender, ReadsBackWithIdenticalCamerasAndTrueAlpha) {
   writeSyntheticDataset(scene, d.file("colmap"), w);
   w.format = "blender";
   writeSyntheticDataset(scene, d.file("blender"), w);
-  for (const char* f : {"transforms_train.json", "transforms_test.json", "points3d.ply", "manifest.json", "train/0000.png"})
+  for (const char* f :
+       {"transforms_train.json", "transforms_test.json", "points3d.ply", "manifest.json", "train/0000.png"})
     EXPECT_TRUE(fs::exists(d.path() / "blender" / f)) << f;
   EXPECT_FALSE(fs::exists(d.path() / "blender" / "sparse"));
 
@@ -250,12 +249,14 @@ TEST(SyntheticDatasetBlender, ReadsBackWithIdenticalCamerasAndTrueAlpha) {
   EXPECT_EQ(test, want_test);
   int partial = 0, empty = 0, full = 0;
   for (const SceneView& v : b.views) {
-    const auto k = static_cast<std::size_t>(std::find(scene.names.begin(), scene.names.end(), v.name) - scene.names.begin());
+    const auto k =
+        static_cast<std::size_t>(std::find(scene.names.begin(), scene.names.end(), v.name) - scene.names.begin());
     ASSERT_LT(k, scene.names.size()) << v.name;
     const Camera& truth = scene.cameras[k];
     EXPECT_EQ(v.camera.K.width, truth.K.width);
     EXPECT_EQ(v.camera.K.height, truth.K.height);
-    for (double x : {v.camera.K.fx - truth.K.fx, v.camera.K.fy - truth.K.fy, v.camera.K.cx - truth.K.cx, v.camera.K.cy - truth.K.cy})
+    for (double x : {v.camera.K.fx - truth.K.fx, v.camera.K.fy - truth.K.fy, v.camera.K.cx - truth.K.cx,
+                     v.camera.K.cy - truth.K.cy})
       EXPECT_NEAR(x, 0.0, 1e-9 * truth.K.fx);
     EXPECT_NEAR((v.camera.R - truth.R).norm(), 0.0, 1e-12);
     EXPECT_NEAR((v.camera.t - truth.t).norm(), 0.0, 1e-12);
@@ -273,7 +274,8 @@ TEST(SyntheticDatasetBlender, ReadsBackWithIdenticalCamerasAndTrueAlpha) {
     const auto ci = std::find_if(c.views.begin(), c.views.end(), [&](const SceneView& x) { return x.name == v.name; });
     const Image8& reference = c.image(static_cast<int>(ci - c.views.begin()));
     int worst = 0;
-    for (std::size_t p = 0; p < composite.data.size(); ++p) worst = std::max(worst, std::abs(composite.data[p] - reference.data[p]));
+    for (std::size_t p = 0; p < composite.data.size(); ++p)
+      worst = std::max(worst, std::abs(composite.data[p] - reference.data[p]));
     EXPECT_LE(worst, 2) << v.name;
   }
   EXPECT_GT(empty, 0);
@@ -309,11 +311,13 @@ TEST(SyntheticDatasetBlender, ReadsBackWithIdenticalCamerasAndTrueAlpha) {
 // as a number escaped as nlohmann's "type must be string", and a width of 1e30 was
 // converted to int (undefined behaviour) before any check.
 TEST(SyntheticManifest, FieldsOfTheWrongTypeOrRangeNameTheField) {
-  for (const auto& [input, field] : std::vector<std::pair<std::string, std::string>>{
-           {"mesh_number.json", "objects"}, {"width_1e30.json", "width"}}) {
+  for (const auto& [input, field] : std::vector<std::pair<std::string, std::string>>{{"mesh_number.json", "objects"},
+                                                                                     {"width_1e30.json", "width"}}) {
     TempDir d;
-    test::writeBytes(d.file("manifest.json"), test::readBytes(test::fuzzRegression("geometry/synth/fuzz_regressions/manifest/" + input)));
-    EXPECT_TRUE(test::throwsInputError([&] { syntheticOptionsFromManifest(d.str()); }, d.file("manifest.json"), field)) << input;
+    test::writeBytes(d.file("manifest.json"),
+                     test::readBytes(test::fuzzRegression("geometry/synth/fuzz_regressions/manifest/" + input)));
+    EXPECT_TRUE(test::throwsInputError([&] { syntheticOptionsFromManifest(d.str()); }, d.file("manifest.json"), field))
+        << input;
   }
 }
 

@@ -130,8 +130,10 @@ RoomParts roomParts(const SyntheticScene& s) {
   for (const auto& o : s.manifest["objects"]) {
     const std::string name = o["name"];
     const Eigen::AlignedBox3f box(vec3(o["bbox_min"]), vec3(o["bbox_max"]));
-    if (name.rfind("room_divider", 0) == 0) p.dividers.push_back(box);
-    else if (name.rfind("room_", 0) != 0) p.content.emplace_back(name, box);
+    if (name.rfind("room_divider", 0) == 0)
+      p.dividers.push_back(box);
+    else if (name.rfind("room_", 0) != 0)
+      p.content.emplace_back(name, box);
   }
   return p;
 }

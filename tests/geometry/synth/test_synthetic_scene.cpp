@@ -23,25 +23,19 @@ using namespace saresgs::synth_test;
 
 namespace {
 
-
 std::string tempPath(const std::string& name) {
   const auto dir = std::filesystem::temp_directory_path() / "saresgs_test_synth";
   std::filesystem::create_directories(dir);
   return (dir / name).string();
 }
 
-Eigen::Vector3f pixel(const ImageF& img, int x, int y) {
-  return {img.at(x, y, 0), img.at(x, y, 1), img.at(x, y, 2)};
-}
+Eigen::Vector3f pixel(const ImageF& img, int x, int y) { return {img.at(x, y, 0), img.at(x, y, 1), img.at(x, y, 2)}; }
 
 double meanAbsDiff(const ImageF& a, const ImageF& b) {
   double s = 0;
   for (std::size_t i = 0; i < a.data.size(); ++i) s += std::abs(a.data[i] - b.data[i]);
   return s / static_cast<double>(a.data.size());
 }
-
-
-
 
 }  // namespace
 
@@ -187,8 +181,8 @@ TEST(SyntheticScene, ObjectLayoutHasBackgroundWithZeroDepth) {
   EXPECT_GT(fg, depth.width * depth.height / 10);
   EXPECT_GT(bg, depth.width * depth.height / 4);
   // Corners are far outside the object: depth 0 and exactly the background colour.
-  for (auto [x, y] : {std::pair{0, 0}, {depth.width - 1, 0}, {0, depth.height - 1},
-                      {depth.width - 1, depth.height - 1}}) {
+  for (auto [x, y] :
+       {std::pair{0, 0}, {depth.width - 1, 0}, {0, depth.height - 1}, {depth.width - 1, depth.height - 1}}) {
     EXPECT_EQ(depth.at(x, y), 0.0f);
     EXPECT_EQ(pixel(img, x, y), s.background);
   }
@@ -214,8 +208,7 @@ TEST(SyntheticScene, DepthIsConsistentAcrossNearbyViews) {
         const Eigen::Vector3d seg = X - cb;
         // Co-visible: nothing blocks the segment from B's centre to just before X.
         const double eps = 2e-3 / seg.norm();
-        if (s.occluded(cb.cast<float>(), seg.cast<float>(), 0.0f, static_cast<float>(1 - eps)))
-          continue;
+        if (s.occluded(cb.cast<float>(), seg.cast<float>(), 0.0f, static_cast<float>(1 - eps))) continue;
         ++covisible;
         const double zb = B.toCamera(X).z();
         // B's depth at uv: bilinear in 1/z between the four nearest pixel centres (exact

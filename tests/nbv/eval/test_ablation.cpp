@@ -89,8 +89,9 @@ TEST(Ablation, MethodSeedsNarrowOneMethodsSeeds) {
   writeBytes(d.file("g.json"), j.dump());
   std::vector<std::string> ids;
   for (const AblationJob& job : expandGrid(readAblationGrid(d.file("g.json")))) ids.push_back(job.id);
-  EXPECT_EQ(ids, (std::vector<std::string>{"a__random__default__s0", "a__random__default__s1", "a__random__default__s2",
-                                           "a__random__default__s3", "a__fisher__default__s1", "a__fisher__default__s3"}));
+  EXPECT_EQ(ids,
+            (std::vector<std::string>{"a__random__default__s0", "a__random__default__s1", "a__random__default__s2",
+                                      "a__random__default__s3", "a__fisher__default__s1", "a__fisher__default__s3"}));
   j["method_seeds"]["fisher"] = {1, 7};
   writeBytes(d.file("g.json"), j.dump());
   EXPECT_TRUE(throwsInputError([&] { readAblationGrid(d.file("g.json")); }, d.file("g.json"), "method_seeds.fisher"));
@@ -120,41 +121,45 @@ TEST(Ablation, MalformedGridsNameTheFileAndField) {
   EXPECT_TRUE(bad(R"({"scenes": [{"name": "a", "dataset": "x"}], "methods": ["nope"]})", "methods"));
   // Sweep options are checked when the grid is read, not when its job runs.
   EXPECT_TRUE(bad(R"({"scenes": [{"name": "a", "dataset": "x"}], "sweep": {"sets": ["frustrum"]}})", "sweep.sets"));
-  EXPECT_TRUE(bad(R"({"scenes": [{"name": "a", "dataset": "x"}], "sweep": {"encodings": ["hash:31"]}})", "sweep.encodings"));
+  EXPECT_TRUE(
+      bad(R"({"scenes": [{"name": "a", "dataset": "x"}], "sweep": {"encodings": ["hash:31"]}})", "sweep.encodings"));
   EXPECT_TRUE(bad(R"({"scenes": [{"name": "a", "dataset": "x"}], "sweep": {"scores": ["and"]}})", "sweep.scores"));
   EXPECT_TRUE(bad(R"({"scenes": [{"name": "a", "dataset": "x"}], "sweep": {"lifting": "sift"}})", "sweep.lifting"));
   EXPECT_TRUE(bad(R"({"scenes": [{"name": "a", "dataset": "x"}], "methods": ["random"], "colour": 1})", "colour"));
   EXPECT_TRUE(bad(R"({"scenes": [{"name": "a/b", "dataset": "x"}], "methods": ["random"]})", "scenes[0].name"));
-  EXPECT_TRUE(bad(R"({"scenes": [{"name": "a", "dataset": "x"}, {"name": "a", "dataset": "y"}], "methods": ["random"]})",
-                  "scenes[1].name"));
+  EXPECT_TRUE(
+      bad(R"({"scenes": [{"name": "a", "dataset": "x"}, {"name": "a", "dataset": "y"}], "methods": ["random"]})",
+          "scenes[1].name"));
   EXPECT_TRUE(bad(R"({"scenes": [{"name": "a", "dataset": "x"}], "methods": ["random"], "seeds": "0"})", "seeds"));
   EXPECT_TRUE(bad(R"({"scenes": [{"name": "a", "dataset": "x"}], "sweep": {"scenes": ["z"]}})", "sweep.scenes"));
   EXPECT_TRUE(bad(R"({"scenes": [{"name": "a", "dataset": "x"}]})", "methods"));
   // Values are checked as read: a negative or fractional seed no longer wraps or truncates,
   // threads are a count, repeats are refused, and the messages are ours.
   const std::string scene = R"({"scenes": [{"name": "a", "dataset": "x"}], "methods": ["random"], )";
-  for (const auto& [text, field] : std::vector<std::pair<std::string, std::string>>{
-           {scene + R"("seeds": [0, -1]})", "seeds[1]: expected a whole number in 0.."},
-           {scene + R"("seeds": [0.5]})", "seeds[0]: expected a whole number"},
-           {scene + R"("seeds": ["1"]})", "seeds[0]: expected a whole number"},
-           {scene + R"("seeds": [1, 2, 1]})", "seeds[2]: 1 appears twice"},
-           {scene + R"("threads": -2})", "threads: expected a whole number in 0..1024"},
-           {scene + R"("threads": "two"})", "threads: expected a whole number"},
-           {scene + R"("threads": 1e12})", "threads"},
-           {scene + R"("preset": 3})", "preset"},
-           {R"({"scenes": [{"name": "a", "dataset": "x"}], "methods": ["random", "fvs", "random"]})", "methods[2]: random appears twice"},
-           {scene + R"("sweep": {"views": [4, -1]}})", "sweep.views[1]: expected a whole number in 1.."},
-           {scene + R"("sweep": {"views": "4"}})", "sweep.views: expected an array"},
-           {scene + R"("sweep": {"keep": 2}})", "sweep.keep: expected a number in 0..1"},
-           {scene + R"("sweep": {"keep": 0}})", "sweep.keep"},
-           {scene + R"("sweep": {"timing_repeats": 0}})", "sweep.timing_repeats"},
-           {R"({"scenes": [{"name": "a", "dataset": "x", "layout": "object", "scene_seed": -1}], "methods": ["random"]})",
-            "scenes[0].scene_seed: expected a non-negative integer"},
-           {R"({"scenes": [{"name": "a", "dataset": "x", "scene_seed": 1}], "methods": ["random"]})",
-            "scenes[0].scene_seed: given without a layout"},
-           {R"({"scenes": [{"name": "a", "dataset": "x", "layuot": "object"}], "methods": ["random"]})",
-            "scenes[0].\"layuot\": unknown field"},
-       }) {
+  for (
+      const auto& [text, field] : std::vector<std::pair<std::string, std::string>>{
+          {scene + R"("seeds": [0, -1]})", "seeds[1]: expected a whole number in 0.."},
+          {scene + R"("seeds": [0.5]})", "seeds[0]: expected a whole number"},
+          {scene + R"("seeds": ["1"]})", "seeds[0]: expected a whole number"},
+          {scene + R"("seeds": [1, 2, 1]})", "seeds[2]: 1 appears twice"},
+          {scene + R"("threads": -2})", "threads: expected a whole number in 0..1024"},
+          {scene + R"("threads": "two"})", "threads: expected a whole number"},
+          {scene + R"("threads": 1e12})", "threads"},
+          {scene + R"("preset": 3})", "preset"},
+          {R"({"scenes": [{"name": "a", "dataset": "x"}], "methods": ["random", "fvs", "random"]})",
+           "methods[2]: random appears twice"},
+          {scene + R"("sweep": {"views": [4, -1]}})", "sweep.views[1]: expected a whole number in 1.."},
+          {scene + R"("sweep": {"views": "4"}})", "sweep.views: expected an array"},
+          {scene + R"("sweep": {"keep": 2}})", "sweep.keep: expected a number in 0..1"},
+          {scene + R"("sweep": {"keep": 0}})", "sweep.keep"},
+          {scene + R"("sweep": {"timing_repeats": 0}})", "sweep.timing_repeats"},
+          {R"({"scenes": [{"name": "a", "dataset": "x", "layout": "object", "scene_seed": -1}], "methods": ["random"]})",
+           "scenes[0].scene_seed: expected a non-negative integer"},
+          {R"({"scenes": [{"name": "a", "dataset": "x", "scene_seed": 1}], "methods": ["random"]})",
+           "scenes[0].scene_seed: given without a layout"},
+          {R"({"scenes": [{"name": "a", "dataset": "x", "layuot": "object"}], "methods": ["random"]})",
+           "scenes[0].\"layuot\": unknown field"},
+      }) {
     writeBytes(f, text);
     std::string msg;
     try {
@@ -234,7 +239,7 @@ TEST(Ablation, TablesAggregateSeedsAndSplitMeanStdInCsv) {
   const Table main = find("results");
   ASSERT_EQ(main.rows.size(), 1u);
   EXPECT_EQ(main.rows[0][3], "21.00 \u00b1 1.41");  // mean 21, sample std sqrt(2)
-  EXPECT_EQ(main.rows[0][5], "n/a");                 // no AUSE
+  EXPECT_EQ(main.rows[0][5], "n/a");                // no AUSE
   const std::string csv = main.csv();
   EXPECT_NE(csv.find("PSNR_mean,PSNR_std"), std::string::npos) << csv;
   EXPECT_NE(csv.find("21.00,1.41"), std::string::npos) << csv;
@@ -259,8 +264,10 @@ TEST(Ablation, FinalFitPerViewTableAveragesEachTestViewOverSeeds) {
     FinalFitReport f;
     // random: views (20, 30) at seed 0 and (22, 31) at seed 1; sa-resgs has no final fit
     // at seed 1, so its cells are seed 0's alone and n says so.
-    if (j.method == "random") f.views = {{"v0", j.seed == 0 ? 20.0 : 22.0, 0.5}, {"v1", j.seed == 0 ? 30.0 : 31.0, 0.5}};
-    else if (j.seed == 0) f.views = {{"v0", 25.0, 0.5}, {"v1", 26.5, 0.5}};
+    if (j.method == "random")
+      f.views = {{"v0", j.seed == 0 ? 20.0 : 22.0, 0.5}, {"v1", j.seed == 0 ? 30.0 : 31.0, 0.5}};
+    else if (j.seed == 0)
+      f.views = {{"v0", 25.0, 0.5}, {"v1", 26.5, 0.5}};
     if (!f.views.empty()) r.final_fit = f;
     results.push_back({j, r, {}});
   }
@@ -270,7 +277,8 @@ TEST(Ablation, FinalFitPerViewTableAveragesEachTestViewOverSeeds) {
   EXPECT_EQ(t.rows[0], (std::vector<std::string>{"a", "random", "2", "21.00", "30.50"}));
   EXPECT_EQ(t.rows[1], (std::vector<std::string>{"a", "sa-resgs", "1", "25.00", "26.50"}));
   const std::vector<NamedPlot> plots = ablationPlots(g, results);
-  EXPECT_TRUE(std::any_of(plots.begin(), plots.end(), [](const NamedPlot& p) { return p.name == "final_fit_per_view"; }));
+  EXPECT_TRUE(
+      std::any_of(plots.begin(), plots.end(), [](const NamedPlot& p) { return p.name == "final_fit_per_view"; }));
 }
 
 // Against the better baseline: fisher ahead of fvs on scene a, fvs ahead on scene b; each
@@ -336,8 +344,9 @@ TEST(Ablation, BetterBaselineIsChosenPerSceneAndPairedBySeed) {
     }
   }
   const std::vector<NamedPlot> plots = ablationPlots(g, results);
-  EXPECT_TRUE(std::any_of(plots.begin(), plots.end(),
-                          [](const NamedPlot& p) { return p.name == "final_fit_vs_better_baseline" && p.image.width > 100; }));
+  EXPECT_TRUE(std::any_of(plots.begin(), plots.end(), [](const NamedPlot& p) {
+    return p.name == "final_fit_vs_better_baseline" && p.image.width > 100;
+  }));
   // Without fvs in the grid there is no such comparison.
   writeBytes(d.file("g2.json"), R"({"preset": "quick", "scenes": [{"name": "a", "dataset": "data/a"}],
                                      "methods": ["fisher", "adaptive"], "seeds": [0]})");
@@ -360,8 +369,8 @@ TEST(Ablation, PrefilterSweepReferenceIsExactAndACollisionFreeHashMatchesIt) {
   spec.timing_repeats = 1;
   PrefilterRegime regime;
   const auto rows = prefilterSweep(
-      scene, spec, [&](const Camera& c) { return truth->render(c); }, [&](const Camera& c) { return truth->renderDepth(c); },
-      0, PrefilterConfig{}, &regime);
+      scene, spec, [&](const Camera& c) { return truth->render(c); },
+      [&](const Camera& c) { return truth->renderDepth(c); }, 0, PrefilterConfig{}, &regime);
   ASSERT_EQ(rows.size(), 2u * 2 * 2 * 3);  // views x scores x sets x encodings
   // Are the scene voxels collision-free in a 2^20 table? Then hashed scores order the
   // candidates exactly as the exact ones do.
@@ -388,7 +397,7 @@ TEST(Ablation, PrefilterSweepReferenceIsExactAndACollisionFreeHashMatchesIt) {
   EXPECT_EQ(regime.scene_voxels, pf->grids().sceneCount());
   EXPECT_EQ(regime.min_points, PrefilterConfig{}.min_points);
   for (const SweepRow& r : rows) {
-    const double expected = r.encoding == "hash:2" ? regime.scene_voxels / 4.0
+    const double expected = r.encoding == "hash:2"    ? regime.scene_voxels / 4.0
                             : r.encoding == "hash:20" ? regime.scene_voxels / double(1u << 20)
                                                       : 0.0;
     EXPECT_DOUBLE_EQ(r.load, expected) << r.encoding;
@@ -399,8 +408,9 @@ TEST(Ablation, PrefilterSweepReferenceIsExactAndACollisionFreeHashMatchesIt) {
   spec.view_counts = {4};
   spec.encodings.resize(1);
   PrefilterRegime indoor_regime;
-  prefilterSweep(scene, spec, [&](const Camera& c) { return truth->render(c); },
-                 [&](const Camera& c) { return truth->renderDepth(c); }, 0, indoor, &indoor_regime);
+  prefilterSweep(
+      scene, spec, [&](const Camera& c) { return truth->render(c); },
+      [&](const Camera& c) { return truth->renderDepth(c); }, 0, indoor, &indoor_regime);
   EXPECT_EQ(indoor_regime.min_points, 5);
   EXPECT_EQ(indoor_regime.resolution, 32);
   EXPECT_EQ(indoor_regime.scene_voxels, makeCoveragePrefilter(scene, indoor)->grids().sceneCount());
@@ -410,8 +420,10 @@ TEST(Ablation, PrefilterSweepReferenceIsExactAndACollisionFreeHashMatchesIt) {
 // 1e30 where a whole number belongs were converted to int or uint64 (undefined
 // behaviour); they are refused by field, as is a negative seed.
 TEST(AblationGrid, NumbersOutOfRangeAreRefusedByField) {
-  for (const auto& [input, field] : std::vector<std::pair<std::string, std::string>>{
-           {"threads_1e30.json", "threads"}, {"seed_1e30.json", "seeds[0]"}, {"sweep_views_1e30.json", "sweep.views[0]"}}) {
+  for (const auto& [input, field] :
+       std::vector<std::pair<std::string, std::string>>{{"threads_1e30.json", "threads"},
+                                                        {"seed_1e30.json", "seeds[0]"},
+                                                        {"sweep_views_1e30.json", "sweep.views[0]"}}) {
     const std::string p = test::fuzzRegression("nbv/eval/fuzz_regressions/ablation_config/" + input);
     EXPECT_TRUE(throwsInputError([&] { readAblationGrid(p); }, p, field)) << input;
   }
@@ -427,5 +439,6 @@ TEST(AblationGrid, AnUnknownKeyIsNamedEvenWhenEmpty) {
   EXPECT_TRUE(throwsInputError([&] { readAblationGrid(p); }, p, "\"\": unknown field"));
   TempDir d;
   writeBytes(d.file("g.json"), R"({"scenes": [{"name": "a", "dataset": "x"}], "methods": ["random"], "seedz": [1]})");
-  EXPECT_TRUE(throwsInputError([&] { readAblationGrid(d.file("g.json")); }, d.file("g.json"), "\"seedz\": unknown field"));
+  EXPECT_TRUE(
+      throwsInputError([&] { readAblationGrid(d.file("g.json")); }, d.file("g.json"), "\"seedz\": unknown field"));
 }

@@ -17,8 +17,8 @@ namespace {
 TEST(PairedStats, MeanIntervalAndWinRateByHand) {
   // d = (0.5, 0, 1.5): mean 2/3; s = sqrt(((-1/6)^2 + (-2/3)^2 + (5/6)^2) / 2) = 0.7637626;
   // half width = t(0.975, 2) s / sqrt(3) = 4.3027 x 0.4409586 = 1.8973.
-  const PairedDifference d = pairedDifference({24.0, 25.0, 26.5}, {23.5, 25.0, 25.0},
-                                              {{20, 21}, {22, 22}, {30, 10}}, {{19, 21}, {23, 22}, {29, 11}});
+  const PairedDifference d = pairedDifference({24.0, 25.0, 26.5}, {23.5, 25.0, 25.0}, {{20, 21}, {22, 22}, {30, 10}},
+                                              {{19, 21}, {23, 22}, {29, 11}});
   EXPECT_EQ(d.n, 3);
   EXPECT_NEAR(d.mean, 2.0 / 3.0, 1e-12);
   ASSERT_TRUE(d.ci_low && d.ci_high);
@@ -90,11 +90,11 @@ TEST(PairedStats, TableRowsPerSceneMethodBaselineAndMetric) {
   std::vector<JobResult> results{job("random", 0, 22, 26), job("random", 1, 22, 26), job("fisher", 0, 23, 27),
                                  job("fisher", 1, 21, 26)};
   Table t = pairedTable(g, results);
-  ASSERT_EQ(t.header, (std::vector<std::string>{"scene", "method", "baseline", "metric", "mean_diff", "ci_low", "ci_high",
-                                                "n", "win_rate"}));
+  ASSERT_EQ(t.header, (std::vector<std::string>{"scene", "method", "baseline", "metric", "mean_diff", "ci_low",
+                                                "ci_high", "n", "win_rate"}));
   ASSERT_EQ(t.rows.size(), 4u);  // fisher vs random, random vs fisher; two metrics each
-  EXPECT_EQ(t.rows[0], (std::vector<std::string>{"s", "fisher", "random", "final_fit_psnr", "0.500", "-5.853", "6.853", "2",
-                                                 "0.750"}));
+  EXPECT_EQ(t.rows[0], (std::vector<std::string>{"s", "fisher", "random", "final_fit_psnr", "0.500", "-5.853", "6.853",
+                                                 "2", "0.750"}));
   EXPECT_EQ(t.rows[1][3], "psnr");
   EXPECT_EQ(t.rows[1][4], "0.000");
   results.pop_back();  // fisher has one seed left
@@ -102,7 +102,8 @@ TEST(PairedStats, TableRowsPerSceneMethodBaselineAndMetric) {
   EXPECT_EQ(t.rows[0][5], "undefined");
   EXPECT_EQ(t.rows[0][6], "undefined");
   EXPECT_EQ(t.rows[0][7], "1");
-  EXPECT_NE(t.csv().find("s,fisher,random,final_fit_psnr,1.000,undefined,undefined,1,1.000"), std::string::npos) << t.csv();
+  EXPECT_NE(t.csv().find("s,fisher,random,final_fit_psnr,1.000,undefined,undefined,1,1.000"), std::string::npos)
+      << t.csv();
 }
 
 // AUSE (the paper's uncertainty claim) is paired like the PSNRs, as method minus baseline

@@ -87,7 +87,7 @@ struct GradCheck {
 // on a kink of the piecewise-smooth renderer (a pixel crossing an alpha threshold or a
 // rectangle edge) and is counted, not compared.
 inline void checkGradientArray(std::vector<double>& param, const std::vector<double>& analytic,
-                const std::function<double()>& loss, const char* name, GradCheck& gc) {
+                               const std::function<double()>& loss, const char* name, GradCheck& gc) {
   for (std::size_t k = 0; k < param.size(); ++k) {
     const double x0 = param[k];
     auto quotient = [&](double h) {

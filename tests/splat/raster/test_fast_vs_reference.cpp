@@ -35,7 +35,8 @@ TEST_P(FastVsReference, ImagesAndPerGaussianOutputsAgree) {
   for (std::size_t i = 1; i < gd.size(); i += 5) mask[i] = 0;
   for (bool masked : {false, true}) {
     SCOPED_TRACE(masked ? "masked" : "full");
-    const std::span<const std::uint8_t> m = masked ? std::span<const std::uint8_t>(mask) : std::span<const std::uint8_t>();
+    const std::span<const std::uint8_t> m =
+        masked ? std::span<const std::uint8_t>(mask) : std::span<const std::uint8_t>();
     const ReferenceImage ref = referenceRender(gd, cam, s, m);
     const auto fast = rasterizeT(gd, cam, s, m);
     for (const auto& [name, kernels] : test::runnableKernels()) {
@@ -63,11 +64,12 @@ TEST_P(FastVsReference, ImagesAndPerGaussianOutputsAgree) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Scenes, FastVsReference,
-    ::testing::Values(Case{40, 0, 40, 30, ExtentRule::kOpacityAware, 1}, Case{80, 3, 48, 40, ExtentRule::kOpacityAware, 2},
-                      Case{80, 1, 33, 17, ExtentRule::kThreeSigma, 3}, Case{150, 2, 64, 48, ExtentRule::kOpacityAware, 4},
-                      Case{5, 0, 1, 1, ExtentRule::kOpacityAware, 5}));
+INSTANTIATE_TEST_SUITE_P(Scenes, FastVsReference,
+                         ::testing::Values(Case{40, 0, 40, 30, ExtentRule::kOpacityAware, 1},
+                                           Case{80, 3, 48, 40, ExtentRule::kOpacityAware, 2},
+                                           Case{80, 1, 33, 17, ExtentRule::kThreeSigma, 3},
+                                           Case{150, 2, 64, 48, ExtentRule::kOpacityAware, 4},
+                                           Case{5, 0, 1, 1, ExtentRule::kOpacityAware, 5}));
 
 TEST(FastVsReference, AnalyticGradientsMatchFiniteDifferencesOfTheReference) {
   const Camera cam = test::smallCamera(20, 16);
@@ -120,7 +122,8 @@ TEST(FastVsReference, ExtremeFieldsOfViewPrincipalPointsAndImageSizes) {
   };
   std::vector<Lens> lenses;
   for (double fov : {1.0, 10.0, 60.0, 120.0, 150.0})
-    for (auto [cx, cy] : {std::pair{0.5, 0.5}, std::pair{0.0, 0.0}, std::pair{1.5, -0.5}}) lenses.push_back({fov, 40, 30, cx, cy});
+    for (auto [cx, cy] : {std::pair{0.5, 0.5}, std::pair{0.0, 0.0}, std::pair{1.5, -0.5}})
+      lenses.push_back({fov, 40, 30, cx, cy});
   lenses.push_back({60.0, 8, 6, 0.5, 0.5});
   lenses.push_back({60.0, 2048, 1536, 0.5, 0.5});
   for (const Lens& L : lenses) {
@@ -135,7 +138,8 @@ TEST(FastVsReference, ExtremeFieldsOfViewPrincipalPointsAndImageSizes) {
     K.cy = L.cy_rel * L.h;
     // The scene's 1-sigma radius (about 1) fills the view's half width.
     const double dist = 1.0 / std::tan(half);
-    const Camera cam = Camera::lookAt(K, Eigen::Vector3d(0.1, -dist, 0.2), Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ());
+    const Camera cam =
+        Camera::lookAt(K, Eigen::Vector3d(0.1, -dist, 0.2), Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ());
     const ReferenceImage ref = referenceRender(gd, cam, s);
     const auto fast = rasterizeT(gd, cam, s);
     for (std::size_t k = 0; k < ref.rgb.size(); ++k) ASSERT_NEAR(fast.rgb[k], ref.rgb[k], 1e-9) << k;

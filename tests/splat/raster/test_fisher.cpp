@@ -52,7 +52,8 @@ TEST(Fisher, ScoreEqualsSumOfSquaredFiniteDifferenceGradients) {
   s.background = {0.2f, 0.4f, 0.1f};
   const Camera train = test::smallCamera(16, 14);
   Intrinsics K = train.K;
-  const Camera cand = Camera::lookAt(K, Eigen::Vector3d(2.5, -2.0, 0.6), Eigen::Vector3d(0, 0, 0), Eigen::Vector3d::UnitZ());
+  const Camera cand =
+      Camera::lookAt(K, Eigen::Vector3d(2.5, -2.0, 0.6), Eigen::Vector3d(0, 0, 0), Eigen::Vector3d::UnitZ());
   GaussiansD Ht = g.zerosLike(), Hv = g.zerosLike();
   addViewInformationT(g, train, s, Ht);
   addViewInformationT(g, cand, s, Hv);
@@ -63,7 +64,8 @@ TEST(Fisher, ScoreEqualsSumOfSquaredFiniteDifferenceGradients) {
     EXPECT_NEAR(analytic, fd, 1e-4 * std::abs(fd)) << lambda;
   }
   // Entry-wise too (the score could hide compensating errors).
-  for (std::size_t k = 0; k < Hv.means.size(); ++k) EXPECT_NEAR(Hv.means[k], Hv_fd.means[k], 1e-4 * (1 + Hv_fd.means[k]));
+  for (std::size_t k = 0; k < Hv.means.size(); ++k)
+    EXPECT_NEAR(Hv.means[k], Hv_fd.means[k], 1e-4 * (1 + Hv_fd.means[k]));
   for (std::size_t k = 0; k < Hv.sh.size(); ++k) EXPECT_NEAR(Hv.sh[k], Hv_fd.sh[k], 1e-4 * (1 + Hv_fd.sh[k]));
 }
 
@@ -87,7 +89,10 @@ std::vector<FisherCase> fisherCases() {
   for (int sh = 0; sh <= 3; ++sh)
     cases.push_back({"random sh" + std::to_string(sh), test::randomScene<double>(120, sh, 50 + sh, 1.2).cast<float>(),
                      cam, sh, sh % 2 ? std::array<float, 3>{0.3f, 0.1f, 0.6f} : std::array<float, 3>{0, 0, 0}});
-  cases.push_back({"dense", test::randomScene<double>(400, 1, 60, 0.7).cast<float>(), test::smallCamera(50, 37), 1,
+  cases.push_back({"dense",
+                   test::randomScene<double>(400, 1, 60, 0.7).cast<float>(),
+                   test::smallCamera(50, 37),
+                   1,
                    {0.2f, 0.2f, 0.2f}});
   {
     // Large Gaussians on a larger view: offsets from the 2D mean of a hundred pixels and
@@ -98,8 +103,11 @@ std::vector<FisherCase> fisherCases() {
   }
   const Camera small = test::smallCamera(32, 24);
   for (double rel : {1e-6, 1e-4, 1e-2, 1.0, 1e2, 1e4})
-    cases.push_back({"scale " + std::to_string(rel), test::oneGaussian(Eigen::Vector3d(0.1, 0.0, 0.05), rel * 3.0), small,
-                     0, {0.1f, 0.2f, 0.3f}});
+    cases.push_back({"scale " + std::to_string(rel),
+                     test::oneGaussian(Eigen::Vector3d(0.1, 0.0, 0.05), rel * 3.0),
+                     small,
+                     0,
+                     {0.1f, 0.2f, 0.3f}});
   Gaussians aniso = test::oneGaussian(Eigen::Vector3d::Zero(), 1.0);
   aniso.log_scales = {std::log(1e-6f * 3), std::log(1e4f * 3), 0.0f};
   cases.push_back({"anisotropic 1e-6 / 1e4", aniso, small, 0, {0.1f, 0.2f, 0.3f}});
@@ -111,9 +119,12 @@ std::vector<FisherCase> fisherCases() {
     const RasterSettings s;
     Gaussians g;
     g.resize(6);
-    const Eigen::Vector3d means[6] = {C + double(s.near_plane) * f, C + 0.5 * double(s.near_plane) * f, C - 1.0 * f,
+    const Eigen::Vector3d means[6] = {C + double(s.near_plane) * f,
+                                      C + 0.5 * double(s.near_plane) * f,
+                                      C - 1.0 * f,
                                       small.unproject(Eigen::Vector2d(0, 12), 2.0),
-                                      small.unproject(Eigen::Vector2d(32, 24), 2.0), C};
+                                      small.unproject(Eigen::Vector2d(32, 24), 2.0),
+                                      C};
     for (int i = 0; i < 6; ++i) {
       for (int k = 0; k < 3; ++k) {
         g.means[3 * i + k] = static_cast<float>(means[i][k]);
@@ -155,7 +166,8 @@ TEST(Fisher, FloatPassEqualsTheDoubleReferenceOnEveryKernelSet) {
     const auto rf = rasterizeT(fc.g, fc.cam, s);
     const auto rd = rasterizeT(gd, fc.cam, s);
     double render_drift = 0;
-    for (std::size_t k = 0; k < rf.rgb.size(); ++k) render_drift = std::max(render_drift, std::abs(rf.rgb[k] - rd.rgb[k]));
+    for (std::size_t k = 0; k < rf.rgb.size(); ++k)
+      render_drift = std::max(render_drift, std::abs(rf.rgb[k] - rd.rgb[k]));
     const bool drift = render_drift > 1e-4;
     if (drift) {
       Gaussians Hw = fc.g.zerosLike();
@@ -241,9 +253,12 @@ TEST(Fisher, JacobianEqualsProjectBackwardWithUnitInputs) {
       projection::projectJacobian(g, i, ct, s, P, f, J);
       for (int r = 0; r < 6; ++r) {
         projection::ProjectedGrad<double> dP;
-        if (r < 2) dP.mean2d[r] = 1;
-        else if (r < 5) dP.conic[r - 2] = 1;
-        else dP.color[0] = dP.color[1] = dP.color[2] = 1;
+        if (r < 2)
+          dP.mean2d[r] = 1;
+        else if (r < 5)
+          dP.conic[r - 2] = 1;
+        else
+          dP.color[0] = dP.color[1] = dP.color[2] = 1;
         double out[6] = {0, 0, 0, 0, 0, 0};
         projection::ParamGradRef<double> ref;
         ref.mean = out;
@@ -258,7 +273,8 @@ TEST(Fisher, JacobianEqualsProjectBackwardWithUnitInputs) {
           EXPECT_EQ(out[3], 0.0);
           continue;
         }
-        for (int k = 0; k < 6; ++k) EXPECT_NEAR(J[r][k], out[k], 1e-10 * scale + 1e-300) << i << " row " << r << " col " << k;
+        for (int k = 0; k < 6; ++k)
+          EXPECT_NEAR(J[r][k], out[k], 1e-10 * scale + 1e-300) << i << " row " << r << " col " << k;
       }
     }
     EXPECT_GT(checked, 20);
@@ -293,7 +309,8 @@ TEST(Fisher, DuplicateOfATrainViewScoresBelowAViewOfUnseenGaussians) {
   K.fx = K.fy = 30;
   K.cx = 16;
   K.cy = 12;
-  const Camera left = Camera::lookAt(K, Eigen::Vector3d(-3, -3, 0), Eigen::Vector3d(-3, 0, 0), Eigen::Vector3d::UnitZ());
+  const Camera left =
+      Camera::lookAt(K, Eigen::Vector3d(-3, -3, 0), Eigen::Vector3d(-3, 0, 0), Eigen::Vector3d::UnitZ());
   const Camera right = Camera::lookAt(K, Eigen::Vector3d(3, -3, 0), Eigen::Vector3d(3, 0, 0), Eigen::Vector3d::UnitZ());
   Gaussians Ht = g.zerosLike(), Hdup = g.zerosLike(), Hnew = g.zerosLike();
   addViewInformationT(g, left, s, Ht);

@@ -42,17 +42,38 @@ Gaussians wideScene(int n, int sh_degree, std::uint64_t seed, const Eigen::Vecto
     g.opacities[i] = static_cast<float>(3.0 * nd(rng));
     for (int k = 0; k < K * 3; ++k) g.sh[i * K * 3 + k] = static_cast<float>((k < 3 ? 1.0 : 0.4) * nd(rng));
     switch (i % 7 == 6 ? static_cast<int>(u(rng) * 10) : -1) {
-      case 0: for (int k = 0; k < 4; ++k) g.rotations[4 * i + k] = 0.0f; break;  // identity
-      case 1: g.rotations[4 * i] = 1e-20f; break;
-      case 2: g.log_scales[3 * i] = 200.0f; break;  // clamped at e^60
-      case 3: g.log_scales[3 * i + 1] = -200.0f; break;
-      case 4: g.opacities[i] = (u(rng) < 0.5 ? -1.0f : 1.0f) * 1e30f; break;
-      case 5: g.means[3 * i + 2] = nan; break;
-      case 6: g.log_scales[3 * i + 2] = inf; break;
-      case 7: g.opacities[i] = nan; break;
-      case 8: g.sh[i * K * 3] = -1e30f; break;  // a clamped channel
-      case 9: for (int k = 0; k < 3; ++k) g.log_scales[3 * i + k] = -30.0f; break;  // eps2d only
-      default: break;
+      case 0:
+        for (int k = 0; k < 4; ++k) g.rotations[4 * i + k] = 0.0f;
+        break;  // identity
+      case 1:
+        g.rotations[4 * i] = 1e-20f;
+        break;
+      case 2:
+        g.log_scales[3 * i] = 200.0f;
+        break;  // clamped at e^60
+      case 3:
+        g.log_scales[3 * i + 1] = -200.0f;
+        break;
+      case 4:
+        g.opacities[i] = (u(rng) < 0.5 ? -1.0f : 1.0f) * 1e30f;
+        break;
+      case 5:
+        g.means[3 * i + 2] = nan;
+        break;
+      case 6:
+        g.log_scales[3 * i + 2] = inf;
+        break;
+      case 7:
+        g.opacities[i] = nan;
+        break;
+      case 8:
+        g.sh[i * K * 3] = -1e30f;
+        break;  // a clamped channel
+      case 9:
+        for (int k = 0; k < 3; ++k) g.log_scales[3 * i + k] = -30.0f;
+        break;  // eps2d only
+      default:
+        break;
     }
   }
   return g;
@@ -100,7 +121,8 @@ std::vector<ProjectCase> projectCases() {
   wide.fx = wide.fy = 6.0;
   wide.cx = 160.3;
   wide.cy = 119.6;
-  cases.push_back({"extreme field of view", Camera::lookAt(wide, {0.2, -3.0, 0.4}, {0, 0, 0}), Eigen::Vector3d::Zero(), 1.5});
+  cases.push_back(
+      {"extreme field of view", Camera::lookAt(wide, {0.2, -3.0, 0.4}, {0, 0, 0}), Eigen::Vector3d::Zero(), 1.5});
   Intrinsics tele = wide;  // about 0.03 degrees
   tele.fx = tele.fy = 6e5;
   cases.push_back({"telephoto", Camera::lookAt(tele, {0.2, -3.0, 0.4}, {0, 0, 0}), Eigen::Vector3d::Zero(), 1e-3});

@@ -110,61 +110,61 @@ struct WalkStats {
 // threshold by more than the path's tolerance (kTolLattice on the lattice, kTolExact off
 // it) is visited and touched, none that fails it by that margin is touched, and where it
 // passes, G is within that tolerance of exp in double.
-#define SARESGS_LATTICE_WALK(NS)                                                                             \
-  void walk##NS(const Spec& s, bool chords, int x0, int y0, WalkStats& st) {                               \
-    using namespace raster_kernels::NS;                                                                    \
-    const TileGaussian<float> g = tileGaussian(s, chords);                                                 \
-    int c0, c1, r0, r1;                                                                                    \
-    tileSpan(g.px0, g.px1, x0, x0 + kTile, c0, c1);                                                        \
-    tileSpan(g.py0, g.py1, y0, y0 + kTile, r0, r1);                                                        \
-    ++st.gaussians;                                                                                        \
-    bool lattice = false;                                                                                  \
-    if (c0 <= c1 && r0 <= r1) {                                                                            \
-      Lattice lt;                                                                                          \
-      const int cb0 = c0 & ~(kBW - 1), cbl = c1 & ~(kBW - 1);                                              \
-      lattice = latticeFits(g, x0, y0, cb0, cbl, r0 / kBH, r1 / kBH, lt);                                  \
-      st.on_lattice += lattice;                                                                            \
-    }                                                                                                      \
-    const double tol = lattice ? kTolLattice : kTolExact;                                                  \
-    std::vector<int> visits(kTile * kTile, 0), touched(kTile * kTile, 0);                                  \
-    forEachBlock(g, x0, y0, x0 + kTile, y0 + kTile, [&](int blk, const Lanes& ln, vf dy) {                 \
-      for (int i = 0; i < L; ++i) {                                                                        \
-        const int k = blk * L + i, row = blockRow(k), col = blockCol(k);                                   \
-        ++visits[row * kTile + col];                                                                       \
-        const float ex = static_cast<float>(x0 + col) + 0.5f - g.mx;                                       \
-        const float ey = static_cast<float>(y0 + row) + 0.5f - g.my;                                       \
-        ASSERT_EQ(ln.dx[i], ex);                                                                           \
-        ASSERT_EQ(dy[i], ey);                                                                              \
-        touched[row * kTile + col] = ln.touches[i] != 0;                                                   \
-        const double dxd = ex, dyd = ey;                                                                   \
-        const double G = std::exp(-0.5 * (static_cast<double>(g.a) * dxd * dxd +                           \
-                                          2.0 * static_cast<double>(g.b) * dxd * dyd +                     \
-                                          static_cast<double>(g.c) * dyd * dyd));                          \
-        const double oG = static_cast<double>(g.o) * G;                                                    \
-        const bool in_rect = std::abs(ex) <= g.hx && std::abs(ey) <= g.hy;                                 \
-        if (in_rect && oG >= kMinA * (1.0 + tol)) {                                                        \
-          ASSERT_NE(ln.touches[i], 0) << "row " << row << " col " << col << " oG " << oG;                  \
-          const double rel = std::abs(static_cast<double>(ln.G[i]) - G) / G;                               \
+#define SARESGS_LATTICE_WALK(NS)                                                                                  \
+  void walk##NS(const Spec& s, bool chords, int x0, int y0, WalkStats& st) {                                      \
+    using namespace raster_kernels::NS;                                                                           \
+    const TileGaussian<float> g = tileGaussian(s, chords);                                                        \
+    int c0, c1, r0, r1;                                                                                           \
+    tileSpan(g.px0, g.px1, x0, x0 + kTile, c0, c1);                                                               \
+    tileSpan(g.py0, g.py1, y0, y0 + kTile, r0, r1);                                                               \
+    ++st.gaussians;                                                                                               \
+    bool lattice = false;                                                                                         \
+    if (c0 <= c1 && r0 <= r1) {                                                                                   \
+      Lattice lt;                                                                                                 \
+      const int cb0 = c0 & ~(kBW - 1), cbl = c1 & ~(kBW - 1);                                                     \
+      lattice = latticeFits(g, x0, y0, cb0, cbl, r0 / kBH, r1 / kBH, lt);                                         \
+      st.on_lattice += lattice;                                                                                   \
+    }                                                                                                             \
+    const double tol = lattice ? kTolLattice : kTolExact;                                                         \
+    std::vector<int> visits(kTile*kTile, 0), touched(kTile*kTile, 0);                                             \
+    forEachBlock(g, x0, y0, x0 + kTile, y0 + kTile, [&](int blk, const Lanes& ln, vf dy) {                        \
+      for (int i = 0; i < L; ++i) {                                                                               \
+        const int k = blk * L + i, row = blockRow(k), col = blockCol(k);                                          \
+        ++visits[row * kTile + col];                                                                              \
+        const float ex = static_cast<float>(x0 + col) + 0.5f - g.mx;                                              \
+        const float ey = static_cast<float>(y0 + row) + 0.5f - g.my;                                              \
+        ASSERT_EQ(ln.dx[i], ex);                                                                                  \
+        ASSERT_EQ(dy[i], ey);                                                                                     \
+        touched[row * kTile + col] = ln.touches[i] != 0;                                                          \
+        const double dxd = ex, dyd = ey;                                                                          \
+        const double G =                                                                                          \
+            std::exp(-0.5 * (static_cast<double>(g.a) * dxd * dxd + 2.0 * static_cast<double>(g.b) * dxd * dyd +  \
+                             static_cast<double>(g.c) * dyd * dyd));                                              \
+        const double oG = static_cast<double>(g.o) * G;                                                           \
+        const bool in_rect = std::abs(ex) <= g.hx && std::abs(ey) <= g.hy;                                        \
+        if (in_rect && oG >= kMinA * (1.0 + tol)) {                                                               \
+          ASSERT_NE(ln.touches[i], 0) << "row " << row << " col " << col << " oG " << oG;                         \
+          const double rel = std::abs(static_cast<double>(ln.G[i]) - G) / G;                                      \
           (lattice ? st.max_rel_lattice : st.max_rel) = std::max(lattice ? st.max_rel_lattice : st.max_rel, rel); \
-          ++st.lanes_checked;                                                                              \
-          ASSERT_LE(rel, tol) << "row " << row << " col " << col << " G " << G;                            \
-          ASSERT_NEAR(ln.alpha[i], std::min(oG, 0.99), 0.99 * tol + 1e-7);                                 \
-        } else if (!in_rect || oG <= kMinA * (1.0 - tol)) {                                                \
-          ASSERT_EQ(ln.touches[i], 0) << "row " << row << " col " << col << " oG " << oG;                  \
-        }                                                                                                  \
-      }                                                                                                    \
-    });                                                                                                    \
-    for (int row = 0; row < kTile; ++row)                                                                  \
-      for (int col = 0; col < kTile; ++col) {                                                              \
-        ASSERT_LE(visits[row * kTile + col], 1);                                                           \
-        const double ex = static_cast<float>(x0 + col) + 0.5f - g.mx;                                      \
-        const double ey = static_cast<float>(y0 + row) + 0.5f - g.my;                                      \
-        const double oG = g.o * std::exp(-0.5 * (g.a * ex * ex + 2.0 * g.b * ex * ey + g.c * ey * ey));    \
-        if (std::abs(ex) <= g.hx && std::abs(ey) <= g.hy && oG >= kMinA * (1.0 + tol)) {                   \
-          ASSERT_EQ(visits[row * kTile + col], 1) << "row " << row << " col " << col;                      \
-          ASSERT_TRUE(touched[row * kTile + col]);                                                         \
-        }                                                                                                  \
-      }                                                                                                    \
+          ++st.lanes_checked;                                                                                     \
+          ASSERT_LE(rel, tol) << "row " << row << " col " << col << " G " << G;                                   \
+          ASSERT_NEAR(ln.alpha[i], std::min(oG, 0.99), 0.99 * tol + 1e-7);                                        \
+        } else if (!in_rect || oG <= kMinA * (1.0 - tol)) {                                                       \
+          ASSERT_EQ(ln.touches[i], 0) << "row " << row << " col " << col << " oG " << oG;                         \
+        }                                                                                                         \
+      }                                                                                                           \
+    });                                                                                                           \
+    for (int row = 0; row < kTile; ++row)                                                                         \
+      for (int col = 0; col < kTile; ++col) {                                                                     \
+        ASSERT_LE(visits[row * kTile + col], 1);                                                                  \
+        const double ex = static_cast<float>(x0 + col) + 0.5f - g.mx;                                             \
+        const double ey = static_cast<float>(y0 + row) + 0.5f - g.my;                                             \
+        const double oG = g.o * std::exp(-0.5 * (g.a * ex * ex + 2.0 * g.b * ex * ey + g.c * ey * ey));           \
+        if (std::abs(ex) <= g.hx && std::abs(ey) <= g.hy && oG >= kMinA * (1.0 + tol)) {                          \
+          ASSERT_EQ(visits[row * kTile + col], 1) << "row " << row << " col " << col;                             \
+          ASSERT_TRUE(touched[row * kTile + col]);                                                                \
+        }                                                                                                         \
+      }                                                                                                           \
   }
 SARESGS_LATTICE_WALK(lattice8)
 SARESGS_LATTICE_WALK(lattice4)
@@ -189,8 +189,10 @@ TEST(TileWalk, GAgreesWithDoubleOnTheLatticeAndOff) {
     EXPECT_GT(st->lanes_checked, 100000);
     EXPECT_GT(st->max_rel_lattice, 0.0);  // the lattice lanes were compared
   }
-  std::printf("lattice walk: 8 lanes %ld of %ld Gaussians on the lattice, max relative error %.3g off it, %.3g on it; 4 lanes %ld, %.3g, %.3g\n",
-              s8.on_lattice, s8.gaussians, s8.max_rel, s8.max_rel_lattice, s4.on_lattice, s4.max_rel, s4.max_rel_lattice);
+  std::printf(
+      "lattice walk: 8 lanes %ld of %ld Gaussians on the lattice, max relative error %.3g off it, %.3g on it; 4 lanes "
+      "%ld, %.3g, %.3g\n",
+      s8.on_lattice, s8.gaussians, s8.max_rel, s8.max_rel_lattice, s4.on_lattice, s4.max_rel, s4.max_rel_lattice);
 }
 
 // Gaussians whose rectangle's corners sit just above and just below the lattice's floor

@@ -83,12 +83,12 @@ TEST(RasterStability, NearPlaneBehindTheCameraAndOnTheBorders) {
   Gaussians g;
   g.resize(6);
   const Eigen::Vector3d means[6] = {
-      C + double(s.near_plane) * f,          // exactly at the near plane
-      C + 0.5 * double(s.near_plane) * f,    // in front of the camera, before the near plane
-      C - 1.0 * f,                           // behind the camera
-      cam.unproject(Eigen::Vector2d(0, 12), 2.0),    // on the left border
-      cam.unproject(Eigen::Vector2d(32, 24), 2.0),   // on the bottom-right corner
-      C,                                      // at the camera centre
+      C + double(s.near_plane) * f,                 // exactly at the near plane
+      C + 0.5 * double(s.near_plane) * f,           // in front of the camera, before the near plane
+      C - 1.0 * f,                                  // behind the camera
+      cam.unproject(Eigen::Vector2d(0, 12), 2.0),   // on the left border
+      cam.unproject(Eigen::Vector2d(32, 24), 2.0),  // on the bottom-right corner
+      C,                                            // at the camera centre
   };
   for (int i = 0; i < 6; ++i) {
     for (int k = 0; k < 3; ++k) {

@@ -171,7 +171,8 @@ TEST(FloatPath, Avx512BackwardEqualsAvx2BitForBit) {
     for (float& l : g.log_scales) l += static_cast<float>(grow);  // up to ~20x wider: chords
     for (const bool bg : {false, true}) {
       for (const int threads : {1, 0}) {
-        SCOPED_TRACE("grow " + std::to_string(grow) + (bg ? " background" : "") + " threads " + std::to_string(threads));
+        SCOPED_TRACE("grow " + std::to_string(grow) + (bg ? " background" : "") + " threads " +
+                     std::to_string(threads));
         RasterSettings s;
         s.sh_degree = 2;
         if (bg) s.background = {0.1f, 0.2f, 0.3f};

@@ -115,8 +115,7 @@ TEST(ReferenceRenderer, SingleIsotropicGaussianMatchesClosedForm) {
       const std::size_t p = pix(i, j);
       EXPECT_EQ(im.contributors[p], alpha > 0 ? 1 : 0) << i << "," << j;
       covered += alpha > 0;
-      for (int c = 0; c < 3; ++c)
-        EXPECT_NEAR(im.rgb[3 * p + c], alpha * colour[c] + (1 - alpha) * bg[c], 1e-12);
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(im.rgb[3 * p + c], alpha * colour[c] + (1 - alpha) * bg[c], 1e-12);
       EXPECT_NEAR(im.alpha[p], alpha, 1e-12);
       if (alpha > 0) {
         EXPECT_NEAR(im.depth[p], 2.0, 1e-12);
@@ -337,8 +336,10 @@ TEST(ReferenceRenderer, CullingNearPlaneBehindAndGuardBand) {
   const std::uint8_t expected[9] = {0, 0, 1, 1, 0, 1, 0, 1, 0};
   for (int k = 0; k < 9; ++k) {
     EXPECT_EQ(im.visible[k], expected[k]) << k;
-    if (!expected[k]) EXPECT_EQ(im.radii[k], 0.0) << k;
-    else EXPECT_GT(im.radii[k], 0.0) << k;
+    if (!expected[k])
+      EXPECT_EQ(im.radii[k], 0.0) << k;
+    else
+      EXPECT_GT(im.radii[k], 0.0) << k;
   }
   EXPECT_TRUE(allFinite(im));
 
@@ -425,16 +426,15 @@ TEST(ReferenceRenderer, OffAxisProjectionWithRotatedCamera) {
   ASSERT_EQ(im.visible[0], 1);
 
   const Eigen::Vector3d p = cam.R * sp.mean + cam.t;
-  const Eigen::Matrix3d Rq = Eigen::Quaterniond(sp.quat[0], sp.quat[1], sp.quat[2], sp.quat[3])
-                                 .normalized()
-                                 .toRotationMatrix();
+  const Eigen::Matrix3d Rq =
+      Eigen::Quaterniond(sp.quat[0], sp.quat[1], sp.quat[2], sp.quat[3]).normalized().toRotationMatrix();
   const Eigen::Matrix3d Sig = Rq * sp.scale.cwiseAbs2().asDiagonal() * Rq.transpose();
   Eigen::Matrix<double, 2, 3> J;
   const double z2 = p.z() * p.z();
   J << K.fx / p.z(), 0, -K.fx * p.x() / z2,  //
       0, K.fy / p.z(), -K.fy * p.y() / z2;
-  const Eigen::Matrix2d S2 = J * cam.R * Sig * cam.R.transpose() * J.transpose() +
-                             double(s.eps2d) * Eigen::Matrix2d::Identity();
+  const Eigen::Matrix2d S2 =
+      J * cam.R * Sig * cam.R.transpose() * J.transpose() + double(s.eps2d) * Eigen::Matrix2d::Identity();
   const Eigen::Matrix2d inv = S2.inverse();
   const Eigen::Vector2d mu(K.fx * p.x() / p.z() + K.cx, K.fy * p.y() / p.z() + K.cy);
   const double o = sigmoidHand(sp.opacity_logit);
@@ -452,8 +452,7 @@ TEST(ReferenceRenderer, OffAxisProjectionWithRotatedCamera) {
       if (al > 0) {
         EXPECT_NEAR(im.depth[pix(i, j)], p.z(), 1e-12);
       }
-      for (int c = 0; c < 3; ++c)
-        EXPECT_NEAR(im.rgb[3 * pix(i, j) + c], al * (kShC0 * sp.dc[c] + 0.5), 1e-12);
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(im.rgb[3 * pix(i, j) + c], al * (kShC0 * sp.dc[c] + 0.5), 1e-12);
     }
   EXPECT_GT(covered, 5);
 }
@@ -555,11 +554,15 @@ TEST(ReferenceRenderer, ExtremeInputsStayFinite) {
   const double logits[] = {-30, -5, 0, 5, 30};
   std::vector<Spec> specs;
   const double near = RasterSettings{}.near_plane;
-  const Eigen::Vector3d means[] = {
-      {0, 0, 2},          {0, 0, near},        {0, 0, -1},        {0, 0, 0},
-      {-15.3 / 15, -11.7 / 15, 2},  // exactly on the top-left image corner
-      {16.7 / 15, 12.3 / 15, 2},    // exactly on the bottom-right corner
-      {-15.3 / 15, 0, 2}, {0.3, 0.2, 1e-5}, {1e3, -1e3, 1e3}};
+  const Eigen::Vector3d means[] = {{0, 0, 2},
+                                   {0, 0, near},
+                                   {0, 0, -1},
+                                   {0, 0, 0},
+                                   {-15.3 / 15, -11.7 / 15, 2},  // exactly on the top-left image corner
+                                   {16.7 / 15, 12.3 / 15, 2},    // exactly on the bottom-right corner
+                                   {-15.3 / 15, 0, 2},
+                                   {0.3, 0.2, 1e-5},
+                                   {1e3, -1e3, 1e3}};
   for (const auto& m : means)
     for (double sa : scales)
       for (double lg : logits) {

@@ -152,8 +152,8 @@ TEST(RenderReuse, LossIntoAKeptResultEqualsAFreshLoss) {
   RasterSettings s;
   s.sh_degree = 1;
   LossResult kept;
-  for (const auto& [w, h, want_grad] : std::vector<std::tuple<int, int, bool>>{
-           {64, 48, true}, {24, 20, true}, {64, 48, false}, {80, 60, true}}) {
+  for (const auto& [w, h, want_grad] :
+       std::vector<std::tuple<int, int, bool>>{{64, 48, true}, {24, 20, true}, {64, 48, false}, {80, 60, true}}) {
     SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h) + (want_grad ? " with" : " without") + " gradient");
     const Camera cam = test::smallCamera(w, h);
     const ImageF render = rasterize(g, cam, s).rgb;

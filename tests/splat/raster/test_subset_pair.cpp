@@ -44,16 +44,22 @@ std::vector<std::uint8_t> randomMask(std::size_t n, std::uint64_t seed, double k
 std::vector<PairCase> cases() {
   std::vector<PairCase> out;
   {
-    PairCase c{"dense sh2 background", test::randomScene<double>(300, 2, 9, 1.2).cast<float>(),
-               test::smallCamera(72, 56), {}, {}};
+    PairCase c{"dense sh2 background",
+               test::randomScene<double>(300, 2, 9, 1.2).cast<float>(),
+               test::smallCamera(72, 56),
+               {},
+               {}};
     c.s.sh_degree = 2;
     c.s.background = {0.1f, 0.2f, 0.3f};
     c.mask = randomMask(c.g.size(), 1);
     out.push_back(std::move(c));
   }
   {
-    PairCase c{"sh3 no background, sparse mask", test::randomScene<double>(120, 3, 5).cast<float>(),
-               test::smallCamera(64, 48), {}, {}};
+    PairCase c{"sh3 no background, sparse mask",
+               test::randomScene<double>(120, 3, 5).cast<float>(),
+               test::smallCamera(64, 48),
+               {},
+               {}};
     c.s.sh_degree = 3;
     c.mask = randomMask(c.g.size(), 2, 0.5);
     out.push_back(std::move(c));
@@ -61,8 +67,11 @@ std::vector<PairCase> cases() {
   {
     // Opaque, overlapping Gaussians: pixels stop early (T < 1e-4) in the full render and
     // later, or not at all, in the subset.
-    PairCase c{"opaque early stop", test::randomScene<double>(400, 0, 11, 0.4).cast<float>(),
-               test::smallCamera(48, 40), {}, {}};
+    PairCase c{"opaque early stop",
+               test::randomScene<double>(400, 0, 11, 0.4).cast<float>(),
+               test::smallCamera(48, 40),
+               {},
+               {}};
     for (auto& o : c.g.opacities) o = 6.0f;
     c.s.background = {1.0f, 0.0f, 0.5f};
     c.mask = randomMask(c.g.size(), 3);
@@ -297,8 +306,7 @@ TEST(SubsetPair, RejectsBadInputs) {
   const ImageF dl = lossImage(24, 20, 1, 1.0f);
   // The subset render has no state of its own: only the pair's backward runs it.
   EXPECT_THROW(rasterizeBackward(g, cam, s, p.subset, dl, grad), std::invalid_argument);
-  EXPECT_THROW(rasterizeBackwardWithSubset(g, cam, s, p, dl, lossImage(20, 20, 1, 1.0f), grad),
-               std::invalid_argument);
+  EXPECT_THROW(rasterizeBackwardWithSubset(g, cam, s, p, dl, lossImage(20, 20, 1, 1.0f), grad), std::invalid_argument);
 }
 
 // RasterSettings::depth_and_contributors = false (a training step's renders): depth and

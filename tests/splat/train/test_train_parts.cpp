@@ -41,13 +41,17 @@ TEST(TrainInit, KnnDistancesMatchBruteForce) {
     std::vector<Eigen::Vector3d> p;
     const int n = 400 + 300 * trial;
     for (int i = 0; i < n; ++i) {
-      if (trial == 1) p.emplace_back(u(rng) * 10, 0.0, 0.0);                // a line: flat box
-      else if (trial == 2) p.emplace_back(nd(rng), nd(rng), 1e-3 * nd(rng));  // a thin sheet
-      else p.emplace_back(nd(rng) * (i % 10 == 0 ? 20 : 1), nd(rng), nd(rng));  // clusters + outliers
+      if (trial == 1)
+        p.emplace_back(u(rng) * 10, 0.0, 0.0);  // a line: flat box
+      else if (trial == 2)
+        p.emplace_back(nd(rng), nd(rng), 1e-3 * nd(rng));  // a thin sheet
+      else
+        p.emplace_back(nd(rng) * (i % 10 == 0 ? 20 : 1), nd(rng), nd(rng));  // clusters + outliers
     }
     if (trial == 3) p.push_back(p[0]), p.push_back(p[0]);  // duplicates
     const auto d = meanSquaredKnnDistance(p);
-    for (std::size_t i = 0; i < p.size(); ++i) ASSERT_NEAR(d[i], bruteMeanSq(p, i, 3), 1e-12 * (1 + d[i])) << trial << " " << i;
+    for (std::size_t i = 0; i < p.size(); ++i)
+      ASSERT_NEAR(d[i], bruteMeanSq(p, i, 3), 1e-12 * (1 + d[i])) << trial << " " << i;
   }
   EXPECT_EQ(meanSquaredKnnDistance({Eigen::Vector3d(1, 2, 3)}).at(0), 1e-7);
   const auto two = meanSquaredKnnDistance({Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0, 3, 4)});
@@ -78,7 +82,9 @@ Gaussians normalModel(int degree, std::size_t n, std::mt19937_64& rng, std::norm
   Gaussians p;
   p.max_sh_degree = degree;
   p.resize(n);
-  p.forEachArray([&](std::vector<float>& a, std::size_t) { for (float& x : a) x = nd(rng); });
+  p.forEachArray([&](std::vector<float>& a, std::size_t) {
+    for (float& x : a) x = nd(rng);
+  });
   return p;
 }
 
@@ -94,7 +100,9 @@ TEST(TrainAdam, MatchesTheScalarFormulaInDouble) {
   std::vector<Gaussians> grads;
   for (int t = 0; t < 4; ++t) {
     Gaussians g = p.zerosLike();
-    g.forEachArray([&](std::vector<float>& a, std::size_t) { for (float& x : a) x = nd(rng) * (t == 2 ? 1e-4f : 1.0f); });
+    g.forEachArray([&](std::vector<float>& a, std::size_t) {
+      for (float& x : a) x = nd(rng) * (t == 2 ? 1e-4f : 1.0f);
+    });
     grads.push_back(g);
     adamStep(p, g, st, lr);
   }
@@ -134,7 +142,9 @@ TEST(TrainAdam, EveryValueIsTheFloatFormulaBitForBit) {
   LearningRates lr;
   for (int t = 1; t <= 3; ++t) {
     Gaussians g = p.zerosLike();
-    g.forEachArray([&](std::vector<float>& a, std::size_t) { for (float& x : a) x = nd(rng) * (t == 2 ? 1e-3f : 1.0f); });
+    g.forEachArray([&](std::vector<float>& a, std::size_t) {
+      for (float& x : a) x = nd(rng) * (t == 2 ? 1e-3f : 1.0f);
+    });
     adamStep(p, g, st, lr);
     const float inv_bc1 = static_cast<float>(1.0 / (1.0 - std::pow(static_cast<double>(ref.beta1), t)));
     const float inv_sqrt_bc2 = static_cast<float>(1.0 / std::sqrt(1.0 - std::pow(static_cast<double>(ref.beta2), t)));
@@ -172,7 +182,9 @@ TEST(TrainAdam, ClearingStepEqualsTheStepAndZeroesTheGradient) {
     b.resetFor(p);
     for (int t = 0; t < 2; ++t) {
       Gaussians g = p.zerosLike();
-      g.forEachArray([&](std::vector<float>& x, std::size_t) { for (float& v : x) v = nd(rng); });
+      g.forEachArray([&](std::vector<float>& x, std::size_t) {
+        for (float& v : x) v = nd(rng);
+      });
       Gaussians h = g;
       adamStep(p, g, a, LearningRates{});
       adamStepClearingGradient(q, h, b, LearningRates{});
@@ -242,8 +254,8 @@ TEST(TrainDensify, ClonesSmallSplitsLargePrunesTransparent) {
 TEST(TrainDensify, BigPruningOnlyWhenAsked) {
   for (bool prune_big : {false, true}) {
     DensifyCase c;
-    c.st.grad_accum.assign(4, 0.0f);  // nothing densifies
-    c.st.max_radius = {30, 1, 1, 1};  // Gaussian 0 is big on screen
+    c.st.grad_accum.assign(4, 0.0f);     // nothing densifies
+    c.st.max_radius = {30, 1, 1, 1};     // Gaussian 0 is big on screen
     c.g.log_scales[6] = std::log(2.0f);  // Gaussian 2 is big in the world (> 0.1 * 10)
     std::mt19937_64 rng(1);
     densifyAndPrune(c.g, c.adam, c.st, c.opt, c.extent, prune_big, rng);
@@ -294,8 +306,10 @@ TEST(TrainDensify, CapLimitsGrowthAndOpacityResetZeroesItsMoments) {
 
 // The brute-force reading of the cap: candidates by mean gradient (ties to the lower
 // index), best first, kept while their added Gaussians fit.
-std::pair<std::vector<int>, std::vector<int>> keptByBruteForce(const std::vector<int>& clone, const std::vector<int>& split,
-                                                               const std::vector<float>& grad, std::size_t room, int split_count) {
+std::pair<std::vector<int>, std::vector<int>> keptByBruteForce(const std::vector<int>& clone,
+                                                               const std::vector<int>& split,
+                                                               const std::vector<float>& grad, std::size_t room,
+                                                               int split_count) {
   std::vector<std::pair<int, bool>> all;
   for (int i : clone) all.push_back({i, false});
   for (int i : split) all.push_back({i, true});
@@ -378,7 +392,7 @@ Gaussians rankedModel(int n) {
   Gaussians g;
   g.resize(n);
   for (int i = 0; i < n; ++i) {
-    g.opacities[i] = static_cast<float>(i);                // lowest opacity: low indices
+    g.opacities[i] = static_cast<float>(i);                  // lowest opacity: low indices
     g.log_scales[3 * i + (i % 3)] = static_cast<float>(-i);  // largest scale: low indices too...
   }
   // ...so make the scale ranking distinct: reverse it for the upper half.
@@ -401,8 +415,8 @@ TEST(TrainResidual, SubsetHoldsExactProportionsAndTheIntendedGaussians) {
   EXPECT_EQ(s.uncertain, expect);
   std::size_t in = 0;
   for (int i = 0; i < n; ++i) {
-    const bool want = std::binary_search(s.random.begin(), s.random.end(), i) ||
-                      std::binary_search(expect.begin(), expect.end(), i);
+    const bool want =
+        std::binary_search(s.random.begin(), s.random.end(), i) || std::binary_search(expect.begin(), expect.end(), i);
     EXPECT_EQ(s.mask[i], want ? 1 : 0);
     in += s.mask[i];
   }
@@ -538,8 +552,8 @@ TEST(TrainResidual, SubsetEqualsItsDefinitionAtScaleAndOnEqualKeys) {
   }
   for (const double beta : {0.0, 0.25, 0.5, 1.0}) {
     o.beta = beta;
-    for (const UncertaintyRanking r : {UncertaintyRanking::kBoth, UncertaintyRanking::kOpacity,
-                                       UncertaintyRanking::kScale}) {
+    for (const UncertaintyRanking r :
+         {UncertaintyRanking::kBoth, UncertaintyRanking::kOpacity, UncertaintyRanking::kScale}) {
       o.ranking = r;
       expectSubsetIsItsDefinition(band, o, 9);
     }

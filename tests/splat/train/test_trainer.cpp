@@ -153,7 +153,8 @@ TEST(Trainer, DivergenceIsStoppedAndNamed) {
     EXPECT_THROW(t.step(s.train[0]), TrainingDiverged);
   }
   TrainerOptions o = quickOptions();
-  for (float* lr : {&o.lr.means, &o.lr.log_scales, &o.lr.rotations, &o.lr.opacities, &o.lr.sh_dc, &o.lr.sh_rest}) *lr *= 1e4f;
+  for (float* lr : {&o.lr.means, &o.lr.log_scales, &o.lr.rotations, &o.lr.opacities, &o.lr.sh_dc, &o.lr.sh_rest})
+    *lr *= 1e4f;
   Trainer t(s, o);
   bool stopped = false;
   try {
@@ -263,20 +264,32 @@ TEST(Trainer, ExtremeModelsTrainWithoutNanOrInf) {
         g.log_scales[3 * i + 1] = g.log_scales[3 * i + 2] = std::log(0.05f * static_cast<float>(s.extent));
         break;
       case 9:  // huge SH coefficients
-        for (std::size_t k = 0; k < g.sh.size() / g.size(); ++k) g.sh[i * (g.sh.size() / g.size()) + k] = (k % 2 ? -1e6f : 1e6f);
+        for (std::size_t k = 0; k < g.sh.size() / g.size(); ++k)
+          g.sh[i * (g.sh.size() / g.size()) + k] = (k % 2 ? -1e6f : 1e6f);
         break;
-      case 0: for (int k = 0; k < 3; ++k) g.log_scales[3 * i + k] = std::log(1e-6f * static_cast<float>(s.extent)); break;
-      case 1: for (int k = 0; k < 3; ++k) g.log_scales[3 * i + k] = std::log(1e4f * static_cast<float>(s.extent)); break;
-      case 2: g.opacities[i] = 30; break;
-      case 3: g.opacities[i] = -30; break;
-      case 4: for (int k = 0; k < 4; ++k) g.rotations[4 * i + k] = 0; break;
+      case 0:
+        for (int k = 0; k < 3; ++k) g.log_scales[3 * i + k] = std::log(1e-6f * static_cast<float>(s.extent));
+        break;
+      case 1:
+        for (int k = 0; k < 3; ++k) g.log_scales[3 * i + k] = std::log(1e4f * static_cast<float>(s.extent));
+        break;
+      case 2:
+        g.opacities[i] = 30;
+        break;
+      case 3:
+        g.opacities[i] = -30;
+        break;
+      case 4:
+        for (int k = 0; k < 4; ++k) g.rotations[4 * i + k] = 0;
+        break;
       case 5:  // at the near plane of the first camera
         for (int k = 0; k < 3; ++k) g.means[3 * i + k] = static_cast<float>(c[k] + 0.0101 * dir[k] + 1e-3 * u(rng));
         break;
       case 6:  // behind it
         for (int k = 0; k < 3; ++k) g.means[3 * i + k] = static_cast<float>(c[k] - 0.5 * dir[k]);
         break;
-      default: break;
+      default:
+        break;
     }
   }
   // Fisher information of the extreme model (what the selectors score) is finite too.
@@ -301,8 +314,8 @@ TEST(Trainer, ExtremeModelsTrainWithoutNanOrInf) {
 // sanitizers check the same input in the test command's fuzz run (fuzz/run_bounded.sh
 // runs every tests/**/fuzz_regressions/<target>/ input).
 TEST(Trainer, ACheckpointWithEmptyViewListsLoads) {
-  const std::string file =
-      std::string(SARESGS_SOURCE_DIR) + "/tests/splat/train/fuzz_regressions/trainer_checkpoint/fresh_empty_view_lists.bin";
+  const std::string file = std::string(SARESGS_SOURCE_DIR) +
+                           "/tests/splat/train/fuzz_regressions/trainer_checkpoint/fresh_empty_view_lists.bin";
   const Scene s = test::ringScene([](int i) { return std::to_string(i); }, false);
   TrainerOptions o;
   o.max_sh_degree = 1;
@@ -384,7 +397,7 @@ TEST(Trainer, WhiteBackgroundResetOnlyWhereTheDataHasABackgroundAndRoomToRecover
     t.train(s.train, 10);
     return maxOpacityOf(t.gaussians());
   };
-  EXPECT_LE(afterTen(object, 40), 0.0101f);   // white data, 30 iterations left: reset
+  EXPECT_LE(afterTen(object, 40), 0.0101f);    // white data, 30 iterations left: reset
   EXPECT_GT(afterTen(enclosed, 40), 0.0101f);  // no background: no reset
   EXPECT_GT(afterTen(object, 25), 0.0101f);    // 15 left < 20: too short to recover
   EXPECT_LE(afterTen(object, 30), 0.0101f);    // exactly the guard: reset
