@@ -9,7 +9,7 @@
 #include "splat/thread_limit.h"
 #include "apps/commands.h"
 #include "apps/memory_budget.h"
-#include "apps/prefilter_flags.h"
+#include "nbv/prefilter_options.h"
 #include "apps/progress.h"
 #include "geometry/scene/dataset_checks.h"
 #include "geometry/io/atomic_file.h"

@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "apps/commands.h"
-#include "apps/prefilter_flags.h"
+#include "nbv/prefilter_options.h"
 #include "apps/view_list.h"
 #include "geometry/scene/dataset_checks.h"
 #include "geometry/error.h"

@@ -140,19 +140,8 @@ VoxelSet CandidateSetBuilder::build(const Camera& cam, CandidateSetKind kind, in
   return tracer_->visibleSet(cam, visible_stride);
 }
 
-CandidateSetKind parseCandidateSet(std::string_view text) {
-  if (text == "frustum") return CandidateSetKind::kFrustum;
-  if (text == "visible") return CandidateSetKind::kVisible;
-  throw std::invalid_argument("prefilter set '" + std::string(text) + "': expected frustum or visible");
-}
 const char* toString(CandidateSetKind k) { return k == CandidateSetKind::kFrustum ? "frustum" : "visible"; }
 
-LiftingSource parseLiftingSource(std::string_view text) {
-  if (text == "flow") return LiftingSource::kFlow;
-  if (text == "depth") return LiftingSource::kDepth;
-  if (text == "oracle") return LiftingSource::kOracle;
-  throw std::invalid_argument("lifting '" + std::string(text) + "': expected flow, depth or oracle");
-}
 const char* toString(LiftingSource s) {
   switch (s) {
     case LiftingSource::kFlow:
@@ -165,37 +154,7 @@ const char* toString(LiftingSource s) {
   return "?";
 }
 
-CoverageCriterion parseCoverageCriterion(std::string_view text) {
-  if (text == "xor") return CoverageCriterion::Hamming;
-  if (text == "new") return CoverageCriterion::NewCount;
-  throw std::invalid_argument("prefilter score '" + std::string(text) + "': expected xor or new");
-}
 const char* toString(CoverageCriterion c) { return c == CoverageCriterion::Hamming ? "xor" : "new"; }
-
-void parseCoverageEncoding(std::string_view text, CoverageScoring& scoring, int min_bits, int max_bits) {
-  const std::string t(text);
-  if (t == "exact") {
-    scoring.encoding = CoverageEncoding::Exact;
-    return;
-  }
-  if (t == "hash:auto") {
-    scoring.encoding = CoverageEncoding::Hashed;
-    scoring.table_size = 0;
-    return;
-  }
-  if (t.rfind("hash:", 0) != 0)
-    throw std::invalid_argument("prefilter encoding '" + t + "': expected hash:auto, hash:K or exact");
-  int bits = 0;
-  const std::string digits = t.substr(5);
-  if (!digits.empty() && digits.size() <= 2 &&
-      std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
-    bits = std::stoi(digits);
-  if (bits < min_bits || bits > max_bits)
-    throw std::invalid_argument("prefilter encoding '" + t + "': expected hash:auto, hash:" + std::to_string(min_bits) +
-                                " .. hash:" + std::to_string(max_bits) + " or exact");
-  scoring.encoding = CoverageEncoding::Hashed;
-  scoring.table_size = std::size_t{1} << bits;
-}
 
 std::string encodingName(const CoverageScoring& s) {
   if (s.encoding == CoverageEncoding::Exact) return "exact";
@@ -236,11 +195,6 @@ nlohmann::json toJson(const PrefilterRegime& r) {
   return j;
 }
 
-SceneType parseSceneType(std::string_view text) {
-  if (text == "indoor") return SceneType::kIndoor;
-  if (text == "outdoor") return SceneType::kOutdoor;
-  throw std::invalid_argument("scene type '" + std::string(text) + "': expected indoor or outdoor");
-}
 const char* toString(SceneType t) { return t == SceneType::kIndoor ? "indoor" : "outdoor"; }
 
 void applySceneType(PrefilterConfig& c, SceneType t) {

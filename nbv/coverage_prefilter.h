@@ -56,7 +56,6 @@ struct PrefilterConfig {
 // scenes use resolution 32 (coarse voxels of about 30 cm in a 10 m room); outdoor keeps
 // 64 at m = 2.
 enum class SceneType { kIndoor, kOutdoor };
-SceneType parseSceneType(std::string_view text);  // indoor | outdoor
 const char* toString(SceneType t);
 void applySceneType(PrefilterConfig& c, SceneType t);
 // The scene type of a built-in layout (`saresgs scene --layout`): the rooms are indoor,
@@ -75,14 +74,7 @@ struct PrefilterRegime {
   std::optional<HashLoad> hash;  // none for exact sets
 };
 
-// Parsers of the textual options; each throws std::invalid_argument naming the value and
-// what was expected. An encoding is "exact" or "hash:K" with K in [min_bits, max_bits]
-// (the active loop takes the paper's 2^11..2^19; the sweep goes beyond); it sets the
-// encoding and table size of `scoring` and leaves its criterion alone.
-CandidateSetKind parseCandidateSet(std::string_view text);        // frustum | visible
-LiftingSource parseLiftingSource(std::string_view text);          // flow | depth | oracle
-CoverageCriterion parseCoverageCriterion(std::string_view text);  // xor | new
-void parseCoverageEncoding(std::string_view text, CoverageScoring& scoring, int min_bits = 11, int max_bits = 19);
+// The options as text (their parsers): nbv/prefilter_options.h.
 const char* toString(CandidateSetKind k);
 const char* toString(LiftingSource s);
 const char* toString(CoverageCriterion c);

@@ -12,6 +12,7 @@
 #include "geometry/error.h"
 #include "geometry/io/json_file.h"
 #include "geometry/scene/manifest.h"
+#include "nbv/prefilter_options.h"
 
 namespace saresgs {
 

@@ -6,6 +6,7 @@
 #include "geometry/error.h"
 #include "nbv/active_run.h"
 #include "nbv/coverage_prefilter.h"
+#include "nbv/prefilter_options.h"
 #include "nbv/eval/run_files.h"
 #include "report/run_page.h"
 #include "nbv/eval/coverage_report.h"
@@ -164,12 +165,9 @@ void bindNbv(py::module_& m) {
          const std::string& set, const std::string& encoding, const std::string& score, const std::string& lifting,
          std::optional<std::string> scene_type, double keep) {
         checkTrainViews(*scene, views, "views");
-        PrefilterConfig c;
-        if (scene_type) applySceneType(c, parseSceneType(*scene_type));
-        c.set = parseCandidateSet(set);
-        parseCoverageEncoding(encoding, c.scoring);
-        c.scoring.criterion = parseCoverageCriterion(score);
-        c.lifting = parseLiftingSource(lifting);
+        // as `saresgs coverage` parses them (scene_type None: the base's grid stands)
+        PrefilterConfig c =
+            parsePrefilterFlags({set, encoding, score, lifting, scene_type.value_or("")}, PrefilterConfig{}, "");
         c.keep_fraction = keep;
         py::gil_scoped_release nogil;
         const CoverageRenderers renderers =
@@ -299,9 +297,9 @@ void bindNbv(py::module_& m) {
              ActiveOptions& o = r->opt;
              o = activeOptionsFrom(settings);
              // As `saresgs active --prefilter-scene`: auto reads a `saresgs scene` manifest's layout.
-             applySceneType(o.prefilter, prefilter_scene == "auto"
-                                             ? sceneTypeOfDataset(dataset->source).value_or(SceneType::kOutdoor)
-                                             : parseSceneType(prefilter_scene));
+             PrefilterFlags flags;
+             flags.scene = prefilter_scene;
+             o.prefilter = parsePrefilterFlags(flags, o.prefilter, "prefilter_", dataset->source);
              if (!selector.is_none()) {
                if (!PyCallable_Check(selector.ptr()))
                  throw py::type_error("selector: expected a callable(SelectionContext)");

@@ -16,6 +16,7 @@
 #include "common/tiny_active_options.h"
 #include "common/tiny_dataset.h"
 #include "geometry/error.h"
+#include "nbv/prefilter_options.h"
 #include "nbv/active_run.h"
 #include "nbv/coverage_prefilter.h"
 #include "nbv/selectors.h"

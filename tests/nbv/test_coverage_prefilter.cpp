@@ -8,6 +8,7 @@
 
 #include "common/tiny_dataset.h"
 #include "geometry/occupancy/occupancy_grid.h"
+#include "nbv/prefilter_options.h"
 #include "nbv/coverage_prefilter.h"
 
 namespace saresgs {

@@ -13,6 +13,7 @@
 #include "geometry/occupancy/coverage_score.h"
 #include "geometry/occupancy/occupancy_grid.h"
 #include "geometry/synth/from_manifest.h"
+#include "nbv/prefilter_options.h"
 #include "nbv/eval/ablation.h"
 #include "nbv/active_run.h"
 #include "nbv/eval/prefilter_sweep.h"
