@@ -133,8 +133,10 @@ int runActive(const ActiveArgs& a) {
   dopt.load.downscale = a.downscale;
   if (!a.background.empty()) dopt.background = parseBackground(a.background, "--background");
   const Scene scene = loadDataset(a.dataset, dopt);
-  // What the run says before it starts, kept for results.json's "warnings" (the report
-  // shows them): the dataset's checks, the background, the memory budget.
+  // What the run says of its data before it starts, kept for results.json's "warnings"
+  // (the report shows them): the dataset's checks and the background. (The memory
+  // budget's line names this machine's memory: printed, not kept, so that the same run
+  // on two machines writes the same results.json.)
   std::string said = formatWarnings(checkDataset(scene, opt.trainer.raster.near_plane)) + backgroundWarning(scene);
   std::cerr << said;
   if (!a.replay.empty()) {
@@ -165,7 +167,6 @@ int runActive(const ActiveArgs& a) {
                                                  opt.trainer.max_sh_degree, models),
                           memoryBudgetBytes(a.memory_budget_gb), a.memory_budget_gb.has_value(), cap);
     std::cerr << budget;
-    said += budget;
     opt.trainer.densify.max_gaussians = opt.final_trainer.densify.max_gaussians = cap;
   }
   const bool resuming = a.resume && fs::exists(ckpt);
