@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <sstream>
 
@@ -17,13 +16,6 @@ namespace saresgs {
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string readText(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 std::string trim(std::string s) {
   const auto sp = [](unsigned char c) { return std::isspace(c) != 0; };
@@ -145,7 +137,7 @@ GridPageResult writeGridPage(const std::string& grid_dir, const GridPageOptions&
   std::sort(md.begin(), md.end());
   for (const fs::path& p : md) {
     nlohmann::json blocks = nlohmann::json::array();
-    for (const MarkdownBlock& b : parseMarkdown(readText(p))) {
+    for (const MarkdownBlock& b : parseMarkdown(readFile(p.string()))) {
       if (b.kind == MarkdownBlock::Kind::kHeading)
         blocks.push_back({{"heading", b.text}, {"level", b.level}});
       else if (b.kind == MarkdownBlock::Kind::kParagraph)
@@ -255,7 +247,7 @@ GridPageResult writeGridPage(const std::string& grid_dir, const GridPageOptions&
       if (e.path().extension() == ".png") pngs.push_back(e.path());
   std::sort(pngs.begin(), pngs.end());
   for (const fs::path& p : pngs)
-    plots.push_back({{"name", p.stem().string()}, {"src", dataUrl("image/png", readText(p))}});
+    plots.push_back({{"name", p.stem().string()}, {"src", dataUrl("image/png", readFile(p.string()))}});
 
   fs::path named = fs::absolute(dir).lexically_normal();
   if (named.filename().empty()) named = named.parent_path();

@@ -3,8 +3,9 @@
 #include <cctype>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
+
+#include "geometry/error.h"
+#include "geometry/io/atomic_file.h"
 
 namespace saresgs {
 
@@ -91,11 +92,11 @@ ViewerScript findViewerScript(const std::string& explicit_path) {
     v.path = env;
   else
     v.path = SARESGS_REPORT_VIEWER_DEFAULT;
-  std::ifstream in(v.path, std::ios::binary);
-  if (!in) return v;
-  std::ostringstream s;
-  s << in.rdbuf();
-  v.script = s.str();
+  try {
+    v.script = readFile(v.path);
+  } catch (const InputError&) {
+    // not there (or not readable): the page says where it was looked for
+  }
   return v;
 }
 

@@ -3,12 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <numeric>
 #include <optional>
-#include <sstream>
 
 #include "geometry/error.h"
 #include "geometry/image/image.h"
@@ -19,6 +17,7 @@
 #include "report/grid_page.h"
 #include "report/html_page.h"
 #include "splat/model_frame.h"
+#include "splat/model_ops.h"
 #include "splat/ply.h"
 #include "splat/rasterize.h"
 #include "splat/splat_file.h"
@@ -33,13 +32,6 @@ namespace {
 constexpr float kErrorScale = 0.25f;
 // Pictures wider than this are shown (and stored) at this width.
 constexpr int kMaxPictureWidth = 512;
-
-std::string readBytes(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // A perceptual dark-to-bright ramp (black, purple, red, orange, pale yellow) for errors.
 std::array<std::uint8_t, 3> ramp(float u) {
@@ -341,7 +333,7 @@ RunPageResult writeRunPage(const std::string& run_dir, const Scene* given, const
                   {"which", model->which},
                   {"gaussians", model->g.size()},
                   {"sh_degree", model->g.max_sh_degree}};
-    std::string ply = readBytes(dir / model->file);
+    std::string ply = readFile((dir / model->file).string());
     if (ply.size() <= o.model_budget_bytes) {
       model_bytes = std::move(ply);
       model_info["format"] = "ply";
@@ -355,25 +347,12 @@ RunPageResult writeRunPage(const std::string& run_dir, const Scene* given, const
           "and rotation)";
       if (keep < g.size()) {
         // the most opaque Gaussians, in the model's order
-        std::vector<std::size_t> idx(g.size());
-        std::iota(idx.begin(), idx.end(), std::size_t{0});
-        std::stable_sort(idx.begin(), idx.end(),
-                         [&](std::size_t a, std::size_t b) { return g.opacities[a] > g.opacities[b]; });
+        std::vector<int> idx(g.size());
+        std::iota(idx.begin(), idx.end(), 0);
+        std::stable_sort(idx.begin(), idx.end(), [&](int a, int b) { return g.opacities[a] > g.opacities[b]; });
         idx.resize(keep);
         std::sort(idx.begin(), idx.end());
-        Gaussians t;
-        t.max_sh_degree = g.max_sh_degree;
-        t.resize(keep);
-        const std::size_t k = static_cast<std::size_t>(g.shCoeffs());
-        for (std::size_t n = 0; n < keep; ++n) {
-          const std::size_t i = idx[n];
-          std::copy_n(&g.means[3 * i], 3, &t.means[3 * n]);
-          std::copy_n(&g.log_scales[3 * i], 3, &t.log_scales[3 * n]);
-          std::copy_n(&g.rotations[4 * i], 4, &t.rotations[4 * n]);
-          t.opacities[n] = g.opacities[i];
-          std::copy_n(&g.sh[3 * k * i], 3 * k, &t.sh[3 * k * n]);
-        }
-        g = std::move(t);
+        g = gatherGaussians(g, idx);
         note +=
             ", and only its " + std::to_string(keep) + " most opaque Gaussians of " + std::to_string(model->g.size());
       }
