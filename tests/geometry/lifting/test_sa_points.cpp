@@ -29,6 +29,7 @@
 #include "common/test_support.h"
 #include "geometry/lifting/sa_points.h"
 #include "geometry/scene/scene.h"
+#include "geometry/synth/synth_test_support.h"
 #include "geometry/synth/synthetic_scene.h"
 
 using namespace saresgs;
@@ -39,7 +40,8 @@ using saresgs::test::writeBytes;
 namespace {
 
 struct World {
-  SyntheticScene scene;
+  explicit World(const SyntheticScene& s) : scene(s) {}
+  const SyntheticScene& scene;  // synth_test::scene's, built once per layout and size
   double extent = 0;
   double voxel = 0;
   std::vector<int> views;  // the training views lifted in the tests
@@ -61,13 +63,7 @@ const World& world(const std::string& layout, int w, int h) {
   const auto key = std::make_tuple(layout, w, h);
   auto it = cache.find(key);
   if (it == cache.end()) {
-    SyntheticOptions o;
-    o.layout = layout;
-    o.width = w;
-    o.height = h;
-    o.seed = 3;
-    World wd;
-    wd.scene = makeSyntheticScene(o);
+    World wd{synth_test::scene(layout, w, h)};
     std::vector<Camera> train;
     for (int i : wd.scene.train) train.push_back(wd.scene.cameras[i]);
     wd.extent = sceneExtent(train);
