@@ -9,6 +9,7 @@
 #include "splat/thread_limit.h"
 #include "apps/commands.h"
 #include "apps/memory_budget.h"
+#include "splat/bench/machine.h"
 #include "nbv/prefilter_options.h"
 #include "apps/progress.h"
 #include "geometry/scene/dataset_checks.h"

@@ -13,6 +13,7 @@
 #include "splat/thread_limit.h"
 #include "apps/commands.h"
 #include "apps/memory_budget.h"
+#include "splat/bench/machine.h"
 #include "apps/progress.h"
 #include "apps/view_list.h"
 #include "geometry/scene/dataset_checks.h"

@@ -13,7 +13,6 @@ void addInfoCommand(CLI::App& app, Action& action);           // apps/cmd_info.c
 void addSceneCommand(CLI::App& app, Action& action);          // apps/cmd_scene.cpp
 void addTrainCommand(CLI::App& app, Action& action);          // apps/cmd_train.cpp
 void addBenchCommand(CLI::App& app, Action& action);          // apps/cmd_bench.cpp
-void addSelectBenchCommand(CLI::App& bench, Action& action);  // apps/cmd_bench_select.cpp: `bench select`
 void addActiveCommand(CLI::App& app, Action& action);         // apps/cmd_active.cpp
 void addCoverageCommand(CLI::App& app, Action& action);       // apps/cmd_coverage.cpp
 void addAblateCommand(CLI::App& app, Action& action);         // apps/cmd_ablate.cpp

@@ -1,6 +1,5 @@
 #include "apps/memory_budget.h"
 
-#include <sys/resource.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -56,12 +55,6 @@ double currentRssBytes() {
   double size = 0, resident = 0;
   if (!(in >> size >> resident)) return 0;
   return resident * static_cast<double>(::sysconf(_SC_PAGESIZE));
-}
-
-double peakRssBytes() {
-  rusage ru{};
-  getrusage(RUSAGE_SELF, &ru);
-  return static_cast<double>(ru.ru_maxrss) * 1024.0;
 }
 
 std::string applyMemoryBudget(const MemoryEstimate& e, double budget, bool budget_given, std::size_t& max_gaussians) {

@@ -21,8 +21,6 @@ double memoryBudgetBytes(std::optional<double> budget_gb);
 // (what is free now must not change a run's numbers). Returns the lines to log.
 std::string applyMemoryBudget(const MemoryEstimate& e, double budget, bool budget_given, std::size_t& max_gaussians);
 
-// This process's peak resident memory so far (getrusage), in bytes.
-double peakRssBytes();
 // This process's resident memory now (/proc/self/statm), in bytes; 0 where unknown.
 double currentRssBytes();
 

@@ -1,5 +1,7 @@
 #include "nbv/eval/selection_bench.h"
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <chrono>
 #include <stdexcept>
@@ -8,7 +10,9 @@
 #include "nbv/path_variance.h"
 #include "nbv/preset.h"
 #include "nbv/selectors.h"
+#include "splat/bench/machine.h"
 #include "splat/fisher.h"
+#include "splat/thread_limit.h"
 #include "splat/train/trainer.h"
 
 namespace saresgs {
@@ -65,6 +69,35 @@ SelectionBenchResult benchSelection(const Scene& scene, const SelectionBenchOpti
     if (c == r.fisher_choice) r.fisher_choice_unseen_share = r.unseen_share.back();
   }
   return r;
+}
+
+nlohmann::json benchSelectionJson(const std::string& path, const SelectionBenchOptions& opt) {
+  const std::string load_before = loadAverage();
+  const auto thread_limit = limitThreads(opt.threads);
+  const SelectionBenchResult r = benchSelection(loadDataset(path), opt);
+  std::vector<double> ratio;
+  for (std::size_t k = 0; k < r.fisher_seconds.size(); ++k)
+    ratio.push_back(r.path_variance_seconds[k] / r.fisher_seconds[k]);
+  nlohmann::json j;
+  j["benchmark"] = "select";
+  j["dataset"] = path;
+  j["held"] = opt.held;
+  j["candidates"] = r.candidates;
+  j["gaussians"] = r.gaussians;
+  j["threads"] = opt.threads;
+  j["fisher_seconds"] = r.fisher_seconds;
+  j["path_variance_seconds"] = r.path_variance_seconds;
+  j["fisher_median_s"] = sampleMedian(r.fisher_seconds);
+  j["path_variance_median_s"] = sampleMedian(r.path_variance_seconds);
+  j["ratio_per_round"] = ratio;
+  j["ratio_median"] = sampleMedian(ratio);
+  j["choices"] = {{"fisher", r.fisher_choice}, {"path-variance", r.path_variance_choice}};
+  j["unseen_share"] = {
+      {"median", sampleMedian(r.unseen_share)},
+      {"max", r.unseen_share.empty() ? 0.0 : *std::max_element(r.unseen_share.begin(), r.unseen_share.end())},
+      {"fisher_choice", r.fisher_choice_unseen_share}};
+  nameMachine(j, load_before);
+  return j;
 }
 
 }  // namespace saresgs

@@ -4,7 +4,10 @@
 // hits both alike. The model is the quick preset's, trained on the held views (farthest
 // point sampling of the train cameras, as an active run's first views) for a few hundred
 // iterations, so that its Gaussians and their footprints are a run's, not a random cloud's.
+#include <nlohmann/json_fwd.hpp>
+
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "geometry/scene/scene.h"
@@ -34,5 +37,10 @@ struct SelectionBenchResult {
 };
 
 SelectionBenchResult benchSelection(const Scene& scene, const SelectionBenchOptions& opt);
+
+// benchSelection on the dataset at `path` as one JSON line: each round's seconds and
+// their ratio (path-variance / FisherRF), the medians, both choices, FisherRF's unseen
+// share, with the machine and its load named. Caps TBB at opt.threads while it runs.
+nlohmann::json benchSelectionJson(const std::string& path, const SelectionBenchOptions& opt);
 
 }  // namespace saresgs
