@@ -11,6 +11,12 @@
 
 namespace saresgs::apps {
 
+// An option within [lo, hi], its default shown in --help: the form most flags take.
+template <typename T, typename B>
+CLI::Option* addRanged(CLI::App* sub, const std::string& name, T& value, const std::string& help, B lo, B hi) {
+  return sub->add_option(name, value, help)->check(CLI::Range(lo, hi))->capture_default_str();
+}
+
 // A whole number >= `min` (seeds, counts, caps).
 inline CLI::Validator wholeNumberAtLeast(long long min) {
   return CLI::Validator(

@@ -324,9 +324,7 @@ CLI::App* addActiveOptions(CLI::App& app, const std::shared_ptr<ActiveArgs>& a) 
   sub->add_option("--replay", a->replay,
                   "Fixed order: train with this method's training on the views of another run's results.json, in their "
                   "order, instead of selecting (the paper's ablation)");
-  sub->add_option("--downscale", a->downscale, "Image downscale factor")
-      ->check(CLI::Range(1, 64))
-      ->capture_default_str();
+  addRanged(sub, "--downscale", a->downscale, "Image downscale factor", 1, 64);
   sub->add_option("--background", a->background, kBackgroundHelp)->check(backgroundValue());
   sub->add_option("--threads", a->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
   sub->add_flag("--resume", a->resume, "Continue the run in OUT from its checkpoint");

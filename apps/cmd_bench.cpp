@@ -38,21 +38,13 @@ void addThreadsAndSeed(CLI::App* sub, int& threads, std::uint64_t& seed, const c
 
 // The random scene's flags, shared by `bench step` and `bench fisher`.
 void addRandomSceneFlags(CLI::App* sub, StepBenchOptions& o, const char* timed_what) {
-  sub->add_option("--width", o.width, "Image width")->check(CLI::Range(1, 16384))->capture_default_str();
-  sub->add_option("--height", o.height, "Image height")->check(CLI::Range(1, 16384))->capture_default_str();
-  sub->add_option("--gaussians", o.gaussians, "Number of Gaussians")
-      ->check(CLI::Range(1, 100000000))
-      ->capture_default_str();
-  sub->add_option("--sh-degree", o.sh_degree, "SH degree (active)")->check(CLI::Range(0, 3))->capture_default_str();
-  sub->add_option("--coverage", o.coverage, "Mean 3-sigma ellipses per pixel")
-      ->check(CLI::Range(0.01, 1000.0))
-      ->capture_default_str();
-  sub->add_option("--steps", o.steps, std::string("Timed ") + timed_what)
-      ->check(CLI::Range(1, 100000))
-      ->capture_default_str();
-  sub->add_option("--warmup", o.warmup, std::string("Untimed ") + timed_what + " first")
-      ->check(CLI::Range(0, 100000))
-      ->capture_default_str();
+  addRanged(sub, "--width", o.width, "Image width", 1, 16384);
+  addRanged(sub, "--height", o.height, "Image height", 1, 16384);
+  addRanged(sub, "--gaussians", o.gaussians, "Number of Gaussians", 1, 100000000);
+  addRanged(sub, "--sh-degree", o.sh_degree, "SH degree (active)", 0, 3);
+  addRanged(sub, "--coverage", o.coverage, "Mean 3-sigma ellipses per pixel", 0.01, 1000.0);
+  addRanged(sub, "--steps", o.steps, std::string("Timed ") + timed_what, 1, 100000);
+  addRanged(sub, "--warmup", o.warmup, std::string("Untimed ") + timed_what + " first", 0, 100000);
   addThreadsAndSeed(sub, o.threads, o.seed, "Scene seed");
   o.heap_allocations = &heapAllocations;
 }
@@ -61,12 +53,8 @@ void addRandomSceneFlags(CLI::App* sub, StepBenchOptions& o, const char* timed_w
 void addDatasetFlags(CLI::App* sub, std::string& dataset, int& width, int& height) {
   sub->add_option("--dataset", dataset,
                   "Dataset folder (default: the built-in room360 scene at --width x --height, written once to out/)");
-  sub->add_option("--width", width, "Image width of the built-in scene")
-      ->check(CLI::Range(16, 8192))
-      ->capture_default_str();
-  sub->add_option("--height", height, "Image height of the built-in scene")
-      ->check(CLI::Range(16, 8192))
-      ->capture_default_str();
+  addRanged(sub, "--width", width, "Image width of the built-in scene", 16, 8192);
+  addRanged(sub, "--height", height, "Image height of the built-in scene", 16, 8192);
 }
 
 struct SelectBenchArgs {
@@ -101,15 +89,9 @@ void addBenchCommand(CLI::App& app, Action& action) {
   CLI::App* train = bench->add_subcommand(
       "train", "Time whole training iterations of a real scene by stage, beside `bench step` at the same size");
   addDatasetFlags(train, tr->dataset, tr->width, tr->height);
-  train->add_option("--iterations", tr->iterations, "Timed iterations")
-      ->check(CLI::Range(1, 1000000))
-      ->capture_default_str();
-  train->add_option("--warmup", tr->warmup, "Untimed iterations first")
-      ->check(CLI::Range(0, 1000000))
-      ->capture_default_str();
-  train->add_option("--compare-steps", tr->compare_steps, "Timed steps of the same-size `bench step`")
-      ->check(CLI::Range(1, 100000))
-      ->capture_default_str();
+  addRanged(train, "--iterations", tr->iterations, "Timed iterations", 1, 1000000);
+  addRanged(train, "--warmup", tr->warmup, "Untimed iterations first", 0, 1000000);
+  addRanged(train, "--compare-steps", tr->compare_steps, "Timed steps of the same-size `bench step`", 1, 100000);
   addThreadsAndSeed(train, tr->threads, tr->seed, "Trainer seed");
   train->add_flag("--residual", tr->residual,
                   "Train with residual supervision, alternated in chunks of 10 iterations with a plain trainer from "
@@ -119,22 +101,12 @@ void addBenchCommand(CLI::App& app, Action& action) {
   auto o = std::make_shared<OccupancyBenchOptions>();
   CLI::App* occ = bench->add_subcommand(
       "occupancy", "Time the prefilter's parts (grids, candidate sets, scoring) on a room360 scene");
-  occ->add_option("--width", o->width, "Image width of the views")->check(CLI::Range(8, 16384))->capture_default_str();
-  occ->add_option("--height", o->height, "Image height of the views")
-      ->check(CLI::Range(8, 16384))
-      ->capture_default_str();
-  occ->add_option("--points", o->points, "Simulated SfM points at most")
-      ->check(CLI::Range(1, 10000000))
-      ->capture_default_str();
-  occ->add_option("--resolution", o->resolution, "Coarse voxels along the longest box side")
-      ->check(CLI::Range(1, 4096))
-      ->capture_default_str();
-  occ->add_option("--upsample", o->upsample, "Fine voxels per coarse voxel per axis")
-      ->check(CLI::Range(1, 16))
-      ->capture_default_str();
-  occ->add_option("--min-points", o->min_points, "SfM points for an occupied coarse voxel")
-      ->check(CLI::Range(1, 1000000))
-      ->capture_default_str();
+  addRanged(occ, "--width", o->width, "Image width of the views", 8, 16384);
+  addRanged(occ, "--height", o->height, "Image height of the views", 8, 16384);
+  addRanged(occ, "--points", o->points, "Simulated SfM points at most", 1, 10000000);
+  addRanged(occ, "--resolution", o->resolution, "Coarse voxels along the longest box side", 1, 4096);
+  addRanged(occ, "--upsample", o->upsample, "Fine voxels per coarse voxel per axis", 1, 16);
+  addRanged(occ, "--min-points", o->min_points, "SfM points for an occupied coarse voxel", 1, 1000000);
   addThreadsAndSeed(occ, o->threads, o->seed, "Scene and SfM seed");
   occ->callback([&action, o] { action = [o] { return printLine(benchOccupancy(*o)); }; });
 
@@ -143,19 +115,11 @@ void addBenchCommand(CLI::App& app, Action& action) {
       "select",
       "Time a selection step of path-variance against FisherRF's on the same model, held views and candidates");
   addDatasetFlags(sel, a->dataset, a->width, a->height);
-  sel->add_option("--held", a->opt.held, "Views held when the step is taken")
-      ->check(CLI::Range(1, 100000))
-      ->capture_default_str();
-  sel->add_option("--train-iterations", a->opt.train_iterations, "Training on the held views first")
-      ->check(CLI::Range(0, 1000000))
-      ->capture_default_str();
-  sel->add_option("--rounds", a->opt.rounds, "Rounds, each one step of each method")
-      ->check(CLI::Range(1, 1000))
-      ->capture_default_str();
+  addRanged(sel, "--held", a->opt.held, "Views held when the step is taken", 1, 100000);
+  addRanged(sel, "--train-iterations", a->opt.train_iterations, "Training on the held views first", 0, 1000000);
+  addRanged(sel, "--rounds", a->opt.rounds, "Rounds, each one step of each method", 1, 1000);
   addThreadsAndSeed(sel, a->opt.threads, a->opt.seed, "Trainer seed");
-  sel->add_option("--kappa", a->opt.kappa, "path-variance's relative damping")
-      ->check(CLI::Range(0.0, 1e6))
-      ->capture_default_str();
+  addRanged(sel, "--kappa", a->opt.kappa, "path-variance's relative damping", 0.0, 1e6);
   sel->callback([&action, a] {
     action = [a] {
       return printLine(benchSelectionJson(benchDataset(a->dataset, a->width, a->height, "bench select"), a->opt));

@@ -8,6 +8,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "apps/cli_checks.h"
 #include "apps/commands.h"
 #include "nbv/prefilter_options.h"
 #include "apps/view_list.h"
@@ -109,24 +110,13 @@ void addCoverageCommand(CLI::App& app, Action& action) {
   sub->add_option("--score", a->flags.score, "xor | new")->capture_default_str();
   sub->add_option("--lifting", a->flags.lifting, "flow | depth | oracle (the dataset's ground-truth depth maps)")
       ->capture_default_str();
-  sub->add_option("--keep", a->config.keep_fraction, "Fraction of candidates kept (top N %)")
-      ->check(CLI::Range(0.0, 1.0))
-      ->capture_default_str();
-  sub->add_option("--resolution", a->config.resolution, "Grid resolution along the longest side")
-      ->check(CLI::Range(4, 4096))
-      ->capture_default_str();
-  sub->add_option("--min-points", a->config.min_points, "SfM points per occupied voxel (paper: 2 outdoor, 5 indoor)")
-      ->check(CLI::Range(1, 1000))
-      ->capture_default_str();
-  sub->add_option("--upsample", a->config.upsample, "Upsampling of the occupied voxels")
-      ->check(CLI::Range(1, 16))
-      ->capture_default_str();
-  sub->add_option("--stride", a->config.visible_stride, "Pixel stride of visibility rays")
-      ->check(CLI::Range(1, 64))
-      ->capture_default_str();
-  sub->add_option("--downscale", a->downscale, "Image downscale factor")
-      ->check(CLI::Range(1, 64))
-      ->capture_default_str();
+  addRanged(sub, "--keep", a->config.keep_fraction, "Fraction of candidates kept (top N %)", 0.0, 1.0);
+  addRanged(sub, "--resolution", a->config.resolution, "Grid resolution along the longest side", 4, 4096);
+  addRanged(sub, "--min-points", a->config.min_points, "SfM points per occupied voxel (paper: 2 outdoor, 5 indoor)", 1,
+            1000);
+  addRanged(sub, "--upsample", a->config.upsample, "Upsampling of the occupied voxels", 1, 16);
+  addRanged(sub, "--stride", a->config.visible_stride, "Pixel stride of visibility rays", 1, 64);
+  addRanged(sub, "--downscale", a->downscale, "Image downscale factor", 1, 64);
   sub->callback([&action, a] { action = [a] { return runCoverage(*a); }; });
 }
 

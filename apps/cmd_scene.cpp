@@ -53,8 +53,8 @@ void addSceneCommand(CLI::App& app, Action& action) {
       ->check(CLI::IsMember({"object", "room360", "unbalanced", "tworooms", "corridor"}))
       ->capture_default_str();
   sub->add_option("--out", args->out, "Output folder")->required();
-  sub->add_option("--width", args->scene.width, "Image width")->check(CLI::Range(16, 8192))->capture_default_str();
-  sub->add_option("--height", args->scene.height, "Image height")->check(CLI::Range(16, 8192))->capture_default_str();
+  addRanged(sub, "--width", args->scene.width, "Image width", 16, 8192);
+  addRanged(sub, "--height", args->scene.height, "Image height", 16, 8192);
   sub->add_option("--seed", args->scene.seed, "Random seed")->check(wholeNumberAtLeast(0))->capture_default_str();
   sub->add_option("--views", args->scene.num_views, "Number of views (0: the layout's default)")
       ->check(CLI::Range(0, kMaxSyntheticViews));
@@ -66,9 +66,7 @@ void addSceneCommand(CLI::App& app, Action& action) {
   sub->add_option("--projection", args->scene.projection, "Photograph mapping")
       ->check(CLI::IsMember({"triplanar", "spherical"}))
       ->capture_default_str();
-  sub->add_option("--spp", args->write.render.samples_per_pixel, "Samples per pixel (>= 4)")
-      ->check(CLI::Range(4, 4096))
-      ->capture_default_str();
+  addRanged(sub, "--spp", args->write.render.samples_per_pixel, "Samples per pixel (>= 4)", 4, 4096);
   sub->add_flag("--specular", args->write.render.specular, "Add a mild specular highlight");
   CLI::Option* sfm = sub->add_option("--sfm", args->write.sfm, "Sparse points: simulated | colmap | none")
                          ->check(CLI::IsMember({"simulated", "colmap", "none"}))

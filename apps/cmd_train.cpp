@@ -167,45 +167,29 @@ void addTrainCommand(CLI::App& app, Action& action) {
   CLI::App* sub = app.add_subcommand("train", "Train 3D Gaussians on all train views of a dataset");
   sub->add_option("--dataset", a->dataset, "COLMAP, Blender or `saresgs scene` folder")->required();
   sub->add_option("--out", a->out, "Output folder")->required();
-  sub->add_option("--iterations", a->iterations, "Training iterations")
-      ->check(CLI::Range(1, 10000000))
-      ->capture_default_str();
-  sub->add_option("--downscale", a->downscale, "Image downscale factor")
-      ->check(CLI::Range(1, 64))
-      ->capture_default_str();
+  addRanged(sub, "--iterations", a->iterations, "Training iterations", 1, 10000000);
+  addRanged(sub, "--downscale", a->downscale, "Image downscale factor", 1, 64);
   sub->add_option("--background", a->background, kBackgroundHelp)->check(backgroundValue());
-  sub->add_option("--sh-degree", a->opt.max_sh_degree, "Maximum SH degree")
-      ->check(CLI::Range(0, 3))
-      ->capture_default_str();
+  addRanged(sub, "--sh-degree", a->opt.max_sh_degree, "Maximum SH degree", 0, 3);
   sub->add_option("--seed", a->opt.seed, "Random seed")->check(wholeNumberAtLeast(0))->capture_default_str();
   sub->add_option("--threads", a->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
   sub->add_option("--densify-until", a->opt.densify.until_iter, "Last densification iteration")
       ->check(wholeNumberAtLeast(0))
       ->capture_default_str();
-  sub->add_option("--max-gaussians", a->opt.densify.max_gaussians, "Cap on the model size (0: none)")
-      ->check(CLI::Range(0.0, 1e9))
-      ->capture_default_str();
+  addRanged(sub, "--max-gaussians", a->opt.densify.max_gaussians, "Cap on the model size (0: none)", 0.0, 1e9);
   sub->add_option("--memory-budget", a->memory_budget_gb,
                   "GB this run may use: refused before it starts if its images and initial model do not fit, the model "
                   "capped to fit (default: refused only beyond what the machine has available)")
       ->check(CLI::Range(0.001, 1e6));
-  sub->add_option("--random-init", a->opt.random_init_points, "Random points when the dataset has none")
-      ->check(CLI::Range(1, 10000000))
-      ->capture_default_str();
+  addRanged(sub, "--random-init", a->opt.random_init_points, "Random points when the dataset has none", 1, 10000000);
   sub->add_flag("--residual", a->opt.residual.enabled, "Add SA-ResGS residual supervision");
   sub->add_option("--views", a->views,
                   "Train on these train views only, in this order (indices or image names, comma-separated; e.g. an "
                   "active run's selected_views to refit them)");
-  sub->add_option("--schedule-scale", a->schedule_scale,
-                  "Scale the densification, opacity-reset and SH schedules (the quick preset's is 0.25)")
-      ->check(CLI::Range(1e-4, 1e4))
-      ->capture_default_str();
-  sub->add_option("--residual-alpha", a->opt.residual.alpha, "Random fraction of G_sub")
-      ->check(CLI::Range(0.0, 1.0))
-      ->capture_default_str();
-  sub->add_option("--residual-beta", a->opt.residual.beta, "Uncertain fraction of G_sub")
-      ->check(CLI::Range(0.0, 1.0))
-      ->capture_default_str();
+  addRanged(sub, "--schedule-scale", a->schedule_scale,
+            "Scale the densification, opacity-reset and SH schedules (the quick preset's is 0.25)", 1e-4, 1e4);
+  addRanged(sub, "--residual-alpha", a->opt.residual.alpha, "Random fraction of G_sub", 0.0, 1.0);
+  addRanged(sub, "--residual-beta", a->opt.residual.beta, "Uncertain fraction of G_sub", 0.0, 1.0);
   sub->add_option("--residual-ranking", a->ranking, "both | opacity | scale | random")
       ->check(CLI::IsMember({"both", "opacity", "scale", "random"}))
       ->capture_default_str();

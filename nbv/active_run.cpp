@@ -1,4 +1,5 @@
 #include "nbv/active_run.h"
+#include "geometry/enum_names.h"
 
 #include <nlohmann/json.hpp>
 
@@ -82,25 +83,10 @@ TrainerOptions finalFitOptions(const ActiveOptions& o, bool method_training) {
 }
 
 const char* toString(ActivePhase p) {
-  switch (p) {
-    case ActivePhase::kTraining:
-      return "training";
-    case ActivePhase::kLifting:
-      return "lifting";
-    case ActivePhase::kPrefilter:
-      return "prefilter";
-    case ActivePhase::kFisher:
-      return "Fisher";
-    case ActivePhase::kExhaustiveFisher:
-      return "exhaustive Fisher";
-    case ActivePhase::kFinalEvaluation:
-      return "final evaluation";
-    case ActivePhase::kFinalFit:
-      return "final fit";
-    case ActivePhase::kFinalFitViews:
-      return "plain refit";
-  }
-  return "?";
+  static constexpr std::array<const char*, 8> kNames{"training",  "lifting",           "prefilter",
+                                                     "Fisher",    "exhaustive Fisher", "final evaluation",
+                                                     "final fit", "plain refit"};
+  return enumName(p, kNames);
 }
 
 void ActiveRun::report(ActivePhase phase, int done, int total) {

@@ -1,4 +1,5 @@
 #include "nbv/coverage_prefilter.h"
+#include "geometry/enum_names.h"
 
 #include <algorithm>
 #include <filesystem>
@@ -142,17 +143,7 @@ VoxelSet CandidateSetBuilder::build(const Camera& cam, CandidateSetKind kind, in
 
 const char* toString(CandidateSetKind k) { return k == CandidateSetKind::kFrustum ? "frustum" : "visible"; }
 
-const char* toString(LiftingSource s) {
-  switch (s) {
-    case LiftingSource::kFlow:
-      return "flow";
-    case LiftingSource::kDepth:
-      return "depth";
-    case LiftingSource::kOracle:
-      return "oracle";
-  }
-  return "?";
-}
+const char* toString(LiftingSource s) { return enumName(s, std::array<const char*, 3>{"flow", "depth", "oracle"}); }
 
 const char* toString(CoverageCriterion c) { return c == CoverageCriterion::Hamming ? "xor" : "new"; }
 

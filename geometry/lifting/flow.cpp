@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "geometry/error.h"
+#include "geometry/enum_names.h"
 #include "geometry/lifting/sa_points.h"
 
 namespace saresgs {
@@ -61,15 +62,7 @@ FlowPreset parseFlowPreset(const std::string& name) {
 }
 
 const char* flowPresetName(FlowPreset p) {
-  switch (p) {
-    case FlowPreset::kUltrafast:
-      return "ultrafast";
-    case FlowPreset::kFast:
-      return "fast";
-    case FlowPreset::kMedium:
-      return "medium";
-  }
-  return "medium";
+  return enumName(p, std::array<const char*, 3>{"ultrafast", "fast", "medium"}, "medium");
 }
 
 CorrespondenceSet flowCorrespondences(const ImageF& image0, const ImageF& image1, const FlowOptions& opts) {

@@ -1,4 +1,5 @@
 #include "geometry/lifting/triangulation.h"
+#include "geometry/enum_names.h"
 #include "geometry/float_env.h"
 
 #include <tbb/blocked_range.h>
@@ -14,25 +15,9 @@ namespace saresgs {
 using Matrix34d = Eigen::Matrix<double, 3, 4>;
 
 const char* rejectionName(Rejection r) {
-  switch (r) {
-    case Rejection::kNone:
-      return "kept";
-    case Rejection::kBorder:
-      return "border";
-    case Rejection::kZeroBaseline:
-      return "zero_baseline";
-    case Rejection::kDegenerate:
-      return "degenerate";
-    case Rejection::kAtInfinity:
-      return "at_infinity";
-    case Rejection::kBehindCamera:
-      return "behind_camera";
-    case Rejection::kParallelRays:
-      return "parallel_rays";
-    case Rejection::kReprojection:
-      return "reprojection";
-  }
-  return "unknown";
+  static constexpr std::array<const char*, kRejectionCount> kNames{
+      "kept", "border", "zero_baseline", "degenerate", "at_infinity", "behind_camera", "parallel_rays", "reprojection"};
+  return enumName(r, kNames, "unknown");
 }
 
 namespace {

@@ -55,14 +55,7 @@ std::string transformsJson(const SyntheticScene& scene, const std::vector<int>& 
   const bool simple = K.fx == K.fy && K.cx == 0.5 * K.width && K.cy == 0.5 * K.height;
   for (const Camera& c : scene.cameras)
     if (!(c.K == K)) throw std::invalid_argument("blender format: every view must share one camera");
-  if (!simple) {
-    j["fl_x"] = K.fx;
-    j["fl_y"] = K.fy;
-    j["cx"] = K.cx;
-    j["cy"] = K.cy;
-    j["w"] = K.width;
-    j["h"] = K.height;
-  }
+  if (!simple) j.update({{"fl_x", K.fx}, {"fl_y", K.fy}, {"cx", K.cx}, {"cy", K.cy}, {"w", K.width}, {"h", K.height}});
   j["frames"] = nlohmann::json::array();
   for (int i : which)
     j["frames"].push_back(

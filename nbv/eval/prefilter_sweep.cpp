@@ -50,11 +50,7 @@ std::vector<CoverageScoring> SweepSpec::defaultEncodings() {
 }
 
 nlohmann::json toJson(const SweepReport& r) {
-  nlohmann::json res;
-  res["scene"] = r.scene;
-  res["dataset"] = r.dataset;
-  res["lifting"] = r.lifting;
-  res["reference"] = r.reference;
+  nlohmann::json res = {{"scene", r.scene}, {"dataset", r.dataset}, {"lifting", r.lifting}, {"reference", r.reference}};
   if (r.resolution > 0)
     res["grid"] = {{"scene_type", r.scene_type},
                    {"resolution", r.resolution},

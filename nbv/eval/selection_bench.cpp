@@ -78,19 +78,18 @@ nlohmann::json benchSelectionJson(const std::string& path, const SelectionBenchO
   std::vector<double> ratio;
   for (std::size_t k = 0; k < r.fisher_seconds.size(); ++k)
     ratio.push_back(r.path_variance_seconds[k] / r.fisher_seconds[k]);
-  nlohmann::json j;
-  j["benchmark"] = "select";
-  j["dataset"] = path;
-  j["held"] = opt.held;
-  j["candidates"] = r.candidates;
-  j["gaussians"] = r.gaussians;
-  j["threads"] = opt.threads;
-  j["fisher_seconds"] = r.fisher_seconds;
-  j["path_variance_seconds"] = r.path_variance_seconds;
-  j["fisher_median_s"] = sampleMedian(r.fisher_seconds);
-  j["path_variance_median_s"] = sampleMedian(r.path_variance_seconds);
-  j["ratio_per_round"] = ratio;
-  j["ratio_median"] = sampleMedian(ratio);
+  nlohmann::json j = {{"benchmark", "select"},
+                      {"dataset", path},
+                      {"held", opt.held},
+                      {"candidates", r.candidates},
+                      {"gaussians", r.gaussians},
+                      {"threads", opt.threads},
+                      {"fisher_seconds", r.fisher_seconds},
+                      {"path_variance_seconds", r.path_variance_seconds},
+                      {"fisher_median_s", sampleMedian(r.fisher_seconds)},
+                      {"path_variance_median_s", sampleMedian(r.path_variance_seconds)},
+                      {"ratio_per_round", ratio},
+                      {"ratio_median", sampleMedian(ratio)}};
   j["choices"] = {{"fisher", r.fisher_choice}, {"path-variance", r.path_variance_choice}};
   j["unseen_share"] = {
       {"median", sampleMedian(r.unseen_share)},

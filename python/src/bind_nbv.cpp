@@ -68,18 +68,11 @@ struct PyActiveRun {
     py::gil_scoped_acquire gil;
     checkSignals();
     if (progress.is_none()) return;
-    py::dict d;
-    d["phase"] = toString(p.phase);
-    d["phase_done"] = p.phase_done;
-    d["phase_total"] = p.phase_total;
-    d["views"] = p.views;
-    d["max_views"] = p.max_views;
-    d["iteration"] = p.iteration;
-    d["total_iterations"] = p.total_iterations;
-    d["loss"] = p.loss;
-    d["psnr"] = p.psnr;
-    d["gaussians"] = p.gaussians;
-    progress(d);
+    progress(py::dict(py::arg("phase") = toString(p.phase), py::arg("phase_done") = p.phase_done,
+                      py::arg("phase_total") = p.phase_total, py::arg("views") = p.views,
+                      py::arg("max_views") = p.max_views, py::arg("iteration") = p.iteration,
+                      py::arg("total_iterations") = p.total_iterations, py::arg("loss") = p.loss,
+                      py::arg("psnr") = p.psnr, py::arg("gaussians") = p.gaussians));
   }
 
   int select(const SelectionContext& ctx, SelectionLog& log) {

@@ -13,14 +13,8 @@ namespace saresgs::python {
 namespace {
 
 py::dict progressDict(const TrainProgress& p) {
-  py::dict d;
-  d["iteration"] = p.iteration;
-  d["done"] = p.done;
-  d["total"] = p.total;
-  d["loss"] = p.loss;
-  d["loss_ema"] = p.loss_ema;
-  d["gaussians"] = p.gaussians;
-  return d;
+  return py::dict(py::arg("iteration") = p.iteration, py::arg("done") = p.done, py::arg("total") = p.total,
+                  py::arg("loss") = p.loss, py::arg("loss_ema") = p.loss_ema, py::arg("gaussians") = p.gaussians);
 }
 
 py::dict evaluationDict(const Evaluation& e) {

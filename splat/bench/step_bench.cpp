@@ -94,15 +94,28 @@ StepTimes timeSteps(const StepBenchOptions& o, const Camera& cam, const ImageF& 
 
 // The size of the random scene and its renders: the same keys in both benchmarks.
 void describeScene(nlohmann::json& j, const StepBenchOptions& o, const RasterSettings& s) {
-  j["width"] = o.width;
-  j["height"] = o.height;
-  j["gaussians"] = o.gaussians;
-  j["sh_degree"] = o.sh_degree;
-  j["coverage"] = o.coverage;
-  j["threads"] = rasterThreadCount(s.execution);
-  j["kernels"] = rasterKernelName(s.execution);
-  j["steps"] = o.steps;
+  j.update({{"width", o.width},
+            {"height", o.height},
+            {"gaussians", o.gaussians},
+            {"sh_degree", o.sh_degree},
+            {"coverage", o.coverage},
+            {"threads", rasterThreadCount(s.execution)},
+            {"kernels", rasterKernelName(s.execution)},
+            {"steps", o.steps}});
 }
+
+// What both benchmarks of the random scene start with: the load before, the thread cap,
+// the size check (before anything large is allocated), the camera and the settings.
+struct RandomSceneBench {
+  explicit RandomSceneBench(const StepBenchOptions& o)
+      : thread_limit(limitThreads(o.threads)), cam(benchCamera(o)), s(benchSettings(o)) {
+    checkBenchSize(o);
+  }
+  std::string load_before = loadAverage();
+  std::unique_ptr<tbb::global_control> thread_limit;
+  Camera cam;
+  RasterSettings s;
+};
 
 }  // namespace
 
@@ -162,11 +175,9 @@ StepTimes timeBenchSteps(const StepBenchOptions& o, bool residual) {
 }
 
 nlohmann::json benchStep(const StepBenchOptions& o) {
-  const std::string load_before = loadAverage();
-  const auto thread_limit = limitThreads(o.threads);
-  checkBenchSize(o);
-  const Camera cam = benchCamera(o);
-  const RasterSettings s = benchSettings(o);
+  const RandomSceneBench b(o);
+  const Camera& cam = b.cam;
+  const RasterSettings& s = b.s;
   const ImageF target = benchTarget(o, cam);
   const StepTimes plain = timeSteps(o, cam, target, false);
   nlohmann::json j;
@@ -201,16 +212,14 @@ nlohmann::json benchStep(const StepBenchOptions& o) {
   j["render_fraction_of_floor"] = floor_ns / render_ns;
   if (o.heap_allocations) j["allocations_per_step"] = plain.allocations_per_step;
   j["page_faults_per_step"] = plain.page_faults_per_step;
-  nameMachine(j, load_before);
+  nameMachine(j, b.load_before);
   return j;
 }
 
 nlohmann::json benchFisher(const StepBenchOptions& o) {
-  const std::string load_before = loadAverage();
-  const auto thread_limit = limitThreads(o.threads);
-  checkBenchSize(o);
-  const Camera cam = benchCamera(o);
-  const RasterSettings s = benchSettings(o);
+  const RandomSceneBench b(o);
+  const Camera& cam = b.cam;
+  const RasterSettings& s = b.s;
   const Gaussians g = benchScene(o, o.seed, cam);
   // dL/drgb as in training: the photometric loss against another random scene's render.
   const RenderResult fwd = rasterize(g, cam, s);
@@ -252,7 +261,7 @@ nlohmann::json benchFisher(const StepBenchOptions& o) {
   j["backward_ms"] = sampleMedian(backward_ms);
   j["fisher_to_backward_ratio"] = sampleMedian(fisher_ms) / sampleMedian(backward_ms);
   j["information_sum"] = checksum;
-  nameMachine(j, load_before);
+  nameMachine(j, b.load_before);
   return j;
 }
 

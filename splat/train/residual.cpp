@@ -1,4 +1,5 @@
 #include "splat/train/residual.h"
+#include "geometry/enum_names.h"
 
 #include <algorithm>
 #include <bit>
@@ -24,17 +25,7 @@ UncertaintyRanking parseUncertaintyRanking(const std::string& s) {
 }
 
 const char* toString(UncertaintyRanking r) {
-  switch (r) {
-    case UncertaintyRanking::kBoth:
-      return "both";
-    case UncertaintyRanking::kOpacity:
-      return "opacity";
-    case UncertaintyRanking::kScale:
-      return "scale";
-    case UncertaintyRanking::kRandom:
-      return "random";
-  }
-  return "?";
+  return enumName(r, std::array<const char*, 4>{"both", "opacity", "scale", "random"});
 }
 
 namespace {
