@@ -18,6 +18,7 @@
 #include "geometry/error.h"
 #include "geometry/io/atomic_file.h"
 #include "geometry/io/byte_order.h"
+#include "geometry/io/ply_scalar.h"
 
 namespace saresgs {
 
@@ -36,41 +37,10 @@ void checkModel(const Gaussians& g) {
 
 // ---- header parsing --------------------------------------------------------------
 
-enum class Type { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64 };
-
-std::optional<Type> parseType(const std::string& s) {
-  static const std::map<std::string, Type> types = {
-      {"char", Type::Int8},     {"int8", Type::Int8},       {"uchar", Type::UInt8},    {"uint8", Type::UInt8},
-      {"short", Type::Int16},   {"int16", Type::Int16},     {"ushort", Type::UInt16},  {"uint16", Type::UInt16},
-      {"int", Type::Int32},     {"int32", Type::Int32},     {"uint", Type::UInt32},    {"uint32", Type::UInt32},
-      {"float", Type::Float32}, {"float32", Type::Float32}, {"double", Type::Float64}, {"float64", Type::Float64}};
-  const auto it = types.find(s);
-  if (it == types.end()) return std::nullopt;
-  return it->second;
-}
-
-std::size_t typeSize(Type t) {
-  switch (t) {
-    case Type::Int8:
-    case Type::UInt8:
-      return 1;
-    case Type::Int16:
-    case Type::UInt16:
-      return 2;
-    case Type::Int32:
-    case Type::UInt32:
-    case Type::Float32:
-      return 4;
-    case Type::Float64:
-      return 8;
-  }
-  return 0;
-}
-
 struct Property {
   std::string name;
   std::string type_name;
-  Type type = Type::Float32;
+  PlyScalar type = PlyScalar::kFloat32;
   bool is_list = false;
   std::size_t offset = 0;  // within the record, for scalar properties
 };
@@ -127,18 +97,18 @@ void addProperty(std::istringstream& ls, const std::string& line, const std::str
   if (type == "list") {
     std::string count_type, item_type;
     ls >> count_type >> item_type >> p.name;
-    if (!parseType(count_type) || !parseType(item_type) || p.name.empty())
+    if (!parsePlyScalar(count_type) || !parsePlyScalar(item_type) || p.name.empty())
       throw InputError(path, "header", "bad property line '" + line + "'");
     p.is_list = true;
     e.has_list = true;
   } else {
-    const auto t = parseType(type);
+    const auto t = parsePlyScalar(type);
     ls >> p.name;
     if (!t || p.name.empty()) throw InputError(path, "header", "bad property line '" + line + "'");
     p.type = *t;
     p.type_name = type;
     p.offset = e.stride;
-    e.stride += typeSize(p.type);
+    e.stride += plyScalarSize(p.type);
   }
   for (const auto& q : e.props)
     if (q.name == p.name) throw InputError(path, "property " + p.name, "appears twice in element " + e.name);
@@ -307,9 +277,9 @@ Gaussians readGaussiansPly(const std::string& path) {
   auto want = [&](const std::string& name, std::vector<float>& array, std::size_t first, std::size_t step) {
     const Property* p = find(name);
     if (!p) throw InputError(path, name, "property missing from element vertex");
-    if (p->type != Type::Float32 && p->type != Type::Float64)
+    if (p->type != PlyScalar::kFloat32 && p->type != PlyScalar::kFloat64)
       throw InputError(path, name, "type " + p->type_name + ", expected float or double");
-    sources.push_back({name, p->offset, p->type == Type::Float64, &array, first, step});
+    sources.push_back({name, p->offset, p->type == PlyScalar::kFloat64, &array, first, step});
   };
   for (int a = 0; a < 3; ++a) want(std::string(1, "xyz"[a]), g.means, a, 3);
   for (int c = 0; c < 3; ++c) want("f_dc_" + std::to_string(c), g.sh, c, 3 * K);

@@ -109,6 +109,17 @@ void insertUnique(Map& map, Record&& record, const ByteReader& in, const Where& 
     in.fail(where, field, "expected unique ids, " + std::to_string(id) + " appears twice");
 }
 
+// One .bin file of records: their count, each record read and kept once by its id, and
+// nothing after the last.
+template <typename Map, typename ReadRecord>
+void readRecords(const std::string& dir, const char* file, const char* count_field, size_t min_bytes, Map& into,
+                 ReadRecord read, const char* kind, const char* id_field, const char* things) {
+  ByteReader in(pathIn(dir, file));
+  const std::uint64_t count = in.readCount({}, count_field, min_bytes);
+  for (std::uint64_t i = 0; i < count; ++i) insertUnique(into, read(in, i), in, {kind, i, true}, id_field);
+  in.expectEnd(count, things);
+}
+
 ColmapCamera readCamera(ByteReader& in, std::uint64_t index) {
   ColmapCamera cam;
   cam.id = in.read<std::uint32_t>({"camera", index, true}, "camera_id");
@@ -123,16 +134,6 @@ ColmapCamera readCamera(ByteReader& in, std::uint64_t index) {
   for (double& p : cam.params) p = in.read<double>(where, "params");
   checkCamera(cam, in.path(), where.name());
   return cam;
-}
-
-void readCameras(const std::string& dir, ColmapModel& model) {
-  ByteReader in(pathIn(dir, "cameras.bin"));
-  const std::uint64_t count = in.readCount({}, "num_cameras", kCameraBytes);
-  for (std::uint64_t i = 0; i < count; ++i) {
-    ColmapCamera cam = readCamera(in, i);
-    insertUnique(model.cameras, std::move(cam), in, {"camera", i, true}, "camera_id");
-  }
-  in.expectEnd(count, "cameras");
 }
 
 // images.bin stores point3D ids as int64 with -1 for "no point".
@@ -170,16 +171,6 @@ ColmapImage readImage(ByteReader& in, std::uint64_t index) {
   return img;
 }
 
-void readImages(const std::string& dir, ColmapModel& model) {
-  ByteReader in(pathIn(dir, "images.bin"));
-  const std::uint64_t count = in.readCount({}, "num_images", kImageBytes);
-  for (std::uint64_t i = 0; i < count; ++i) {
-    ColmapImage img = readImage(in, i);
-    insertUnique(model.images, std::move(img), in, {"image", i, true}, "image_id");
-  }
-  in.expectEnd(count, "images");
-}
-
 ColmapPoint3D readPoint(ByteReader& in, std::uint64_t index) {
   ColmapPoint3D pt;
   pt.id = in.read<std::uint64_t>({"point", index, true}, "point3D_id");
@@ -197,16 +188,6 @@ ColmapPoint3D readPoint(ByteReader& in, std::uint64_t index) {
   }
   checkPoint(pt, in.path(), where.name());
   return pt;
-}
-
-void readPoints(const std::string& dir, ColmapModel& model) {
-  ByteReader in(pathIn(dir, "points3D.bin"));
-  const std::uint64_t count = in.readCount({}, "num_points3D", kPointBytes);
-  for (std::uint64_t i = 0; i < count; ++i) {
-    ColmapPoint3D pt = readPoint(in, i);
-    insertUnique(model.points, std::move(pt), in, {"point", i, true}, "point3D_id");
-  }
-  in.expectEnd(count, "points");
 }
 
 // Little-endian values collected in a buffer and passed to the stream in large
@@ -315,9 +296,11 @@ void checkWritable(const ColmapModel& model, const std::string& dir) {
 
 ColmapModel readColmapBinary(const std::string& dir) {
   ColmapModel model;
-  readCameras(dir, model);
-  readImages(dir, model);
-  readPoints(dir, model);
+  readRecords(dir, "cameras.bin", "num_cameras", kCameraBytes, model.cameras, readCamera, "camera", "camera_id",
+              "cameras");
+  readRecords(dir, "images.bin", "num_images", kImageBytes, model.images, readImage, "image", "image_id", "images");
+  readRecords(dir, "points3D.bin", "num_points3D", kPointBytes, model.points, readPoint, "point", "point3D_id",
+              "points");
   return model;
 }
 

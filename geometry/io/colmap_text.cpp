@@ -219,15 +219,23 @@ ColmapCamera parseCamera(Fields& f) {
   return cam;
 }
 
-void readCameras(const std::string& dir, ColmapModel& model) {
-  TextFile file(pathIn(dir, "cameras.txt"), "cameras");
+// cameras.txt or points3D.txt: one record a line, each parsed, checked and kept once by
+// its id, and as many as the header's count says.
+template <typename Map, typename Parse, typename Check>
+void readRecords(const std::string& dir, const char* name, const char* things, Map& into, Parse parse, Check check,
+                 const char* id_field) {
+  TextFile file(pathIn(dir, name), things);
   while (const auto line = file.nextRecord()) {
     Fields f(file.path(), *line);
-    ColmapCamera cam = parseCamera(f);
-    checkCamera(cam, file.path(), f.where());
-    insertUnique(model.cameras, std::move(cam), f, "CAMERA_ID");
+    auto record = parse(f);
+    check(record, file.path(), f.where());
+    insertUnique(into, std::move(record), f, id_field);
   }
-  file.checkCount(model.cameras.size());
+  file.checkCount(into.size());
+}
+
+void readCameras(const std::string& dir, ColmapModel& model) {
+  readRecords(dir, "cameras.txt", "cameras", model.cameras, parseCamera, checkCamera, "CAMERA_ID");
 }
 
 // The first line of an image: IMAGE_ID QW QX QY QZ TX TY TZ CAMERA_ID NAME.
@@ -298,14 +306,7 @@ ColmapPoint3D parsePoint(Fields& f) {
 }
 
 void readPoints(const std::string& dir, ColmapModel& model) {
-  TextFile file(pathIn(dir, "points3D.txt"), "points");
-  while (const auto line = file.nextRecord()) {
-    Fields f(file.path(), *line);
-    ColmapPoint3D pt = parsePoint(f);
-    checkPoint(pt, file.path(), f.where());
-    insertUnique(model.points, std::move(pt), f, "POINT3D_ID");
-  }
-  file.checkCount(model.points.size());
+  readRecords(dir, "points3D.txt", "points", model.points, parsePoint, checkPoint, "POINT3D_ID");
 }
 
 // 17 significant digits: enough for any double to read back exactly, and close enough

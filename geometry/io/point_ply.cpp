@@ -10,71 +10,16 @@
 #include "geometry/error.h"
 #include "geometry/io/atomic_file.h"
 #include "geometry/io/byte_order.h"
+#include "geometry/io/ply_scalar.h"
 
 namespace saresgs {
 
 namespace {
 
-enum class Scalar { kInt8, kUInt8, kInt16, kUInt16, kInt32, kUInt32, kFloat32, kFloat64 };
-
-std::optional<Scalar> scalarType(const std::string& t) {
-  if (t == "char" || t == "int8") return Scalar::kInt8;
-  if (t == "uchar" || t == "uint8") return Scalar::kUInt8;
-  if (t == "short" || t == "int16") return Scalar::kInt16;
-  if (t == "ushort" || t == "uint16") return Scalar::kUInt16;
-  if (t == "int" || t == "int32") return Scalar::kInt32;
-  if (t == "uint" || t == "uint32") return Scalar::kUInt32;
-  if (t == "float" || t == "float32") return Scalar::kFloat32;
-  if (t == "double" || t == "float64") return Scalar::kFloat64;
-  return std::nullopt;
-}
-
-std::size_t sizeOf(Scalar s) {
-  switch (s) {
-    case Scalar::kInt8:
-    case Scalar::kUInt8:
-      return 1;
-    case Scalar::kInt16:
-    case Scalar::kUInt16:
-      return 2;
-    case Scalar::kInt32:
-    case Scalar::kUInt32:
-    case Scalar::kFloat32:
-      return 4;
-    case Scalar::kFloat64:
-      return 8;
-  }
-  return 0;
-}
-
-double loadScalar(const char* p, Scalar s) {
-  using byte_order::load;
-  constexpr auto le = std::endian::little;
-  switch (s) {
-    case Scalar::kInt8:
-      return load<std::int8_t>(p, le);
-    case Scalar::kUInt8:
-      return load<std::uint8_t>(p, le);
-    case Scalar::kInt16:
-      return load<std::int16_t>(p, le);
-    case Scalar::kUInt16:
-      return load<std::uint16_t>(p, le);
-    case Scalar::kInt32:
-      return load<std::int32_t>(p, le);
-    case Scalar::kUInt32:
-      return load<std::uint32_t>(p, le);
-    case Scalar::kFloat32:
-      return load<float>(p, le);
-    case Scalar::kFloat64:
-      return load<double>(p, le);
-  }
-  return 0;
-}
-
 struct VertexLayout {
   bool ascii = false;
   std::uint64_t count = 0;
-  std::vector<Scalar> types;
+  std::vector<PlyScalar> types;
   std::size_t stride = 0;
   int xyz[3] = {-1, -1, -1};
   int rgb[3] = {-1, -1, -1};
@@ -128,7 +73,7 @@ VertexLayout parseHeader(const std::string& bytes, const std::string& path) {
       if (!in_vertex) continue;
       std::string type, name;
       ls >> type >> name;
-      const auto t = scalarType(type);
+      const auto t = parsePlyScalar(type);
       if (type == "list")
         throw InputError(path, "property " + name, "a list property in the vertex element is not supported");
       if (!t || name.empty()) throw InputError(path, "header", "bad property line '" + *line + "'");
@@ -136,12 +81,13 @@ VertexLayout parseHeader(const std::string& bytes, const std::string& path) {
       for (int k = 0; k < 3; ++k) {
         if (name == kXyz[k]) L.xyz[k] = index;
         if (name == kRgb[k]) {
-          if (*t != Scalar::kUInt8) throw InputError(path, "property " + name, "expected uchar colours, got " + type);
+          if (*t != PlyScalar::kUInt8)
+            throw InputError(path, "property " + name, "expected uchar colours, got " + type);
           L.rgb[k] = index;
         }
       }
       L.types.push_back(*t);
-      L.stride += sizeOf(*t);
+      L.stride += plyScalarSize(*t);
     } else {
       throw InputError(path, "header", "unknown header line '" + *line + "'");
     }
@@ -198,8 +144,8 @@ std::vector<PlyPoint> readPointsPly(const std::string& path) {
         pos = end;
       }
     } else {
-      for (std::size_t k = 0, off = 0; k < n_props; off += sizeOf(L.types[k]), ++k)
-        values[k] = loadScalar(bytes.data() + pos + off, L.types[k]);
+      for (std::size_t k = 0, off = 0; k < n_props; off += plyScalarSize(L.types[k]), ++k)
+        values[k] = loadPlyScalar(bytes.data() + pos + off, L.types[k]);
       pos += L.stride;
     }
     PlyPoint& pt = out[i];

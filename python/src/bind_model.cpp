@@ -50,6 +50,20 @@ void checkModel(const Gaussians& g) {
     throw py::value_error("Gaussians: inconsistent array sizes");
 }
 
+// The property of one of the model's arrays: a writable float32 view, (N, cols), or (N,)
+// for cols 0; assigning an array of that shape copies it in.
+auto arrayGetter(std::vector<float> Gaussians::*member, py::ssize_t cols) {
+  return [member, cols](py::object self) {
+    auto& g = self.cast<Gaussians&>();
+    std::vector<py::ssize_t> shape{static_cast<py::ssize_t>(g.size())};
+    if (cols > 0) shape.push_back(cols);
+    return view(self, g.*member, shape);
+  };
+}
+auto arraySetter(std::vector<float> Gaussians::*member, std::size_t per, const char* what, const char* shape) {
+  return [=](Gaussians& g, const py::array& a) { assign(g.*member, a, g.size(), per, what, shape); };
+}
+
 py::tuple renderTuple(RenderResult&& r) {
   return py::make_tuple(imageArray(std::move(r.rgb)), imageArray(std::move(r.depth)), imageArray(std::move(r.alpha)));
 }
@@ -84,34 +98,13 @@ void bindModel(py::module_& m) {
            py::arg("means"), py::arg("log_scales"), py::arg("rotations"), py::arg("opacities"), py::arg("sh"))
       .def("__len__", &Gaussians::size)
       .def_readonly("max_sh_degree", &Gaussians::max_sh_degree)
-      .def_property(
-          "means",
-          [](py::object self) {
-            auto& g = self.cast<Gaussians&>();
-            return view(self, g.means, {static_cast<py::ssize_t>(g.size()), 3});
-          },
-          [](Gaussians& g, const py::array& a) { assign(g.means, a, g.size(), 3, "means", "(N, 3)"); })
-      .def_property(
-          "log_scales",
-          [](py::object self) {
-            auto& g = self.cast<Gaussians&>();
-            return view(self, g.log_scales, {static_cast<py::ssize_t>(g.size()), 3});
-          },
-          [](Gaussians& g, const py::array& a) { assign(g.log_scales, a, g.size(), 3, "log_scales", "(N, 3)"); })
-      .def_property(
-          "rotations",
-          [](py::object self) {
-            auto& g = self.cast<Gaussians&>();
-            return view(self, g.rotations, {static_cast<py::ssize_t>(g.size()), 4});
-          },
-          [](Gaussians& g, const py::array& a) { assign(g.rotations, a, g.size(), 4, "rotations", "(N, 4)"); })
-      .def_property(
-          "opacities",
-          [](py::object self) {
-            auto& g = self.cast<Gaussians&>();
-            return view(self, g.opacities, {static_cast<py::ssize_t>(g.size())});
-          },
-          [](Gaussians& g, const py::array& a) { assign(g.opacities, a, g.size(), 1, "opacities", "(N,)"); })
+      .def_property("means", arrayGetter(&Gaussians::means, 3), arraySetter(&Gaussians::means, 3, "means", "(N, 3)"))
+      .def_property("log_scales", arrayGetter(&Gaussians::log_scales, 3),
+                    arraySetter(&Gaussians::log_scales, 3, "log_scales", "(N, 3)"))
+      .def_property("rotations", arrayGetter(&Gaussians::rotations, 4),
+                    arraySetter(&Gaussians::rotations, 4, "rotations", "(N, 4)"))
+      .def_property("opacities", arrayGetter(&Gaussians::opacities, 0),
+                    arraySetter(&Gaussians::opacities, 1, "opacities", "(N,)"))
       .def_property(
           "sh",
           [](py::object self) {
