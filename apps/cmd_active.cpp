@@ -12,6 +12,7 @@
 #include "splat/bench/machine.h"
 #include "nbv/prefilter_options.h"
 #include "apps/progress.h"
+#include "apps/settings_flags.h"
 #include "geometry/scene/dataset_checks.h"
 #include "geometry/io/atomic_file.h"
 #include "geometry/io/json_file.h"
@@ -29,61 +30,23 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Options as typed; the preset's values apply where an override is not given.
+// What describes where the run reads and writes, beside its settings (nbv/active_settings.h).
 struct ActiveArgs {
-  std::string dataset, out, method = "adaptive", preset = "quick", fvs_metric = "euclidean", ranking, replay,
-                            background;
-  int downscale = 1, threads = 0;
-  bool resume = false, continue_training = false, sub_only = false, time_exhaustive_fisher = false,
-       no_plain_refit = false, final_residual = false;
-  std::uint64_t seed = 0;
-  double fisher_lambda = 1e-6;
-  std::optional<int> max_views, interval, total, final_iterations, renamed_iterations;
-  std::optional<long long> max_gaussians;
-  std::optional<double> beta, prefilter_keep, hybrid_weight, gate_keep, adaptive_clustering, memory_budget_gb,
-      path_variance_kappa;
-  std::string hybrid_fisher = "logdet", hybrid_coverage = "facility";
-  PrefilterFlags prefilter;
+  std::string dataset, out, replay, background;
+  int downscale = 1;
+  bool resume = false;
+  std::optional<int> renamed_iterations;
+  std::optional<double> memory_budget_gb;
+  ActiveSettings settings;
 };
 
-// The run's options: the preset, then every option given on the command line.
+// The run's options: the preset, then every setting given on the command line.
 ActiveOptions activeOptions(const ActiveArgs& a) {
   if (a.renamed_iterations)
     throw std::invalid_argument(
         "--iterations is now --min-iterations: the loop trains at least that many iterations in all, the last phase "
         "what is left and never less than views x --interval (results.json: iterations, phase_iterations)");
-  ActiveSettings settings;
-  settings.preset = a.preset;
-  settings.method = parseMethod(a.method);
-  settings.seed = a.seed;
-  settings.threads = a.threads;
-  settings.max_views = a.max_views;
-  settings.interval = a.interval;
-  settings.min_iterations = a.total;
-  settings.final_iterations = a.final_iterations;
-  if (a.max_gaussians) settings.max_gaussians = static_cast<std::size_t>(*a.max_gaussians);
-  settings.plain_refit = !a.no_plain_refit;
-  settings.final_residual = a.final_residual;
-  settings.fisher_lambda = a.fisher_lambda;
-  settings.gate_keep = a.gate_keep;
-  settings.path_variance_kappa = a.path_variance_kappa;
-  settings.adaptive_clustering = a.adaptive_clustering;
-  settings.hybrid_weight = a.hybrid_weight;
-  ActiveOptions o = activeOptionsFrom(settings);
-  // What only the command line sets.
-  o.reset_after_add = !a.continue_training;
-  o.time_exhaustive_fisher = a.time_exhaustive_fisher;
-  o.fvs_metric = a.fvs_metric == "great-circle" ? ViewDistance::kGreatCircle : ViewDistance::kEuclidean;
-  if (a.beta) o.trainer.residual.beta = *a.beta;
-  if (!a.ranking.empty()) o.trainer.residual.ranking = parseUncertaintyRanking(a.ranking);
-  if (a.sub_only) o.trainer.residual.sub_only = true;
-  o.prefilter = parsePrefilterFlags(a.prefilter, o.prefilter, "--prefilter-", a.dataset);
-  if (a.prefilter_keep) o.prefilter.keep_fraction = *a.prefilter_keep;
-  o.hybrid_criterion = a.hybrid_fisher == "trace" ? FisherCriterion::kTrace : FisherCriterion::kLogDet;
-  o.hybrid_coverage = a.hybrid_coverage == "views"      ? HybridCoverage::kViewDistance
-                      : a.hybrid_coverage == "facility" ? HybridCoverage::kFacility
-                                                        : HybridCoverage::kSurface;
-  return o;
+  return activeOptionsFrom(a.settings, a.dataset, SettingNaming::kFlag);
 }
 
 void printSummary(const RunReport& r, const std::string& out) {
@@ -128,7 +91,7 @@ void writeReportPage(const std::string& out, const Scene& scene, int threads) {
 }
 
 int runActive(const ActiveArgs& a) {
-  const auto thread_limit = limitThreads(a.threads);
+  const auto thread_limit = limitThreads(a.settings.threads);
   ActiveOptions opt = activeOptions(a);
   DatasetOptions dopt;
   dopt.load.downscale = a.downscale;
@@ -173,8 +136,9 @@ int runActive(const ActiveArgs& a) {
   const bool resuming = a.resume && fs::exists(ckpt);
   ActiveRun run(scene, opt, ckpt);
   if (resuming) std::cerr << "resuming from " << ckpt << "\n";
-  std::cerr << "active run: " << a.method << " on " << a.dataset << " (" << scene.train.size() << " candidates, "
-            << scene.test.size() << " test views), preset " << a.preset << ", seed " << opt.seed << "\n";
+  std::cerr << "active run: " << toString(opt.method) << " on " << a.dataset << " (" << scene.train.size()
+            << " candidates, " << scene.test.size() << " test views), preset " << a.settings.preset << ", seed "
+            << opt.seed << "\n";
   if (opt.method == Method::kAdaptive) {
     const bool kmedian = usesKmedianGate(scene, opt);
     std::cerr << "adaptive: capture clustering " << captureClustering(scene) << (kmedian ? " > " : " <= ")
@@ -207,11 +171,12 @@ int runActive(const ActiveArgs& a) {
   writeRunFiles(run, r, scene, a.out);
   const RunReport report = makeRunReport(
       scene, opt, r,
-      {a.dataset, a.preset, a.replay, t.gaussians().size(), rasterThreadCount(opt.trainer.raster.execution)});
+      {a.dataset, a.settings.preset, a.replay, t.gaussians().size(), rasterThreadCount(opt.trainer.raster.execution)});
   note_memory("end", static_cast<int>(r.selected_views.size()), t.gaussians().size());
   nlohmann::json results = toJson(report);
   // Machine state, like the timings: not part of what a resumed run must reproduce.
   results["memory"] = {{"peak_rss_bytes", peakRssBytes()}, {"rss_at_phase_start_this_process", phase_memory}};
+  results["settings"] = activeSettingsJson(a.settings);
   results["warnings"] = nlohmann::json::array();
   for (std::size_t p = 0, q; p < said.size(); p = q + 1) {
     q = said.find('\n', p);
@@ -220,7 +185,7 @@ int runActive(const ActiveArgs& a) {
   }
   writeFileAtomic(a.out + "/results.json", results.dump(2) + "\n");
   printSummary(report, a.out);
-  writeReportPage(a.out, scene, a.threads);
+  writeReportPage(a.out, scene, a.settings.threads);
   std::printf("peak resident memory %.0f MB (this process)\n", peakRssBytes() / (1024.0 * 1024.0));
   return 0;
 }
@@ -234,99 +199,17 @@ CLI::App* addActiveOptions(CLI::App& app, const std::shared_ptr<ActiveArgs>& a) 
   CLI::App* sub = app.add_subcommand("active", "Active reconstruction: select views one by one while training");
   sub->add_option("--dataset", a->dataset, "COLMAP, Blender or `saresgs scene` folder")->required();
   sub->add_option("--out", a->out, "Output folder")->required();
-  sub->add_option("--method", a->method, methodChoices())->check(CLI::IsMember(methodNames()))->capture_default_str();
-  sub->add_option("--seed", a->seed, "Random seed")->check(wholeNumberAtLeast(0))->capture_default_str();
-  sub->add_option("--preset", a->preset, "quick | paper")->capture_default_str();
-  sub->add_option("--max-views", a->max_views, "Views at the end (default 20)")->check(wholeNumberAtLeast(1));
-  sub->add_option("--interval", a->interval, "Iterations per view held (preset's by default)")
-      ->check(wholeNumberAtLeast(1));
-  sub->add_option("--min-iterations", a->total,
-                  "Least total iterations of the loop: the last phase trains what is left and never less than views x "
-                  "interval, so more may run (preset's by default; results.json: iterations, phase_iterations)")
-      ->check(wholeNumberAtLeast(1));
   sub->add_option("--iterations", a->renamed_iterations, "Renamed --min-iterations")->group("");
-  sub->add_option(
-         "--final-iterations", a->final_iterations,
-         "Final fit: a fresh model trained on the chosen views for N iterations (0: none; preset's by default)")
-      ->check(wholeNumberAtLeast(0));
-  sub->add_flag("--no-plain-refit", a->no_plain_refit,
-                "Methods with their own training (sa-resgs, resgs): leave out the plain 3DGS refit of the chosen "
-                "views that judges selection apart from training (as long as the final fit itself)");
-  sub->add_flag("--final-residual", a->final_residual,
-                "Final fit with the paper's residual supervision whatever the method (the loop and its selection "
-                "unchanged); a plain 3DGS refit of the same views follows unless --no-plain-refit");
   sub->add_option("--memory-budget", a->memory_budget_gb,
                   "GB this run may use: refused before it starts if its images and initial models do not fit, the "
                   "models capped to fit (default: refused only beyond what the machine has available)")
       ->check(CLI::Range(0.001, 1e6));
-  sub->add_option("--max-gaussians", a->max_gaussians, "Cap on the model size (0: none; preset's by default)")
-      ->check(CLI::Range(0.0, 1e9));
-  sub->add_option("--residual-beta", a->beta, "Uncertain fraction of the residual subset (default 0.1)")
-      ->check(CLI::Range(0.0, 1.0));
-  sub->add_option("--residual-ranking", a->ranking,
-                  "Uncertainty ranking: both | opacity | scale | random (default both)")
-      ->check(CLI::IsMember({"both", "opacity", "scale", "random"}));
-  sub->add_flag("--residual-sub-only", a->sub_only, "Ablation: subset loss only, no full-render loss");
-  sub->add_flag("--continue-training", a->continue_training,
-                "Keep training the same model after each addition instead of resetting it");
-  sub->add_option("--fvs-metric", a->fvs_metric, "euclidean | great-circle")
-      ->check(CLI::IsMember({"euclidean", "great-circle"}))
-      ->capture_default_str();
-  sub->add_option("--fisher-lambda", a->fisher_lambda, "Fisher damping lambda (> 0)")
-      ->check(positiveNumber())
-      ->capture_default_str();
-  sub->add_option("--prefilter-set", a->prefilter.set, "frustum | visible")->capture_default_str();
-  sub->add_option("--prefilter-encoding", a->prefilter.encoding,
-                  "hash:auto (the smallest 2^K, K in 11..19, with load <= 0.5) | hash:K (11..19) | exact")
-      ->capture_default_str();
-  sub->add_option("--prefilter-scene", a->prefilter.scene,
-                  "indoor (5 SfM points per occupied voxel, grid 32) | outdoor (2, grid 64) | auto (a built-in scene's "
-                  "layout says; outdoor otherwise)")
-      ->check(CLI::IsMember({"auto", "indoor", "outdoor"}))
-      ->capture_default_str();
-  sub->add_option("--prefilter-score", a->prefilter.score, "xor | new")->capture_default_str();
-  sub->add_option("--prefilter-lifting", a->prefilter.lifting,
-                  "SA-Point lifting: flow (DIS + epipolar refinement) | depth (the trainer's rendered depth) | oracle "
-                  "(the dataset's ground-truth depth maps)")
-      ->capture_default_str();
-  sub->add_option("--prefilter-keep", a->prefilter_keep, "Fraction kept for Fisher (default 0.2)")
-      ->check(CLI::Range(0.0, 1.0));
-  sub->add_option("--hybrid-weight", a->hybrid_weight,
-                  "hybrid: share of the coverage evidence against Fisher's, in [0, 1] (default 0.5)")
-      ->check(CLI::Range(0.0, 1.0));
-  sub->add_option("--hybrid-fisher", a->hybrid_fisher, "hybrid: Fisher criterion combined, trace | logdet")
-      ->check(CLI::IsMember({"trace", "logdet"}))
-      ->capture_default_str();
-  sub->add_option(
-         "--hybrid-coverage", a->hybrid_coverage,
-         "hybrid: second evidence, surface (Embree-visible SfM surface no held view saw) | views (distance to the "
-         "nearest held camera) | facility (the facility-location gain over the train views, by the overlap of their "
-         "visible "
-         "surface)")
-      ->check(CLI::IsMember({"surface", "views", "facility"}))
-      ->capture_default_str();
-  sub->add_option("--path-variance-kappa", a->path_variance_kappa,
-                  "path-variance: each parameter group's damping, as a multiple of the median of its nonzero held "
-                  "information (0: --fisher-lambda alone; default 0.01)")
-      ->check(CLI::Range(0.0, 1e6));
-  sub->add_option(
-         "--gate-keep", a->gate_keep,
-         "kmedian-fisher, fvs-fisher, adaptive: fraction of the candidates, best by the gate's spread score (k-median "
-         "gain or distance to the nearest held view), that Fisher ranks (default 0.2)")
-      ->check(CLI::Range(0.0, 1.0));
-  sub->add_option(
-         "--adaptive-clustering", a->adaptive_clustering,
-         "adaptive: a capture whose clustering (the coefficient of variation of each train camera's distance to its "
-         "5th nearest; `saresgs info` prints it) exceeds this gets the k-median gate, any other the farthest-view gate "
-         "(default 0.7)")
-      ->check(CLI::Range(0.0, 1e6));
-  sub->add_flag("--time-exhaustive-fisher", a->time_exhaustive_fisher, "Also time Fisher over all candidates");
+  addSettingFlags(sub, a->settings);
   sub->add_option("--replay", a->replay,
                   "Fixed order: train with this method's training on the views of another run's results.json, in their "
                   "order, instead of selecting (the paper's ablation)");
   addRanged(sub, "--downscale", a->downscale, "Image downscale factor", 1, 64);
   sub->add_option("--background", a->background, kBackgroundHelp)->check(backgroundValue());
-  sub->add_option("--threads", a->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
   sub->add_flag("--resume", a->resume, "Continue the run in OUT from its checkpoint");
   return sub;
 }

@@ -51,25 +51,4 @@ ActiveOptions presetOptions(Preset p) {
   return o;
 }
 
-ActiveOptions activeOptionsFrom(const ActiveSettings& s) {
-  ActiveOptions o = presetOptions(parsePreset(s.preset));
-  o.method = s.method;
-  o.seed = s.seed;
-  o.trainer.raster.execution.threads = s.threads;
-  o.final_trainer.raster.execution.threads = s.threads;
-  if (s.max_views) o.max_views = *s.max_views;
-  if (s.interval) o.interval = *s.interval;
-  if (s.min_iterations) o.total_iterations = *s.min_iterations;
-  if (s.final_iterations) o.final_iterations = *s.final_iterations;
-  if (s.max_gaussians) o.trainer.densify.max_gaussians = o.final_trainer.densify.max_gaussians = *s.max_gaussians;
-  o.plain_refit = s.plain_refit;
-  o.final_residual = s.final_residual;
-  if (s.fisher_lambda) o.fisher_lambda = *s.fisher_lambda;
-  if (s.gate_keep) o.gate_keep = *s.gate_keep;
-  if (s.path_variance_kappa) o.path_variance_kappa = *s.path_variance_kappa;
-  if (s.adaptive_clustering) o.adaptive_clustering = *s.adaptive_clustering;
-  if (s.hybrid_weight) o.hybrid_weight = *s.hybrid_weight;
-  return o;
-}
-
 }  // namespace saresgs

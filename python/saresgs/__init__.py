@@ -31,6 +31,7 @@ from ._core import (  # noqa: F401,E402
     InputError,
     SelectionContext,
     Trainer,
+    active_settings,
     coverage,
     fisher_scores,
     fvs_scores,
@@ -46,6 +47,6 @@ from ._core import (  # noqa: F401,E402
 
 __all__ = [
     "ActiveRun", "Camera", "Dataset", "Gaussians", "InputError", "SelectionContext", "Trainer",
-    "coverage", "fisher_scores", "fvs_scores", "load_dataset", "loss_and_gradient", "make_scene",
+    "active_settings", "coverage", "fisher_scores", "fvs_scores", "load_dataset", "loss_and_gradient", "make_scene",
     "methods", "psnr", "render", "render_gradient", "ssim",
 ]

@@ -25,6 +25,34 @@ namespace {
 
 py::object jsonToPython(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
 
+// A keyword's value as JSON (what the settings table checks); numpy scalars count as the
+// Python numbers they hold.
+nlohmann::json pythonToJson(const py::object& v, const std::string& name) {
+  py::object plain = v;
+  if (py::hasattr(v, "item") && py::hasattr(v, "dtype")) plain = v.attr("item")();
+  try {
+    return nlohmann::json::parse(py::module_::import("json").attr("dumps")(plain).cast<std::string>());
+  } catch (const py::error_already_set&) {
+    throw py::type_error(name + ": expected a number, text, bool or None, got " +
+                         py::str(py::type::of(v).attr("__name__")).cast<std::string>());
+  }
+}
+
+// ActiveRun's docstring: its own arguments, then every setting of the table.
+const std::string& activeRunInitDoc() {
+  static const std::string doc = [] {
+    std::string d =
+        "ActiveRun(dataset, *, selector=None, checkpoint='', background=None, **settings). `selector` (a callable "
+        "taking a SelectionContext and returning a candidate, or (candidate, scores)) replaces the method's "
+        "selection (method 'custom'); `checkpoint` names a checkpoint file written after every added view and resumed "
+        "when present; background as load_dataset's (None: the dataset's own). The settings are `saresgs active`'s "
+        "flags with underscores (the preset's value where not given):\n";
+    for (const SettingField& f : activeSettingFields()) d += "  " + f.name + ": " + f.help + "\n";
+    return d;
+  }();
+  return doc;
+}
+
 void checkTrainViews(const Scene& s, const std::vector<int>& views, const char* what) {
   for (int v : views)
     if (std::find(s.train.begin(), s.train.end(), v) == s.train.end())
@@ -54,6 +82,7 @@ struct PySelectionContext {
 struct PyActiveRun {
   std::shared_ptr<Scene> dataset;
   std::string preset;
+  ActiveSettings settings;
   ActiveOptions opt;
   py::object selector = py::none(), progress = py::none();
   std::unique_ptr<ActiveRun> run;
@@ -108,7 +137,9 @@ struct PyActiveRun {
     const RunReport r = makeRunReport(
         *dataset, opt, *result,
         {dataset_path, preset, {}, run->trainer().gaussians().size(), rasterThreadCount(opt.trainer.raster.execution)});
-    return jsonToPython(toJson(r));
+    nlohmann::json j = toJson(r);
+    j["settings"] = activeSettingsJson(settings);
+    return jsonToPython(j);
   }
 };
 
@@ -116,6 +147,18 @@ struct PyActiveRun {
 
 void bindNbv(py::module_& m) {
   m.def("methods", &methodNames, "The built-in view-selection methods (`saresgs active --method`), plus custom.");
+  m.def(
+      "active_settings",
+      [] {
+        const nlohmann::json defaults = activeSettingsJson(ActiveSettings{});
+        py::list out;
+        for (const SettingField& f : activeSettingFields())
+          out.append(py::dict(py::arg("name") = f.name, py::arg("flag") = settingFlag(f), py::arg("help") = f.help,
+                              py::arg("default") = jsonToPython(defaults.at(f.name)), py::arg("choices") = f.choices));
+        return out;
+      },
+      "Every setting of an active run (ActiveRun's keywords, `saresgs active`'s flags, results.json's "
+      "\"settings\"): a list of {name, flag, help, default (None: the preset's), choices}.");
 
   m.def(
       "fisher_scores",
@@ -265,34 +308,26 @@ void bindNbv(py::module_& m) {
       "train_phase(), next_view(), add_view() and finish() step through it. `selector` (a callable "
       "taking a SelectionContext and returning a candidate, or (candidate, scores)) replaces the "
       "method's selection: the run is then method 'custom'.")
-      .def(py::init([](const std::shared_ptr<Scene>& dataset, const std::string& method, py::object selector,
-                       std::uint64_t seed, const std::string& preset, int threads, std::optional<int> max_views,
-                       std::optional<int> interval, std::optional<int> min_iterations,
-                       std::optional<int> final_iterations, std::optional<std::size_t> max_gaussians,
-                       const std::string& prefilter_scene, const std::string& checkpoint, bool plain_refit,
-                       bool final_residual, const py::object& background) {
+      .def(py::init([](const std::shared_ptr<Scene>& dataset, py::object selector, const std::string& checkpoint,
+                       const py::object& background, const py::kwargs& keywords) {
              auto r = std::make_unique<PyActiveRun>();
              r->dataset = withBackground(dataset, background);
-             r->preset = preset;
-             // The same settings as `saresgs active`'s, turned into options by the same function.
-             ActiveSettings settings;
-             settings.preset = preset;
-             settings.method = selector.is_none() ? parseMethod(method) : Method::kCustom;
-             settings.seed = seed;
-             settings.threads = threads;
-             settings.max_views = max_views;
-             settings.interval = interval;
-             settings.min_iterations = min_iterations;
-             settings.final_iterations = final_iterations;
-             settings.max_gaussians = max_gaussians;
-             settings.plain_refit = plain_refit;
-             settings.final_residual = final_residual;
+             // The same table of settings as `saresgs active`'s flags, turned into options by
+             // the same function (nbv/active_settings.h).
+             ActiveSettings& settings = r->settings;
+             for (const auto& [key, value] : keywords) {
+               const std::string name = py::str(key);
+               const SettingField* f = findActiveSetting(name);
+               if (!f)
+                 throw py::type_error("ActiveRun: unknown keyword '" + name +
+                                      "' (saresgs.active_settings() lists the settings)");
+               setActiveSetting(settings, *f, pythonToJson(py::reinterpret_borrow<py::object>(value), name),
+                                SettingNaming::kKeyword);
+             }
+             if (!selector.is_none()) settings.method = Method::kCustom;
+             r->preset = settings.preset;
              ActiveOptions& o = r->opt;
-             o = activeOptionsFrom(settings);
-             // As `saresgs active --prefilter-scene`: auto reads a `saresgs scene` manifest's layout.
-             PrefilterFlags flags;
-             flags.scene = prefilter_scene;
-             o.prefilter = parsePrefilterFlags(flags, o.prefilter, "prefilter_", dataset->source);
+             o = activeOptionsFrom(settings, dataset->source, SettingNaming::kKeyword);
              if (!selector.is_none()) {
                if (!PyCallable_Check(selector.ptr()))
                  throw py::type_error("selector: expected a callable(SelectionContext)");
@@ -306,15 +341,8 @@ void bindNbv(py::module_& m) {
              r->run = std::make_unique<ActiveRun>(*r->dataset, o, checkpoint);
              return r;
            }),
-           py::arg("dataset"), py::arg("method") = "adaptive", py::arg("selector") = py::none(), py::arg("seed") = 0,
-           py::arg("preset") = "quick", py::arg("threads") = 0, py::arg("max_views") = py::none(),
-           py::arg("interval") = py::none(), py::arg("min_iterations") = py::none(),
-           py::arg("final_iterations") = py::none(), py::arg("max_gaussians") = py::none(),
-           py::arg("prefilter_scene") = "auto", py::arg("checkpoint") = "", py::arg("plain_refit") = true,
-           py::arg("final_residual") = false, py::arg("background") = py::none(),
-           "Options as `saresgs active`'s (the preset's where not given); `checkpoint` names a checkpoint file "
-           "written after every added view and resumed when present; plain_refit=False is --no-plain-refit, "
-           "final_residual=True is --final-residual; background as load_dataset's (None: the dataset's own).")
+           py::arg("dataset"), py::kw_only(), py::arg("selector") = py::none(), py::arg("checkpoint") = "",
+           py::arg("background") = py::none(), activeRunInitDoc().c_str())
       .def_property_readonly("method", [](const PyActiveRun& r) { return std::string(toString(r.opt.method)); })
       .def_property_readonly(
           "held", [](const PyActiveRun& r) { return r.run->held(); }, "the views held, in order")

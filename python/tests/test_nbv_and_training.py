@@ -47,8 +47,9 @@ def test_python_random_selector_is_the_builtin_random_bit_for_bit(room, tmp_path
     # And the built-in one from Python is the command line's run.
     run_cli("active", "--dataset", room.source, "--method", "random", *SHORT_CLI, "--out", tmp_path / "cli")
     cli = json.loads((tmp_path / "cli" / "results.json").read_text())
-    for key in ("selected_view_indices", "psnr", "ssim", "final_fit", "background"):
+    for key in ("selected_view_indices", "psnr", "ssim", "final_fit", "background", "settings"):
         assert cli[key] == builtin[key], key
+    assert builtin["settings"]["max_views"] == 7 and builtin["settings"]["gate_keep"] is None
     # A room's manifest says it has no background; every view of the path is evaluated.
     assert builtin["background"] == {"color": None, "random": False, "from": "manifest: none"}
     assert len(builtin["final_fit"]["path"]) == len(room)
