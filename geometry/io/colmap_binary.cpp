@@ -16,10 +16,7 @@ namespace saresgs {
 
 namespace {
 
-using colmap_detail::checkCamera;
-using colmap_detail::checkImagePoints;
-using colmap_detail::checkPoint;
-using colmap_detail::checkPose;
+using namespace colmap_detail;  // the checks both readers share
 
 // Smallest size of one record, used to refuse counts that the file cannot hold
 // before anything is allocated for them.

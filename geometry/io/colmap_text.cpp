@@ -20,10 +20,7 @@ namespace saresgs {
 
 namespace {
 
-using colmap_detail::checkCamera;
-using colmap_detail::checkImagePoints;
-using colmap_detail::checkPoint;
-using colmap_detail::checkPose;
+using namespace colmap_detail;  // the checks both readers share
 
 constexpr std::string_view kSpace = " \t\r\v\f";
 

@@ -25,34 +25,12 @@ namespace {
 
 inline float fade(float t) { return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f); }
 
-// One of the 12 cube-edge directions, picked by the lattice hash, dotted with the offset.
+// One of the 12 cube-edge directions, picked by the lattice hash, dotted with the offset:
+// hash 0-3 gives +-x +-y, 4-7 +-x +-z, 8-11 +-y +-z (bit 0 flips the first, bit 1 the second).
 inline float grad(std::uint64_t h, float x, float y, float z) {
-  switch (h % 12) {
-    case 0:
-      return x + y;
-    case 1:
-      return -x + y;
-    case 2:
-      return x - y;
-    case 3:
-      return -x - y;
-    case 4:
-      return x + z;
-    case 5:
-      return -x + z;
-    case 6:
-      return x - z;
-    case 7:
-      return -x - z;
-    case 8:
-      return y + z;
-    case 9:
-      return -y + z;
-    case 10:
-      return y - z;
-    default:
-      return -y - z;
-  }
+  const std::uint64_t k = h % 12;
+  const float u = k < 8 ? x : y, v = k < 4 ? y : z;
+  return ((k & 1) ? -u : u) + ((k & 2) ? -v : v);
 }
 
 }  // namespace
