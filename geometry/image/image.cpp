@@ -3,14 +3,15 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cctype>
 #include <cstring>
 #include <filesystem>
 #include <optional>
 #include <stdexcept>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "geometry/error.h"
+#include "geometry/image/codecs.h"
 #include "geometry/image/png_decode.h"
 #include "geometry/io/atomic_file.h"
 
@@ -43,16 +44,14 @@ Image8 toByte(const ImageF& img) {
 
 namespace {
 
-// The file's bytes when it starts with PNG's signature (and is under 1 GiB); else none.
-std::optional<std::vector<std::uint8_t>> pngBytes(const std::string& path) {
+// The whole file (under 1 GiB); none when it cannot be read.
+std::optional<std::vector<std::uint8_t>> fileBytes(const std::string& path) {
   std::FILE* file = std::fopen(path.c_str(), "rb");
   if (!file) return std::nullopt;
   std::optional<std::vector<std::uint8_t>> out;
-  std::uint8_t head[8];
-  if (std::fread(head, 1, 8, file) == 8 && std::memcmp(head, kPngSignature, 8) == 0 &&
-      std::fseek(file, 0, SEEK_END) == 0) {
+  if (std::fseek(file, 0, SEEK_END) == 0) {
     const long size = std::ftell(file);
-    if (size >= 8 && size < (1L << 30) && std::fseek(file, 0, SEEK_SET) == 0) {
+    if (size >= 0 && size < (1L << 30) && std::fseek(file, 0, SEEK_SET) == 0) {
       std::vector<std::uint8_t> bytes(static_cast<std::size_t>(size));
       if (std::fread(bytes.data(), 1, bytes.size(), file) == bytes.size()) out = std::move(bytes);
     }
@@ -65,22 +64,23 @@ std::optional<std::vector<std::uint8_t>> pngBytes(const std::string& path) {
 
 Image8 readImage(const std::string& path, bool keep_alpha) {
   if (!std::filesystem::exists(path)) throw InputError(path, "file", "image does not exist");
-  // Plain 8-bit RGB(A) PNGs, most datasets' images, by the fast path (png_decode.h); the
-  // rest, and any file it declines, by OpenCV.
-  if (const auto bytes = pngBytes(path))
-    if (auto img = decodePlainPng(*bytes, keep_alpha)) return std::move(*img);
-  cv::Mat m = cv::imread(path, keep_alpha ? cv::IMREAD_UNCHANGED : cv::IMREAD_COLOR);
-  if (m.empty()) throw InputError(path, "file", "not a readable PNG/JPEG image");
-  if (m.depth() == CV_16U) m.convertTo(m, CV_8U, 1.0 / 257.0);
-  if (m.depth() != CV_8U) throw InputError(path, "pixel type", "expected 8 or 16-bit channels");
-  // Converted straight into the returned image's storage (one allocation fewer and no copy:
-  // fresh pages cost a fault each).
-  Image8 out(m.cols, m.rows, m.channels() == 4 ? 4 : 3);
-  cv::Mat dst(out.height, out.width, CV_8UC(out.channels), out.data.data());
-  const int code = m.channels() == 1 ? cv::COLOR_GRAY2RGB : m.channels() == 4 ? cv::COLOR_BGRA2RGBA : cv::COLOR_BGR2RGB;
-  cv::cvtColor(m, dst, code);
-  if (dst.data != out.data.data()) throw std::logic_error("readImage: OpenCV reallocated the destination");
-  return out;
+  const auto bytes = fileBytes(path);
+  if (!bytes) throw InputError(path, "file", "cannot be read (or is 1 GiB or more)");
+  const std::span<const std::uint8_t> b(*bytes);
+  std::string why;
+  if (b.size() >= 8 && std::memcmp(b.data(), kPngSignature, 8) == 0) {
+    // Plain 8-bit RGB(A) PNGs, most datasets' images, by the fast path (png_decode.h); the
+    // rest, and any file it declines, by libpng.
+    if (auto img = decodePlainPng(b, keep_alpha)) return std::move(*img);
+    if (auto img = decodePng(b, keep_alpha, &why)) return std::move(*img);
+  } else if (b.size() >= 3 && b[0] == 0xff && b[1] == 0xd8 && b[2] == 0xff) {
+    // A dataset's images (read with alpha) are taken as stored, as COLMAP takes them;
+    // without alpha, as EXIF says to show them (what OpenCV did for both).
+    if (auto img = decodeJpeg(b, /*exif_orientation=*/!keep_alpha, &why)) return std::move(*img);
+  } else {
+    why = "neither PNG nor JPEG";
+  }
+  throw InputError(path, "file", "not a readable PNG/JPEG image (" + why + ")");
 }
 
 bool imageHasAlpha(const std::string& path) {
@@ -134,25 +134,13 @@ bool imageHasTransparency(const std::string& path) {
 }
 
 std::vector<std::uint8_t> encodeImage(const Image8& img, const std::string& ext, int jpeg_quality) {
-  const int type = CV_8UC(img.channels);
-  cv::Mat m(img.height, img.width, type, const_cast<std::uint8_t*>(img.data.data()));
-  cv::Mat bgr;
-  if (img.channels == 3)
-    cv::cvtColor(m, bgr, cv::COLOR_RGB2BGR);
-  else if (img.channels == 4)
-    cv::cvtColor(m, bgr, cv::COLOR_RGBA2BGRA);
-  else
-    bgr = m;
-  std::vector<std::uint8_t> bytes;
-  bool encoded = false;
-  const std::vector<int> params = {cv::IMWRITE_JPEG_QUALITY, std::clamp(jpeg_quality, 0, 100)};
-  try {
-    encoded = cv::imencode(ext, bgr, bytes, params);
-  } catch (const cv::Exception&) {
-    encoded = false;  // OpenCV throws for an extension it has no encoder for
-  }
-  if (!encoded) throw InputError(ext, "extension", "expected .png or .jpg to encode the image");
-  return bytes;
+  std::string e = ext;
+  for (char& c : e) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (img.channels != 1 && img.channels != 3 && img.channels != 4)
+    throw std::invalid_argument("encodeImage: expected 1, 3 or 4 channels");
+  if (e == ".png") return encodePng(img);
+  if (e == ".jpg" || e == ".jpeg") return encodeJpeg(img, std::clamp(jpeg_quality, 0, 100));
+  throw InputError(ext, "extension", "expected .png or .jpg to encode the image");
 }
 
 void writeImage(const std::string& path, const Image8& img) {
