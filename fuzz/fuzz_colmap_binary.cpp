@@ -4,18 +4,11 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "fuzz/fuzz_support.h"
-#include "geometry/io/colmap.h"
-#include "geometry/scene/colmap_convert.h"
+#include "fuzz/fuzz_colmap.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  using namespace saresgs;
-  static const std::string dir = fuzz::scratchPath("colmap_binary/model");
-  fuzz::writeParts(dir, {"cameras.bin", "images.bin", "points3D.bin"}, fuzz::splitFiles(data, size));
-  fuzz::check([&] {
-    const ColmapModel model = readColmapBinary(dir);
-    validateColmapModel(model, dir);
-    for (const auto& [id, cam] : model.cameras) (void)intrinsicsFromColmap(cam, dir + "/cameras.bin");
-  });
+  static const std::string dir = saresgs::fuzz::scratchPath("colmap_binary/model");
+  saresgs::fuzz::checkColmapModel(dir, {"cameras.bin", "images.bin", "points3D.bin"}, saresgs::readColmapBinary, data,
+                                  size);
   return 0;
 }

@@ -4,18 +4,11 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "fuzz/fuzz_support.h"
-#include "geometry/io/colmap.h"
-#include "geometry/scene/colmap_convert.h"
+#include "fuzz/fuzz_colmap.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  using namespace saresgs;
-  static const std::string dir = fuzz::scratchPath("colmap_text/model");
-  fuzz::writeParts(dir, {"cameras.txt", "images.txt", "points3D.txt"}, fuzz::splitFiles(data, size));
-  fuzz::check([&] {
-    const ColmapModel model = readColmapText(dir);
-    validateColmapModel(model, dir);
-    for (const auto& [id, cam] : model.cameras) (void)intrinsicsFromColmap(cam, dir + "/cameras.txt");
-  });
+  static const std::string dir = saresgs::fuzz::scratchPath("colmap_text/model");
+  saresgs::fuzz::checkColmapModel(dir, {"cameras.txt", "images.txt", "points3D.txt"}, saresgs::readColmapText, data,
+                                  size);
   return 0;
 }

@@ -6,7 +6,9 @@
 #include "fuzz/fuzz_support.h"
 #include "geometry/image/image.h"
 #include "geometry/synth/write_dataset.h"
+#include "tests/common/ring_run.h"
 #include "tests/common/ring_scene.h"
+#include "tests/common/synthetic_options.h"
 
 namespace saresgs::fuzz {
 
@@ -46,27 +48,16 @@ TrainerOptions tinyTrainer() {
 }
 
 ActiveOptions tinyActive() {
-  ActiveOptions o;
-  o.method = Method::kRandom;
-  o.initial_views = 2;
-  o.max_views = 4;
-  o.interval = 1;
-  o.total_iterations = 8;
+  // The run whose checkpoints the tests replay, with no progress or final evaluation.
+  ActiveOptions o = test::ringRunOptions();
   o.progress_test_views = 0;
   o.final_iterations = 0;
   o.trainer = tinyTrainer();
-  o.seed = 5;
   return o;
 }
 
 SyntheticOptions tinySyntheticOptions() {
-  SyntheticOptions o;
-  o.layout = "object";
-  o.width = 16;
-  o.height = 12;
-  o.num_views = 4;
-  o.seed = 1;
-  return o;
+  return test::syntheticOptions("object", 16, 12, /*seed=*/1, /*num_views=*/4);
 }
 
 const std::string& tinyDataset() {

@@ -6,9 +6,7 @@
 #include "geometry/io/pfm.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  using namespace saresgs;
-  static const std::string path = fuzz::scratchPath("pfm/depth.pfm");
-  fuzz::writeBytes(path, {reinterpret_cast<const char*>(data), size});
-  fuzz::check([&] { (void)readPfm(path); });
+  static const std::string path = saresgs::fuzz::scratchPath("pfm/depth.pfm");
+  saresgs::fuzz::checkFile(path, data, size, [](const std::string& p) { (void)saresgs::readPfm(p); });
   return 0;
 }

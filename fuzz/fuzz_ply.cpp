@@ -6,9 +6,7 @@
 #include "splat/ply.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  using namespace saresgs;
-  static const std::string path = fuzz::scratchPath("ply/point_cloud.ply");
-  fuzz::writeBytes(path, {reinterpret_cast<const char*>(data), size});
-  fuzz::check([&] { (void)readGaussiansPly(path); });
+  static const std::string path = saresgs::fuzz::scratchPath("ply/point_cloud.ply");
+  saresgs::fuzz::checkFile(path, data, size, [](const std::string& p) { (void)saresgs::readGaussiansPly(p); });
   return 0;
 }

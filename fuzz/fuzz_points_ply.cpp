@@ -7,9 +7,7 @@
 #include "geometry/io/point_ply.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  using namespace saresgs;
-  static const std::string path = fuzz::scratchPath("points_ply/points3d.ply");
-  fuzz::writeBytes(path, {reinterpret_cast<const char*>(data), size});
-  fuzz::check([&] { (void)readPointsPly(path); });
+  static const std::string path = saresgs::fuzz::scratchPath("points_ply/points3d.ply");
+  saresgs::fuzz::checkFile(path, data, size, [](const std::string& p) { (void)saresgs::readPointsPly(p); });
   return 0;
 }

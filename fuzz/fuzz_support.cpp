@@ -132,4 +132,10 @@ void check(const std::function<void()>& read) {
   }
 }
 
+void checkFile(const std::string& path, const std::uint8_t* data, std::size_t size,
+               const std::function<void(const std::string& path)>& read) {
+  writeBytes(path, {reinterpret_cast<const char*>(data), size});
+  check([&] { read(path); });
+}
+
 }  // namespace saresgs::fuzz

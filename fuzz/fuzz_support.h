@@ -36,5 +36,9 @@ void writeParts(const std::string& dir, const std::vector<std::string>& names,
 // Runs `read` on one input under the contract above. With SARESGS_FUZZ_EXPECT_VALID=1
 // in the environment a refusal aborts too: the seed check of the test command.
 void check(const std::function<void()>& read);
+// The whole of a target that reads one file: writes the input (data, size) to `path` and
+// runs `read` on that file under check().
+void checkFile(const std::string& path, const std::uint8_t* data, std::size_t size,
+               const std::function<void(const std::string& path)>& read);
 
 }  // namespace saresgs::fuzz

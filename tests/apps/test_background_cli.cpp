@@ -20,14 +20,12 @@
 #include "geometry/scene/colmap_convert.h"
 #include "geometry/scene/scene.h"
 
+using saresgs::test::runCli;
 using saresgs::test::TempDir;
 namespace fs = std::filesystem;
 using nlohmann::json;
 
 namespace {
-
-using Result = saresgs::test::CommandResult;
-Result run(const std::string& args) { return saresgs::test::runCommand(std::string(SARESGS_CLI) + " " + args); }
 
 json resultsOf(const std::string& dir) { return saresgs::readJsonFile(dir + "/results.json"); }
 
@@ -126,7 +124,8 @@ void toColmap(const std::string& blender, const std::string& out) {
 
 TEST(BackgroundCli, AnObjectWrittenFourWaysTrainsToTheSamePsnr) {
   TempDir d;
-  Result r = run("scene --layout object --views 40 --width 96 --height 72 --format blender --out " + d.file("blender"));
+  auto r =
+      runCli("scene --layout object --views 40 --width 96 --height 72 --format blender --out " + d.file("blender"));
   ASSERT_EQ(r.code, 0) << r.output;
   toNerfstudio(d.file("blender"), d.file("ns_rgba"), /*jpeg=*/false);
   toNerfstudio(d.file("blender"), d.file("ns_jpeg"), /*jpeg=*/true);
@@ -145,15 +144,15 @@ TEST(BackgroundCli, AnObjectWrittenFourWaysTrainsToTheSamePsnr) {
                         {"colmap_rgba", "", "alpha in the images, none said (white)", true}};
   std::map<std::string, double> psnr;
   for (const Case& c : cases) {
-    r = run("info --dataset " + d.file(c.folder) + " " + c.option);
+    r = runCli("info --dataset " + d.file(c.folder) + " " + c.option);
     ASSERT_EQ(r.code, 0) << r.output;
     EXPECT_NE(r.output.find("background: white (" + std::string(c.from) + ")"), std::string::npos)
         << c.folder << r.output;
     EXPECT_EQ(r.output.find("the images have alpha but nothing says") != std::string::npos, c.warns)
         << c.folder << r.output;
     const std::string out = d.file(std::string("t_") + c.folder);
-    r = run("train --dataset " + d.file(c.folder) + " " + c.option + " --iterations 300 --seed 0 --threads 1 --out " +
-            out);
+    r = runCli("train --dataset " + d.file(c.folder) + " " + c.option +
+               " --iterations 300 --seed 0 --threads 1 --out " + out);
     ASSERT_EQ(r.code, 0) << r.output;
     const json j = resultsOf(out);
     EXPECT_EQ(j["background"]["color"], json::array({1.0, 1.0, 1.0})) << c.folder;
@@ -170,8 +169,8 @@ TEST(BackgroundCli, AnObjectWrittenFourWaysTrainsToTheSamePsnr) {
 
   // The bug this guards: the RGBA folder trained on black against targets on white. Said
   // black, the targets are composited on black too, and the run trains as well.
-  r = run("train --dataset " + d.file("ns_rgba") + " --background black --iterations 300 --seed 0 --threads 1 --out " +
-          d.file("t_black"));
+  r = runCli("train --dataset " + d.file("ns_rgba") +
+             " --background black --iterations 300 --seed 0 --threads 1 --out " + d.file("t_black"));
   ASSERT_EQ(r.code, 0) << r.output;
   const json black = resultsOf(d.file("t_black"));
   EXPECT_EQ(black["background"]["color"], json::array({0.0, 0.0, 0.0}));
@@ -180,17 +179,18 @@ TEST(BackgroundCli, AnObjectWrittenFourWaysTrainsToTheSamePsnr) {
 
 TEST(BackgroundCli, RandomBackgroundTrainsAnRgbaObjectNearlyAsWellAsWhite) {
   TempDir d;
-  Result r = run("scene --layout object --views 40 --width 96 --height 72 --format blender --out " + d.file("blender"));
+  auto r =
+      runCli("scene --layout object --views 40 --width 96 --height 72 --format blender --out " + d.file("blender"));
   ASSERT_EQ(r.code, 0) << r.output;
-  r = run("info --dataset " + d.file("blender") + " --background random");
+  r = runCli("info --dataset " + d.file("blender") + " --background random");
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("background: random per training step, evaluated on white (--background)"), std::string::npos)
       << r.output;
   std::map<std::string, json> res;
   for (const char* bg : {"white", "random"}) {
     const std::string out = d.file(std::string("t_") + bg);
-    r = run("train --dataset " + d.file("blender") + " --background " + bg +
-            " --iterations 300 --seed 0 --threads 1 --out " + out);
+    r = runCli("train --dataset " + d.file("blender") + " --background " + bg +
+               " --iterations 300 --seed 0 --threads 1 --out " + out);
     ASSERT_EQ(r.code, 0) << r.output;
     res[bg] = resultsOf(out);
   }
@@ -208,8 +208,8 @@ TEST(BackgroundCli, ABadBackgroundIsRefusedNamingTheOption) {
   TempDir d;
   for (const char* bad : {"purple", "1,1", "0.5,0.5,2", "0.5,,0.5", "nan,0,0", "1,1,1,1"}) {
     for (const char* cmd : {"train --iterations 1 --out ", "active --out "}) {
-      const Result r =
-          run(std::string(cmd) + d.file("o") + " --dataset " + d.file("none") + " --background '" + bad + "'");
+      const auto r =
+          runCli(std::string(cmd) + d.file("o") + " --dataset " + d.file("none") + " --background '" + bad + "'");
       EXPECT_NE(r.code, 0) << bad;
       EXPECT_NE(r.output.find("--background"), std::string::npos) << cmd << bad << ": " << r.output;
       EXPECT_NE(r.output.find("expected white, black, random, or R,G,B"), std::string::npos)

@@ -9,11 +9,11 @@
 #include "common/run_command.h"
 #include "common/test_support.h"
 
+using saresgs::test::runCli;
+
 namespace {
 
 using Result = saresgs::test::CommandResult;
-
-Result run(const std::string& args) { return saresgs::test::runCommand(std::string(SARESGS_CLI) + " " + args); }
 
 // A benchmark's whole output is one JSON line: parsed into j.
 ::testing::AssertionResult oneJsonLine(const Result& r, nlohmann::json& j) {
@@ -31,14 +31,11 @@ Result run(const std::string& args) { return saresgs::test::runCommand(std::stri
 }  // namespace
 
 TEST(BenchCli, OccupancyPrintsOneJsonLineWithTheMeasuredParts) {
-  const Result r = run("bench occupancy --width 32 --height 24 --points 400 --resolution 16 --threads 1");
-  ASSERT_EQ(r.code, 0) << r.output;
   // One line, nothing else (stdout and stderr together).
-  ASSERT_FALSE(r.output.empty());
-  EXPECT_EQ(r.output.find('\n'), r.output.size() - 1) << r.output;
   nlohmann::json j;
-  ASSERT_NO_THROW(j = nlohmann::json::parse(r.output)) << r.output;
-  ASSERT_TRUE(j.is_object()) << r.output;
+  ASSERT_TRUE(
+      oneJsonLine(runCli("bench occupancy --width 32 --height 24 --points 400 --resolution 16 --threads 1"), j));
+  ASSERT_TRUE(j.is_object()) << j;
 
   EXPECT_EQ(j.at("benchmark"), "occupancy");
   EXPECT_EQ(j.at("width"), 32);
@@ -75,22 +72,19 @@ TEST(BenchCli, OccupancyPrintsOneJsonLineWithTheMeasuredParts) {
 }
 
 TEST(BenchCli, OccupancyRejectsABadOptionValueByName) {
-  Result r = run("bench occupancy --resolution 0");
+  Result r = runCli("bench occupancy --resolution 0");
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.output.find("--resolution"), std::string::npos) << r.output;
 
-  r = run("bench occupancy --points many");
+  r = runCli("bench occupancy --points many");
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.output.find("--points"), std::string::npos) << r.output;
 }
 
 TEST(BenchCli, FisherPrintsOneJsonLineWithTheRatioToTheBackwardPass) {
-  const Result r = run("bench fisher --width 40 --height 32 --gaussians 300 --threads 1 --steps 3 --warmup 1");
-  ASSERT_EQ(r.code, 0) << r.output;
-  ASSERT_FALSE(r.output.empty());
-  EXPECT_EQ(r.output.find('\n'), r.output.size() - 1) << r.output;
   nlohmann::json j;
-  ASSERT_NO_THROW(j = nlohmann::json::parse(r.output)) << r.output;
+  ASSERT_TRUE(
+      oneJsonLine(runCli("bench fisher --width 40 --height 32 --gaussians 300 --threads 1 --steps 3 --warmup 1"), j));
   EXPECT_EQ(j.at("benchmark"), "fisher");
   EXPECT_EQ(j.at("width"), 40);
   EXPECT_EQ(j.at("gaussians"), 300);
@@ -114,7 +108,7 @@ TEST(BenchCli, FisherKernelsFromTheEnvironment) {
   nlohmann::json base, by_default;
   ASSERT_TRUE(oneJsonLine(withIsa("baseline"), base));
   EXPECT_EQ(base.at("kernels"), "baseline");
-  ASSERT_TRUE(oneJsonLine(run(args), by_default));
+  ASSERT_TRUE(oneJsonLine(runCli(args), by_default));
   const std::string best = by_default.at("kernels");
   if (best != "baseline") {
     nlohmann::json avx2;
@@ -134,7 +128,7 @@ TEST(BenchCli, FisherKernelsFromTheEnvironment) {
 TEST(BenchCli, StepReportsAllocationsPageFaultsAndTheFloor) {
   nlohmann::json j;
   ASSERT_TRUE(
-      oneJsonLine(run("bench step --width 40 --height 32 --gaussians 300 --threads 1 --steps 3 --warmup 1"), j));
+      oneJsonLine(runCli("bench step --width 40 --height 32 --gaussians 300 --threads 1 --steps 3 --warmup 1"), j));
   EXPECT_GE(j.at("allocations_per_step").get<double>(), 0.0);
   EXPECT_GE(j.at("page_faults_per_step").get<double>(), 0.0);
   // Pairs are the contributors of every pixel; the floor is a positive time per pair and
@@ -152,7 +146,7 @@ TEST(BenchCli, StepReportsAllocationsPageFaultsAndTheFloor) {
 TEST(BenchCli, TrainTimesRealIterationsByStageBesideTheSameSizeStep) {
   saresgs::test::TempDir d;
   const std::string data = d.file("tiny");
-  Result r = run("scene --layout object --views 12 --width 48 --height 32 --out " + data);
+  Result r = runCli("scene --layout object --views 12 --width 48 --height 32 --out " + data);
   ASSERT_EQ(r.code, 0) << r.output;
   r = saresgs::test::runCommand(std::string(SARESGS_CLI) + " bench train --dataset " + data +
                                 " --iterations 6 --warmup 2 --compare-steps 2 --threads 1 2>/dev/null");
@@ -195,7 +189,7 @@ TEST(BenchCli, TrainTimesRealIterationsByStageBesideTheSameSizeStep) {
   EXPECT_NEAR(j.at("residual_to_plain_ratio").get<double>(),
               j["mean_iteration_ms"].get<double>() / p["mean_iteration_ms"].get<double>(), 1e-9);
 
-  r = run("bench train --dataset " + d.file("missing") + " --iterations 2");
+  r = runCli("bench train --dataset " + d.file("missing") + " --iterations 2");
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.output.find("missing"), std::string::npos) << r.output;
 }

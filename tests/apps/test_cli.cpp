@@ -11,6 +11,7 @@
 #include "geometry/scene/scene.h"
 #include "nbv/method.h"
 
+using saresgs::test::runCli;
 using saresgs::test::TempDir;
 namespace fs = std::filesystem;
 
@@ -18,17 +19,15 @@ namespace {
 
 using Result = saresgs::test::CommandResult;
 
-Result run(const std::string& args) { return saresgs::test::runCommand(std::string(SARESGS_CLI) + " " + args); }
-
 }  // namespace
 
 TEST(Cli, SceneWritesADatasetThatInfoReads) {
   TempDir d;
-  const Result r = run("scene --layout room360 --views 16 --width 64 --height 48 --out " + d.file("s"));
+  const Result r = runCli("scene --layout room360 --views 16 --width 64 --height 48 --out " + d.file("s"));
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("16 views"), std::string::npos) << r.output;
   EXPECT_TRUE(fs::exists(d.path() / "s" / "contact_sheet.png"));
-  const Result i = run("info --dataset " + d.file("s"));
+  const Result i = runCli("info --dataset " + d.file("s"));
   ASSERT_EQ(i.code, 0) << i.output;
   EXPECT_NE(i.output.find("16 with ground-truth depth"), std::string::npos) << i.output;
   // The summary's numbers are the library's.
@@ -38,25 +37,25 @@ TEST(Cli, SceneWritesADatasetThatInfoReads) {
 
 TEST(Cli, BadInputGivesAClearErrorAndNonZeroExit) {
   TempDir d;
-  Result r = run("info --dataset " + d.file("missing"));
+  Result r = runCli("info --dataset " + d.file("missing"));
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.output.find(d.file("missing")), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("does not exist"), std::string::npos) << r.output;
 
-  r = run("scene --layout nowhere --out " + d.file("x"));
+  r = runCli("scene --layout nowhere --out " + d.file("x"));
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.output.find("--layout"), std::string::npos) << r.output;
 
-  r = run("scene --layout object --mesh " + d.file("no_such.off") + " --out " + d.file("x"));
+  r = runCli("scene --layout object --mesh " + d.file("no_such.off") + " --out " + d.file("x"));
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.output.find("no_such.off"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(d.path() / "x"));  // nothing half-written in place
 
-  r = run("");
+  r = runCli("");
   EXPECT_NE(r.code, 0);
 
   // An unknown subcommand is named, with the choices.
-  r = run("nosuch");
+  r = runCli("nosuch");
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.output.find("unknown subcommand 'nosuch'"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("active"), std::string::npos) << r.output;
@@ -73,14 +72,14 @@ TEST(Cli, BadInputGivesAClearErrorAndNonZeroExit) {
            {"active --dataset " + d.file("missing") + " --fisher-lambda -1 --out " + d.file("a"), "--fisher-lambda"},
            {"active --dataset " + d.file("missing") + " --max-views 0 --out " + d.file("a"), "--max-views"},
            {"active --dataset " + d.file("missing") + " --seed 12abc --out " + d.file("a"), "--seed"}}) {
-    r = run(args);
+    r = runCli(args);
     EXPECT_NE(r.code, 0) << args;
     EXPECT_NE(r.output.find(option), std::string::npos) << args << ": " << r.output;
   }
   EXPECT_FALSE(fs::exists(d.path() / "v"));
 
   // A benchmark too large for the machine is refused up front, naming the limit.
-  r = run("bench step --width 16384 --height 16384 --gaussians 100000000");
+  r = runCli("bench step --width 16384 --height 16384 --gaussians 100000000");
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.output.find("--gaussians"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("half this machine's memory"), std::string::npos) << r.output;
@@ -90,9 +89,9 @@ TEST(Cli, BadInputGivesAClearErrorAndNonZeroExit) {
 // consumers (our .ply reader, the JSON), then coverage and an active run on it.
 TEST(Cli, TrainCoverageAndActiveOnASmallScene) {
   TempDir d;
-  ASSERT_EQ(run("scene --layout object --views 12 --width 64 --height 48 --out " + d.file("s")).code, 0);
+  ASSERT_EQ(runCli("scene --layout object --views 12 --width 64 --height 48 --out " + d.file("s")).code, 0);
 
-  Result r = run("train --dataset " + d.file("s") + " --iterations 60 --sh-degree 1 --out " + d.file("t"));
+  Result r = runCli("train --dataset " + d.file("s") + " --iterations 60 --sh-degree 1 --out " + d.file("t"));
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("PSNR"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("[train]"), std::string::npos) << r.output;  // progress on stderr
@@ -102,19 +101,19 @@ TEST(Cli, TrainCoverageAndActiveOnASmallScene) {
   EXPECT_TRUE(fs::exists(d.path() / "t" / "test_renders" / "all.png"));
   ASSERT_TRUE(fs::exists(d.path() / "t" / "point_cloud.ply"));
 
-  r = run("coverage --dataset " + d.file("s") +
-          " --views 0,3 --set visible --encoding exact --score new --resolution 32 --out " + d.file("c"));
+  r = runCli("coverage --dataset " + d.file("s") +
+             " --views 0,3 --set visible --encoding exact --score new --resolution 32 --out " + d.file("c"));
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("observed"), std::string::npos) << r.output;
   for (const char* f : {"coverage.json", "coverage.csv", "coverage.png"})
     EXPECT_TRUE(fs::exists(d.path() / "c" / f)) << f;
   // The trained model renders the extrapolated views just as well (datasets without truth).
-  r = run("coverage --dataset " + d.file("s") + " --views 0,3 --model " + d.file("t/point_cloud.ply") +
-          " --resolution 32 --out " + d.file("c2"));
+  r = runCli("coverage --dataset " + d.file("s") + " --views 0,3 --model " + d.file("t/point_cloud.ply") +
+             " --resolution 32 --out " + d.file("c2"));
   ASSERT_EQ(r.code, 0) << r.output;
 
-  r = run("active --dataset " + d.file("s") +
-          " --method fvs --max-views 5 --interval 4 --min-iterations 40 --final-iterations 0 --out " + d.file("a"));
+  r = runCli("active --dataset " + d.file("s") +
+             " --method fvs --max-views 5 --interval 4 --min-iterations 40 --final-iterations 0 --out " + d.file("a"));
   ASSERT_EQ(r.code, 0) << r.output;
   const std::string ar = saresgs::test::readBytes(d.file("a/results.json"));
   for (const char* key : {"\"psnr\"", "\"ssim\"", "\"ause\"", "\"selected_views\"", "\"seconds\""})
@@ -139,12 +138,12 @@ TEST(Cli, TrainCoverageAndActiveOnASmallScene) {
   }
   EXPECT_NE(r.output.find("peak resident memory"), std::string::npos) << r.output;
   // Running again into the same folder without --resume is refused (nothing overwritten).
-  r = run("active --dataset " + d.file("s") +
-          " --method fvs --max-views 5 --interval 4 --min-iterations 40 --final-iterations 0 --out " + d.file("a"));
+  r = runCli("active --dataset " + d.file("s") +
+             " --method fvs --max-views 5 --interval 4 --min-iterations 40 --final-iterations 0 --out " + d.file("a"));
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.output.find("--resume"), std::string::npos) << r.output;
 
-  r = run("coverage --dataset " + d.file("s") + " --views 0,99 --out " + d.file("c3"));
+  r = runCli("coverage --dataset " + d.file("s") + " --views 0,99 --out " + d.file("c3"));
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.output.find("--views"), std::string::npos) << r.output;
 }
@@ -156,15 +155,15 @@ TEST(Cli, ActiveAcceptsEveryMethodOfTheList) {
   TempDir d;
   for (saresgs::Method m : saresgs::allMethods()) {
     const std::string name = saresgs::toString(m);
-    const Result r = run("active --method " + name + " --dataset " + d.file("missing") + " --out " + d.file("o"));
+    const Result r = runCli("active --method " + name + " --dataset " + d.file("missing") + " --out " + d.file("o"));
     EXPECT_NE(r.code, 0) << name;
     EXPECT_NE(r.output.find(d.file("missing")), std::string::npos) << name << ": " << r.output;
     EXPECT_EQ(r.output.find("--method"), std::string::npos) << name << ": " << r.output;
   }
-  const Result bad = run("active --method clairvoyant --dataset " + d.file("missing") + " --out " + d.file("o"));
+  const Result bad = runCli("active --method clairvoyant --dataset " + d.file("missing") + " --out " + d.file("o"));
   EXPECT_NE(bad.code, 0);
   EXPECT_NE(bad.output.find("--method"), std::string::npos) << bad.output;
-  const Result help = run("active --help");
+  const Result help = runCli("active --help");
   EXPECT_NE(help.output.find(saresgs::methodChoices()), std::string::npos) << help.output;
 }
 
@@ -176,13 +175,13 @@ TEST(Cli, ActiveAcceptsEveryMethodOfTheList) {
 // train` without --residual, byte for byte too.
 TEST(Cli, FinalFitEqualsTrainOnTheChosenViews) {
   TempDir d;
-  ASSERT_EQ(run("scene --layout object --views 12 --width 64 --height 48 --out " + d.file("s")).code, 0);
+  ASSERT_EQ(runCli("scene --layout object --views 12 --width 64 --height 48 --out " + d.file("s")).code, 0);
   // One short active run of `method` (and `flags`) into OUT, and `saresgs train` on exactly
   // a run's views (initial, then selected) with its final fit's options.
   auto active = [&](const std::string& method, const std::string& flags, const std::string& out) {
-    return run("active --dataset " + d.file("s") + " --method " + method +
-               " --max-views 5 --interval 4 --min-iterations 40 --final-iterations 150 --seed 3 --threads 2 " + flags +
-               "--out " + d.file(out));
+    return runCli("active --dataset " + d.file("s") + " --method " + method +
+                  " --max-views 5 --interval 4 --min-iterations 40 --final-iterations 150 --seed 3 --threads 2 " +
+                  flags + "--out " + d.file(out));
   };
   auto trainOn = [&](const nlohmann::json& of_run) {
     std::string views;
@@ -203,7 +202,7 @@ TEST(Cli, FinalFitEqualsTrainOnTheChosenViews) {
   const std::string train = trainOn(a);
   for (const bool residual : {true, false}) {
     const std::string out = d.file(residual ? "tr" : "tp");
-    r = run(train + (residual ? "--residual " : "") + "--out " + out);
+    r = runCli(train + (residual ? "--residual " : "") + "--out " + out);
     ASSERT_EQ(r.code, 0) << r.output;
     const nlohmann::json t = nlohmann::json::parse(saresgs::test::readBytes(out + "/results.json"));
     const nlohmann::json& fit = a[residual ? "final_fit" : "final_fit_views"];
@@ -232,7 +231,7 @@ TEST(Cli, FinalFitEqualsTrainOnTheChosenViews) {
   EXPECT_EQ(fr["psnr"], f["psnr"]);
   EXPECT_EQ(fr["final_fit"]["residual"], true);
   EXPECT_EQ(fr["final_fit_views"], f["final_fit"]);
-  r = run(trainOn(f) + "--residual --out " + d.file("ftr"));
+  r = runCli(trainOn(f) + "--residual --out " + d.file("ftr"));
   ASSERT_EQ(r.code, 0) << r.output;
   const nlohmann::json ftr = nlohmann::json::parse(saresgs::test::readBytes(d.file("ftr/results.json")));
   EXPECT_EQ(ftr["psnr"].get<double>(), fr["final_fit"]["psnr"].get<double>());
@@ -251,7 +250,7 @@ TEST(Cli, FinalFitEqualsTrainOnTheChosenViews) {
   EXPECT_EQ(saresgs::test::readBytes(d.file("n/final_fit.ply")), saresgs::test::readBytes(d.file("a/final_fit.ply")));
   EXPECT_FALSE(std::filesystem::exists(d.file("n/final_fit_views.ply")));
   // A view listed twice, or not a train view, is refused by name.
-  r = run("train --dataset " + d.file("s") + " --views 0,0 --iterations 5 --out " + d.file("t2"));
+  r = runCli("train --dataset " + d.file("s") + " --views 0,0 --iterations 5 --out " + d.file("t2"));
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.output.find("--views"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("twice"), std::string::npos) << r.output;
@@ -263,7 +262,7 @@ TEST(Cli, FinalFitEqualsTrainOnTheChosenViews) {
 // commands refuse it, naming the cameras and the first view's field.
 TEST(Cli, ImplausibleIntrinsicsAreWarnedAboutOrRefusedByField) {
   TempDir d;
-  Result r = run("scene --layout room360 --views 16 --width 64 --height 48 --out " + d.file("s"));
+  Result r = runCli("scene --layout room360 --views 16 --width 64 --height 48 --out " + d.file("s"));
   ASSERT_EQ(r.code, 0) << r.output;
   const std::string cams = d.file("s/sparse/0/cameras.txt"), original = saresgs::test::readBytes(cams);
   auto edit = [&](const std::string& f, const std::string& cx, const std::string& cy) {
@@ -286,12 +285,12 @@ TEST(Cli, ImplausibleIntrinsicsAreWarnedAboutOrRefusedByField) {
     saresgs::test::writeBytes(cams, out);
   };
   edit("0.001", "", "");
-  r = run("info --dataset " + d.file("s"));
+  r = runCli("info --dataset " + d.file("s"));
   EXPECT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("warning: 0001.png: fx: fx = 0.001 px"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("more like these"), std::string::npos) << r.output;
   edit("", "5000", "-3000");
-  r = run("info --dataset " + d.file("s"));
+  r = runCli("info --dataset " + d.file("s"));
   EXPECT_NE(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("intrinsics or poses"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("cx = 5000"), std::string::npos) << r.output;

@@ -14,14 +14,12 @@
 #include "geometry/io/json_file.h"
 #include "geometry/scene/scene.h"
 
+using saresgs::test::runCli;
 using saresgs::test::TempDir;
 namespace fs = std::filesystem;
 using nlohmann::json;
 
 namespace {
-
-using Result = saresgs::test::CommandResult;
-Result run(const std::string& args) { return saresgs::test::runCommand(std::string(SARESGS_CLI) + " " + args); }
 
 double psnrOf(const std::string& results) { return saresgs::readJsonFile(results).at("psnr").get<double>(); }
 
@@ -41,12 +39,7 @@ void toNerfstudio(const std::string& blender, const std::string& out) {
   ns["frames"] = json::array();
   const saresgs::Scene b = saresgs::loadDataset(blender);
   const saresgs::Intrinsics& K = b.views[0].camera.K;
-  ns["fl_x"] = K.fx;
-  ns["fl_y"] = K.fy;
-  ns["cx"] = K.cx;
-  ns["cy"] = K.cy;
-  ns["w"] = K.width;
-  ns["h"] = K.height;
+  ns.update({{"fl_x", K.fx}, {"fl_y", K.fy}, {"cx", K.cx}, {"cy", K.cy}, {"w", K.width}, {"h", K.height}});
   int k = 0;
   for (const char* split : {"transforms_train.json", "transforms_test.json"}) {
     const json t = saresgs::readJsonFile((fs::path(blender) / split).string());
@@ -71,8 +64,8 @@ void toNerfstudio(const std::string& blender, const std::string& out) {
 
 TEST(NerfstudioCli, TransformsJsonTrainsAsTheBlenderFolderDoes) {
   TempDir d;
-  Result r =
-      run("scene --layout room360 --views 24 --width 96 --height 72 --format blender --out " + d.file("blender"));
+  auto r =
+      runCli("scene --layout room360 --views 24 --width 96 --height 72 --format blender --out " + d.file("blender"));
   ASSERT_EQ(r.code, 0) << r.output;
   toNerfstudio(d.file("blender"), d.file("ns"));
 
@@ -94,8 +87,8 @@ TEST(NerfstudioCli, TransformsJsonTrainsAsTheBlenderFolderDoes) {
 
   // Trained the same way, the two reach the same PSNR (JPEG's loss aside).
   for (const char* which : {"blender", "ns"}) {
-    r = run("train --dataset " + d.file(which) + " --iterations 300 --seed 0 --threads 1 --out " +
-            d.file(std::string("t_") + which));
+    r = runCli("train --dataset " + d.file(which) + " --iterations 300 --seed 0 --threads 1 --out " +
+               d.file(std::string("t_") + which));
     ASSERT_EQ(r.code, 0) << r.output;
   }
   // cameras.json beside the .ply: every view, named by its image.

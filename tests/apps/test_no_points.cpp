@@ -14,24 +14,17 @@
 #include "common/test_support.h"
 #include "geometry/scene/scene.h"
 
+using saresgs::test::runCli;
 using saresgs::test::TempDir;
 namespace fs = std::filesystem;
-
-namespace {
-
-saresgs::test::CommandResult run(const std::string& args) {
-  return saresgs::test::runCommand(std::string(SARESGS_CLI) + " " + args);
-}
-
-}  // namespace
 
 TEST(NoPoints, BlenderObjectWithoutPointsTrainsWithinOneDecibelOfColmapWithPoints) {
   TempDir d;
   const auto t0 = std::chrono::steady_clock::now();
   const std::string size = "--layout object --width 128 --height 96 --views 60 ";
-  auto r = run("scene " + size + "--format blender --no-points --out " + d.file("blender"));
+  auto r = runCli("scene " + size + "--format blender --no-points --out " + d.file("blender"));
   ASSERT_EQ(r.code, 0) << r.output;
-  r = run("scene " + size + "--out " + d.file("colmap"));
+  r = runCli("scene " + size + "--out " + d.file("colmap"));
   ASSERT_EQ(r.code, 0) << r.output;
 
   // What the test is about: no points, and cameras on the upper hemisphere, whose centres'
@@ -49,7 +42,8 @@ TEST(NoPoints, BlenderObjectWithoutPointsTrainsWithinOneDecibelOfColmapWithPoint
   EXPECT_FALSE(saresgs::loadDataset(d.file("colmap")).points.empty());
 
   auto train = [&](const std::string& dataset) {
-    const auto res = run("train --dataset " + d.file(dataset) + " --iterations 1000 --out " + d.file("t_" + dataset));
+    const auto res =
+        runCli("train --dataset " + d.file(dataset) + " --iterations 1000 --out " + d.file("t_" + dataset));
     EXPECT_EQ(res.code, 0) << res.output;
     const auto j = nlohmann::json::parse(saresgs::test::readBytes(d.file("t_" + dataset + "/results.json")));
     EXPECT_EQ(j["evaluated_on"], "test");

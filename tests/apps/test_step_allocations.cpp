@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "apps/heap_count.h"
+#include "common/pinhole.h"
 #include "splat/rasterize.h"
 #include "splat/train/trainer.h"
 
@@ -19,12 +20,7 @@ using namespace saresgs;
 namespace {
 
 Camera camera(int w, int h) {
-  Intrinsics K;
-  K.width = w;
-  K.height = h;
-  K.fx = K.fy = 0.9 * w;
-  K.cx = 0.5 * w;
-  K.cy = 0.5 * h;
+  const Intrinsics K = test::pinhole(w, h, 0.9 * w);
   return Camera::lookAt(K, Eigen::Vector3d(0.3, -3.0, 0.5), Eigen::Vector3d(0, 0, 0), Eigen::Vector3d::UnitZ());
 }
 

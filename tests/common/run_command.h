@@ -24,4 +24,10 @@ inline CommandResult runCommand(const std::string& command) {
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
 }
 
+#ifdef SARESGS_CLI
+// The project's command line (the `saresgs` binary that SARESGS_CLI names in test_apps)
+// run with `args`.
+inline CommandResult runCli(const std::string& args) { return runCommand(std::string(SARESGS_CLI) + " " + args); }
+#endif
+
 }  // namespace saresgs::test

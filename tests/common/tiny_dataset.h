@@ -6,19 +6,14 @@
 #include "geometry/scene/scene.h"
 #include "geometry/synth/synthetic_scene.h"
 #include "geometry/synth/write_dataset.h"
+#include "common/synthetic_options.h"
 #include "common/test_support.h"
 
 namespace saresgs::test {
 
 // The options the tiny dataset is made with (tests rebuild the scene for ground truth).
 inline SyntheticOptions tinyDatasetOptions() {
-  SyntheticOptions o;
-  o.layout = "object";
-  o.width = 64;
-  o.height = 48;
-  o.num_views = 16;
-  o.seed = 3;
-  return o;
+  return syntheticOptions("object", 64, 48, /*seed=*/3, /*num_views=*/16);
 }
 
 // The folder it is written to (once per test program).

@@ -12,6 +12,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "common/ring_run.h"
 #include "common/test_support.h"
 #include "common/tiny_active_options.h"
 #include "common/tiny_dataset.h"
@@ -371,15 +372,8 @@ TEST(ActiveRun, ProgressNamesEveryPhaseWithItsCounts) {
 // random selection from 2 views, seed 5); both are refused by field.
 TEST(ActiveRun, CheckpointNumbersOutOfRangeAreRefusedByField) {
   Scene s = test::ringScene([](int i) { return "view" + std::to_string(i) + ".png"; }, true);
-  ActiveOptions o;
-  o.method = Method::kRandom;
-  o.initial_views = 2;
-  o.max_views = 4;
-  o.interval = 1;
-  o.total_iterations = 8;
-  o.trainer.max_sh_degree = 1;
+  ActiveOptions o = test::ringRunOptions();
   o.trainer.random_init_points = 8;
-  o.seed = 5;
   for (const auto& [input, field] : std::vector<std::pair<std::string, std::string>>{
            {"selected_1e30.json", "selected"}, {"views_before_1e30.json", "steps[0].views_before"}}) {
     TempDir d;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "common/pinhole.h"
 #include "geometry/error.h"
 #include "geometry/occupancy/candidate_sets.h"
 #include "geometry/occupancy/occupancy_grid.h"
@@ -76,12 +77,7 @@ Scene occluderScene() {
     for (int j = 0; j <= 200; ++j) s.points.push_back({Eigen::Vector3d(0, -1 + 0.01 * i, -1 + 0.01 * j), {}});
   for (int i = 0; i <= 100; ++i)
     for (int j = 0; j <= 100; ++j) s.points.push_back({Eigen::Vector3d(-1.5, -0.5 + 0.01 * i, -0.5 + 0.01 * j), {}});
-  Intrinsics K;
-  K.width = 64;
-  K.height = 48;
-  K.fx = K.fy = 60;
-  K.cx = 32;
-  K.cy = 24;
+  const Intrinsics K = test::pinhole(64, 48, 60);
   const Eigen::Vector3d eyes[] = {{3, 0, 0}, {-4, 0, 0}, {3, 0.3, 0}};
   const Eigen::Vector3d targets[] = {{0, 0, 0}, {0, 0, 0}, {0, 0.3, 0}};
   for (int v = 0; v < 3; ++v) {
@@ -95,11 +91,17 @@ Scene occluderScene() {
   return s;
 }
 
-TEST(HybridSelectors, HybridPrefersUnobservedSurfaceBehindAnOccluderThatFrustumSetsMiss) {
-  const Scene s = occluderScene();
+// Surface coverage of the occluder scene: a 64^3 grid, every pixel cast.
+SurfaceCoverageOptions occluderCoverageOptions() {
   SurfaceCoverageOptions o;
   o.grid.resolution = 64;
   o.stride = 1;
+  return o;
+}
+
+TEST(HybridSelectors, HybridPrefersUnobservedSurfaceBehindAnOccluderThatFrustumSetsMiss) {
+  const Scene s = occluderScene();
+  const SurfaceCoverageOptions o = occluderCoverageOptions();
   SurfaceCoverage cov(s, o);
   ASSERT_GT(cov.surfaceCount(), 1000u);
   cov.observe({0});
@@ -138,9 +140,7 @@ TEST(HybridSelectors, HybridPrefersUnobservedSurfaceBehindAnOccluderThatFrustumS
 // gains more than C, a second look at what A covers.
 TEST(HybridSelectors, FacilityGainIsTheRiseInCoverageOfTheTrainViews) {
   const Scene s = occluderScene();
-  SurfaceCoverageOptions o;
-  o.grid.resolution = 64;
-  o.stride = 1;
+  const SurfaceCoverageOptions o = occluderCoverageOptions();
   SurfaceCoverage cov(s, o);
   EXPECT_EQ(cov.similarity(1, 1), 1.0);
   EXPECT_EQ(cov.similarity(0, 2), cov.similarity(2, 0));

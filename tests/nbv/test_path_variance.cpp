@@ -7,6 +7,7 @@
 #include <cmath>
 #include <vector>
 
+#include "common/pinhole.h"
 #include "nbv/path_variance.h"
 #include "nbv/selectors.h"
 #include "splat/fisher_detail.h"
@@ -16,12 +17,7 @@ namespace saresgs {
 namespace {
 
 Camera ringCamera(double degrees, double radius = 3.0, int w = 32, int h = 24) {
-  Intrinsics K;
-  K.width = w;
-  K.height = h;
-  K.fx = K.fy = 0.9 * w;
-  K.cx = 0.5 * w;
-  K.cy = 0.5 * h;
+  const Intrinsics K = test::pinhole(w, h, 0.9 * w);
   const double a = degrees * M_PI / 180;
   return Camera::lookAt(K, Eigen::Vector3d(radius * std::cos(a), radius * std::sin(a), 0.3), Eigen::Vector3d::Zero(),
                         Eigen::Vector3d::UnitZ());

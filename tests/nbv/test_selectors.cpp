@@ -10,28 +10,15 @@
 #include "nbv/active_run.h"
 #include "nbv/ause.h"
 #include "nbv/selectors.h"
+#include "common/ring_scene.h"
 
 namespace saresgs {
 namespace {
 
+// n 32x24 cameras on a ring of radius 4 in the plane z = 0, every one a train view.
 Scene ringScene(int n) {
-  Scene s;
-  Intrinsics K;
-  K.width = 32;
-  K.height = 24;
-  K.fx = K.fy = 30;
-  K.cx = 16;
-  K.cy = 12;
-  for (int i = 0; i < n; ++i) {
-    const double a = 2 * M_PI * i / n;
-    SceneView v;
-    v.name = std::to_string(i);
-    v.camera = Camera::lookAt(K, Eigen::Vector3d(4 * std::cos(a), 4 * std::sin(a), 0), Eigen::Vector3d::Zero(),
-                              Eigen::Vector3d::UnitZ());
-    s.views.push_back(v);
-    s.train.push_back(i);
-  }
-  return s;
+  return test::cameraRing(
+      n, test::pinhole(32, 24, 30), 4, 0, [](int i) { return std::to_string(i); }, false);
 }
 
 TEST(Selectors, FarthestViewPicksTheOppositeCamera) {

@@ -65,6 +65,17 @@ inline ::testing::AssertionResult valuesBitEqual(const std::vector<float>& got, 
   return ::testing::AssertionSuccess();
 }
 
+// Calls f(a's array, b's array, name) for each of the five parameter arrays, in
+// forEachArray's order: an array-by-array comparison of two models of any scalar types.
+template <typename A, typename B, typename F>
+void forEachArrayPair(const GaussiansT<A>& a, const GaussiansT<B>& b, F&& f) {
+  f(a.means, b.means, "means");
+  f(a.log_scales, b.log_scales, "log_scales");
+  f(a.rotations, b.rotations, "rotations");
+  f(a.opacities, b.opacities, "opacities");
+  f(a.sh, b.sh, "sh");
+}
+
 // How many values of `after` differ from `before`'s (the models have the same shape).
 inline int countChanged(const Gaussians& before, const Gaussians& after) {
   std::vector<const std::vector<float>*> b;

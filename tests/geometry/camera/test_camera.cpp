@@ -10,14 +10,7 @@ using namespace saresgs;
 namespace {
 
 Intrinsics makeK(int w = 256, int h = 192) {
-  Intrinsics K;
-  K.width = w;
-  K.height = h;
-  K.fx = 220;
-  K.fy = 230;
-  K.cx = 0.5 * w + 3.25;
-  K.cy = 0.5 * h - 2.5;
-  return K;
+  return Intrinsics{.width = w, .height = h, .fx = 220, .fy = 230, .cx = 0.5 * w + 3.25, .cy = 0.5 * h - 2.5};
 }
 
 Camera randomCamera(std::mt19937_64& rng) {

@@ -13,14 +13,7 @@ using namespace saresgs;
 namespace {
 
 Intrinsics makeK(int w = 640, int h = 480, double f = 500) {
-  Intrinsics K;
-  K.width = w;
-  K.height = h;
-  K.fx = f;
-  K.fy = f * 1.01;
-  K.cx = 0.5 * w + 2.5;
-  K.cy = 0.5 * h - 1.5;
-  return K;
+  return Intrinsics{.width = w, .height = h, .fx = f, .fy = f * 1.01, .cx = 0.5 * w + 2.5, .cy = 0.5 * h - 1.5};
 }
 
 Camera randomRotationCamera(std::mt19937_64& rng, const Eigen::Vector3d& centre) {

@@ -18,14 +18,7 @@ using namespace saresgs;
 namespace {
 
 Intrinsics makeK(int w = 96, int h = 72) {
-  Intrinsics K;
-  K.width = w;
-  K.height = h;
-  K.fx = 0.9 * w;
-  K.fy = 0.9 * w;
-  K.cx = 0.5 * w + 1.25;
-  K.cy = 0.5 * h - 0.75;
-  return K;
+  return Intrinsics{.width = w, .height = h, .fx = 0.9 * w, .fy = 0.9 * w, .cx = 0.5 * w + 1.25, .cy = 0.5 * h - 0.75};
 }
 
 // A scene grid whose coarse voxels are a random subset of a 24 x 18 x 12 box (each chosen

@@ -4,9 +4,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <random>
 #include <set>
+#include <utility>
+#include <vector>
 
 #include "common/test_support.h"
 #include "geometry/occupancy/occupancy_grid.h"
@@ -270,21 +273,18 @@ TEST(OccupancyGrids, BadInputRaisesInputError) {
         build({Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(NAN, 0, 0)}, {});
       },
       "SfM points", "point 1"));
-  OccupancyOptions o;
-  o.resolution = 0;
-  EXPECT_TRUE(test::throwsInputError([&] { build(pts, o); }, "SfM points", "resolution"));
-  o = {};
-  o.min_points = 0;
-  EXPECT_TRUE(test::throwsInputError([&] { build(pts, o); }, "SfM points", "min_points"));
-  o = {};
-  o.upsample = 0;
-  EXPECT_TRUE(test::throwsInputError([&] { build(pts, o); }, "SfM points", "upsample"));
-  o = {};
-  o.trim_percent = 50;
-  EXPECT_TRUE(test::throwsInputError([&] { build(pts, o); }, "SfM points", "trim_percent"));
-  o = {};
-  o.dilation_radius = -1;
-  EXPECT_TRUE(test::throwsInputError([&] { build(pts, o); }, "SfM points", "dilation_radius"));
+  // One option out of range at a time, the others as OccupancyOptions has them: refused by name.
+  const std::vector<std::pair<const char*, std::function<void(OccupancyOptions&)>>> bad_options = {
+      {"resolution", [](OccupancyOptions& o) { o.resolution = 0; }},
+      {"min_points", [](OccupancyOptions& o) { o.min_points = 0; }},
+      {"upsample", [](OccupancyOptions& o) { o.upsample = 0; }},
+      {"trim_percent", [](OccupancyOptions& o) { o.trim_percent = 50; }},
+      {"dilation_radius", [](OccupancyOptions& o) { o.dilation_radius = -1; }}};
+  for (const auto& [field, set] : bad_options) {
+    OccupancyOptions o;
+    set(o);
+    EXPECT_TRUE(test::throwsInputError([&] { build(pts, o); }, "SfM points", field));
+  }
   OccupancyGrids g = build(pts, {});
   const std::vector<Eigen::Vector3d> bad{Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0, INFINITY, 0)};
   EXPECT_TRUE(test::throwsInputError([&] { g.addObserved(bad); }, "SA-Points", "point 1"));

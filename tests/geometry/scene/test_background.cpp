@@ -81,6 +81,13 @@ void writeNerfstudio(const TempDir& d, std::uint8_t a, bool rgb) {
   std::ofstream(d.file("transforms.json")) << j.dump();
 }
 
+// The dataset in d loaded as `--background said` asks.
+Scene loadWithBackground(const TempDir& d, const std::string& said) {
+  DatasetOptions o;
+  o.background = parseBackground(said, "--background");
+  return loadDataset(d.str(), o);
+}
+
 }  // namespace
 
 TEST(Background, NerfstudioRgbaIsCompositedOnWhiteAndTrainedOnWhite) {
@@ -103,9 +110,7 @@ TEST(Background, NerfstudioRgbaIsCompositedOnWhiteAndTrainedOnWhite) {
 TEST(Background, ASaidColourWinsAndIsTheCompositingColour) {
   TempDir d;
   writeNerfstudio(d, 128, false);
-  DatasetOptions o;
-  o.background = parseBackground("0,0,1", "--background");
-  const Scene s = loadDataset(d.str(), o);
+  const Scene s = loadWithBackground(d, "0,0,1");
   EXPECT_EQ(*s.background, (std::array<float, 3>{0, 0, 1}));
   EXPECT_EQ(s.background_from, "--background");
   EXPECT_EQ(backgroundWarning(s), "");
@@ -123,9 +128,7 @@ TEST(Background, ASaidColourWinsAndIsTheCompositingColour) {
 TEST(Background, RandomKeepsEachImagesAlpha) {
   TempDir d;
   writeNerfstudio(d, 77, false);
-  DatasetOptions o;
-  o.background = parseBackground("random", "--background");
-  const Scene s = loadDataset(d.str(), o);
+  const Scene s = loadWithBackground(d, "random");
   EXPECT_TRUE(s.random_background);
   EXPECT_EQ(*s.background, (std::array<float, 3>{1, 1, 1}));  // what evaluation renders against
   const Image8* a = s.alpha(2);

@@ -10,13 +10,7 @@ using namespace saresgs;
 // camera-to-world rotation, so that x_cam = rotation^T (x_world - position).
 TEST(CamerasJson, PositionAndRotationMapTheWorldIntoEachCamera) {
   Scene s;
-  Intrinsics K;
-  K.width = 64;
-  K.height = 48;
-  K.fx = 70;
-  K.fy = 72;
-  K.cx = 31;
-  K.cy = 25;
+  const Intrinsics K{.width = 64, .height = 48, .fx = 70, .fy = 72, .cx = 31, .cy = 25};
   for (int i = 0; i < 3; ++i) {
     SceneView v;
     v.name = "img_" + std::to_string(i) + ".png";

@@ -2,6 +2,7 @@
 
 #include <filesystem>
 
+#include "common/synthetic_options.h"
 #include "common/test_support.h"
 #include "geometry/error.h"
 #include "geometry/io/colmap.h"
@@ -228,15 +229,11 @@ TEST(ColmapDataset, AnImageNamedTwiceOrAWidthThatWrapsIsRefused) {
 // is an array, not {train, test}, escaped as nlohmann's "cannot use value() with array".
 TEST(ColmapDataset, AManifestSplitThatIsNotAnObjectNamesTheField) {
   TempDir d;
-  SyntheticOptions o;
-  o.layout = "object";
-  o.width = 16;
-  o.height = 12;
-  o.num_views = 4;
   WriteDatasetOptions w;
   w.simulated.max_points = 6;
   w.simulated.candidates = 400;
-  writeSyntheticDataset(makeSyntheticScene(o), d.file("ds"), w);
+  writeSyntheticDataset(makeSyntheticScene(test::syntheticOptions("object", 16, 12, /*seed=*/0, /*num_views=*/4)),
+                        d.file("ds"), w);
   ASSERT_NO_THROW(loadDataset(d.file("ds")));
   const std::string manifest = d.file("ds/manifest.json");
   test::writeBytes(manifest,

@@ -10,17 +10,17 @@ using namespace saresgs;
 
 namespace {
 
+// The 320x240 camera of every view, with focal length f and principal point (cx, cy).
+Intrinsics withFocal(double f, double cx = 160, double cy = 120) {
+  return Intrinsics{.width = 320, .height = 240, .fx = f, .fy = f, .cx = cx, .cy = cy};
+}
+
 // Four views on a ring looking at a cloud of points about the origin; view 1 may get
 // other intrinsics.
 Scene ring(const Intrinsics& odd) {
   Scene s;
   s.source = "ring";
-  Intrinsics K;
-  K.width = 320;
-  K.height = 240;
-  K.fx = K.fy = 300;
-  K.cx = 160;
-  K.cy = 120;
+  const Intrinsics K = withFocal(300);
   for (int i = 0; i < 4; ++i) {
     SceneView v;
     v.name = "v" + std::to_string(i) + ".jpg";
@@ -32,16 +32,6 @@ Scene ring(const Intrinsics& odd) {
   for (int k = 0; k < 50; ++k)
     s.points.push_back({Eigen::Vector3d(0.02 * k - 0.5, 0.3 * std::sin(k), 0.2 * std::cos(k)), {1, 2, 3}});
   return s;
-}
-
-Intrinsics withFocal(double f, double cx = 160, double cy = 120) {
-  Intrinsics K;
-  K.width = 320;
-  K.height = 240;
-  K.fx = K.fy = f;
-  K.cx = cx;
-  K.cy = cy;
-  return K;
 }
 
 }  // namespace

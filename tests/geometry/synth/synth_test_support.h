@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "geometry/synth/synthetic_scene.h"
+#include "tests/common/synthetic_options.h"
 
 namespace saresgs::synth_test {
 
@@ -21,12 +22,7 @@ inline const SyntheticScene& scene(const std::string& layout, int w = 128, int h
   auto key = std::make_tuple(layout, w, h);
   auto it = cache.find(key);
   if (it == cache.end()) {
-    SyntheticOptions o;
-    o.layout = layout;
-    o.width = w;
-    o.height = h;
-    o.seed = 3;
-    it = cache.emplace(key, makeSyntheticScene(o)).first;
+    it = cache.emplace(key, makeSyntheticScene(test::syntheticOptions(layout, w, h, /*seed=*/3))).first;
   }
   return it->second;
 }

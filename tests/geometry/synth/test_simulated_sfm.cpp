@@ -2,17 +2,14 @@
 
 #include <algorithm>
 
+#include "common/synthetic_options.h"
 #include "geometry/synth/write_dataset.h"
 
 using namespace saresgs;
 
 TEST(SimulatedSfm, NoiseOutliersAndTracksAreAsSpecified) {
-  SyntheticOptions o;
-  o.layout = "room360";
-  o.width = 128;
-  o.height = 96;
-  o.num_views = 40;
-  const SyntheticScene scene = makeSyntheticScene(o);
+  const SyntheticScene scene =
+      makeSyntheticScene(test::syntheticOptions("room360", 128, 96, /*seed=*/0, /*num_views=*/40));
   ColmapModel model = colmapModelOf(scene);
   SimulatedSfmOptions sim;
   sim.candidates = 6000;
@@ -58,12 +55,8 @@ TEST(SimulatedSfm, NoiseOutliersAndTracksAreAsSpecified) {
 }
 
 TEST(SimulatedSfm, DeterministicForASeed) {
-  SyntheticOptions o;
-  o.layout = "object";
-  o.width = 64;
-  o.height = 48;
-  o.num_views = 12;
-  const SyntheticScene scene = makeSyntheticScene(o);
+  const SyntheticScene scene =
+      makeSyntheticScene(test::syntheticOptions("object", 64, 48, /*seed=*/0, /*num_views=*/12));
   ColmapModel a = colmapModelOf(scene), b = colmapModelOf(scene), c = colmapModelOf(scene);
   SimulatedSfmOptions sim;
   sim.candidates = 2000;

@@ -9,7 +9,9 @@
 #include <unistd.h>
 #include <filesystem>
 #include <iomanip>
+#include <tuple>
 
+#include "common/synthetic_options.h"
 #include "common/test_support.h"
 #include "geometry/io/colmap.h"
 #include "geometry/scene/scene.h"
@@ -24,13 +26,7 @@ namespace fs = std::filesystem;
 namespace {
 
 SyntheticOptions smallOptions(const std::string& layout) {
-  SyntheticOptions o;
-  o.layout = layout;
-  o.width = 96;
-  o.height = 72;
-  o.num_views = 24;
-  o.seed = 5;
-  return o;
+  return test::syntheticOptions(layout, 96, 72, /*seed=*/5, /*num_views=*/24);
 }
 
 // q_tol: COLMAP normalises every quaternion it reads from text, so a model it converted
@@ -39,10 +35,8 @@ void expectSameModel(const ColmapModel& a, const ColmapModel& b, double q_tol = 
   ASSERT_EQ(a.cameras.size(), b.cameras.size());
   for (const auto& [id, c] : a.cameras) {
     const ColmapCamera& d = b.cameras.at(id);
-    EXPECT_EQ(c.model, d.model);
-    EXPECT_EQ(c.width, d.width);
-    EXPECT_EQ(c.height, d.height);
-    EXPECT_EQ(c.params, d.params);
+    EXPECT_EQ(std::tie(c.model, c.width, c.height, c.params), std::tie(d.model, d.width, d.height, d.params))
+        << "camera " << id;
   }
   ASSERT_EQ(a.images.size(), b.images.size());
   for (const auto& [id, im] : a.images) {
@@ -63,10 +57,7 @@ void expectSameModel(const ColmapModel& a, const ColmapModel& b, double q_tol = 
   ASSERT_EQ(a.points.size(), b.points.size());
   for (const auto& [id, p] : a.points) {
     const ColmapPoint3D& q = b.points.at(id);
-    EXPECT_EQ(p.xyz, q.xyz);
-    EXPECT_EQ(p.rgb, q.rgb);
-    EXPECT_EQ(p.error, q.error);
-    EXPECT_EQ(p.track, q.track);
+    EXPECT_EQ(std::tie(p.xyz, p.rgb, p.error, p.track), std::tie(q.xyz, q.rgb, q.error, q.track)) << "point " << id;
   }
 }
 

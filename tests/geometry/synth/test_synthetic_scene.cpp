@@ -252,12 +252,7 @@ TEST(SyntheticScene, RenderIsDeterministicAndThreadCountIndependent) {
   EXPECT_EQ(one.data, a.data);
   EXPECT_EQ(two.data, a.data);
   // A scene built again from the same options renders the same image.
-  SyntheticOptions o;
-  o.layout = "room360";
-  o.width = 128;
-  o.height = 96;
-  o.seed = 3;
-  const SyntheticScene again = makeSyntheticScene(o);
+  const SyntheticScene again = makeSyntheticScene(test::syntheticOptions("room360", 128, 96, /*seed=*/3));
   EXPECT_EQ(again.render(again.cameras[33]).data, a.data);
   EXPECT_EQ(again.manifest, s.manifest);
 }

@@ -13,6 +13,7 @@
 #include "geometry/camera/camera.h"
 #include "splat/gaussians.h"
 #include "splat/raster_execution.h"
+#include "splat/rasterize.h"
 
 namespace saresgs::test {
 
@@ -32,12 +33,7 @@ inline std::vector<std::pair<const char*, RasterKernels>> runnableFisherKernels(
 }
 
 inline Camera smallCamera(int w = 24, int h = 20) {
-  Intrinsics K;
-  K.width = w;
-  K.height = h;
-  K.fx = K.fy = 0.9 * w;
-  K.cx = 0.5 * w + 0.3;
-  K.cy = 0.5 * h - 0.2;
+  const Intrinsics K{.width = w, .height = h, .fx = 0.9 * w, .fy = 0.9 * w, .cx = 0.5 * w + 0.3, .cy = 0.5 * h - 0.2};
   return Camera::lookAt(K, Eigen::Vector3d(0.2, -3.0, 0.4), Eigen::Vector3d(0, 0, 0), Eigen::Vector3d::UnitZ());
 }
 
@@ -78,6 +74,32 @@ inline Gaussians oneGaussian(const Eigen::Vector3d& mean, double scale, float lo
   return g;
 }
 
+// Six small Gaussians (scale 0.05, opacity logit 3, SH DC (0.7, 0, 0)) where projection
+// must take care, for `cam` and the near plane of `s`.
+inline Gaussians nearPlaneAndBorderScene(const Camera& cam, const RasterSettings& s) {
+  const Eigen::Vector3d C = cam.center(), f = cam.viewDirection();
+  const Eigen::Vector3d means[6] = {
+      C + double(s.near_plane) * f,                                    // exactly at the near plane
+      C + 0.5 * double(s.near_plane) * f,                              // in front of the camera, before it
+      C - 1.0 * f,                                                     // behind the camera
+      cam.unproject(Eigen::Vector2d(0, 0.5 * cam.K.height), 2.0),      // on the left border
+      cam.unproject(Eigen::Vector2d(cam.K.width, cam.K.height), 2.0),  // on the bottom-right corner
+      C,                                                               // at the camera centre
+  };
+  Gaussians g;
+  g.resize(6);
+  for (int i = 0; i < 6; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      g.means[3 * i + k] = static_cast<float>(means[i][k]);
+      g.log_scales[3 * i + k] = std::log(0.05f);
+    }
+    g.rotations[4 * i] = 1;
+    g.opacities[i] = 3.0f;
+    g.sh[3 * i] = 0.7f;
+  }
+  return g;
+}
+
 struct GradCheck {
   int checked = 0, kinks = 0, bad = 0;
 };
@@ -111,6 +133,16 @@ inline void checkGradientArray(std::vector<double>& param, const std::vector<dou
       ADD_FAILURE() << name << "[" << k << "]: analytic " << analytic[k] << " vs finite difference " << fd;
     }
   }
+}
+
+// checkGradientArray for each of g's five parameter arrays against grad's, in
+// forEachArray's order.
+inline void checkGradients(GaussiansD& g, const GaussiansD& grad, const std::function<double()>& loss, GradCheck& gc) {
+  checkGradientArray(g.means, grad.means, loss, "means", gc);
+  checkGradientArray(g.log_scales, grad.log_scales, loss, "log_scales", gc);
+  checkGradientArray(g.rotations, grad.rotations, loss, "rotations", gc);
+  checkGradientArray(g.opacities, grad.opacities, loss, "opacities", gc);
+  checkGradientArray(g.sh, grad.sh, loss, "sh", gc);
 }
 
 }  // namespace saresgs::test

@@ -93,11 +93,7 @@ TEST(FastVsReference, AnalyticGradientsMatchFiniteDifferencesOfTheReference) {
       return l;
     };
     test::GradCheck gc;
-    test::checkGradientArray(g.means, grad.means, loss, "means", gc);
-    test::checkGradientArray(g.log_scales, grad.log_scales, loss, "log_scales", gc);
-    test::checkGradientArray(g.rotations, grad.rotations, loss, "rotations", gc);
-    test::checkGradientArray(g.opacities, grad.opacities, loss, "opacities", gc);
-    test::checkGradientArray(g.sh, grad.sh, loss, "sh", gc);
+    test::checkGradients(g, grad, loss, gc);
     EXPECT_EQ(gc.bad, 0);
     EXPECT_GT(gc.checked, 80);
     EXPECT_LE(gc.kinks, gc.checked / 20);

@@ -8,10 +8,12 @@
 #include <string>
 #include <vector>
 
+#include "common/pinhole.h"
 #include "raster_test_scenes.h"
 #include "splat/fisher.h"
 #include "splat/fisher_detail.h"
 #include "splat/raster/projection.h"
+#include "tests/splat/gaussians_bits.h"
 
 namespace saresgs {
 namespace {
@@ -114,28 +116,11 @@ std::vector<FisherCase> fisherCases() {
   Gaussians logits = test::randomScene<double>(20, 1, 30).cast<float>();
   for (std::size_t i = 0; i < logits.size(); ++i) logits.opacities[i] = (i % 2) ? 30.0f : -30.0f;
   cases.push_back({"logits +-30", logits, small, 1, {0.1f, 0.2f, 0.3f}});
-  {
-    const Eigen::Vector3d C = small.center(), f = small.viewDirection();
-    const RasterSettings s;
-    Gaussians g;
-    g.resize(6);
-    const Eigen::Vector3d means[6] = {C + double(s.near_plane) * f,
-                                      C + 0.5 * double(s.near_plane) * f,
-                                      C - 1.0 * f,
-                                      small.unproject(Eigen::Vector2d(0, 12), 2.0),
-                                      small.unproject(Eigen::Vector2d(32, 24), 2.0),
-                                      C};
-    for (int i = 0; i < 6; ++i) {
-      for (int k = 0; k < 3; ++k) {
-        g.means[3 * i + k] = static_cast<float>(means[i][k]);
-        g.log_scales[3 * i + k] = std::log(0.05f);
-      }
-      g.rotations[4 * i] = 1;
-      g.opacities[i] = 3.0f;
-      g.sh[3 * i] = 0.7f;
-    }
-    cases.push_back({"near plane, behind, borders", g, small, 0, {0.1f, 0.2f, 0.3f}});
-  }
+  cases.push_back({"near plane, behind, borders",
+                   test::nearPlaneAndBorderScene(small, RasterSettings{}),
+                   small,
+                   0,
+                   {0.1f, 0.2f, 0.3f}});
   return cases;
 }
 
@@ -221,11 +206,7 @@ TEST(Fisher, Avx512WalkEqualsAvx2BitForBit) {
           ASSERT_EQ(std::bit_cast<std::uint32_t>(x[k]), std::bit_cast<std::uint32_t>(y[k]))
               << what << "[" << k << "]: avx2 " << x[k] << ", avx512 " << y[k];
       };
-      same(a.means, b.means, "means");
-      same(a.log_scales, b.log_scales, "log_scales");
-      same(a.rotations, b.rotations, "rotations");
-      same(a.opacities, b.opacities, "opacities");
-      same(a.sh, b.sh, "sh");
+      test::forEachArrayPair(a, b, same);
       for (float v : a.means) nonzero += v != 0.0f;
     }
   }
@@ -303,12 +284,7 @@ TEST(Fisher, DuplicateOfATrainViewScoresBelowAViewOfUnseenGaussians) {
   Gaussians g = test::randomScene<float>(24, 0, 5, 0.25);
   for (std::size_t i = 0; i < g.size(); ++i) g.means[3 * i] += (i % 2 ? 3.0f : -3.0f);
   RasterSettings s;
-  Intrinsics K;
-  K.width = 32;
-  K.height = 24;
-  K.fx = K.fy = 30;
-  K.cx = 16;
-  K.cy = 12;
+  const Intrinsics K = test::pinhole(32, 24, 30);
   const Camera left =
       Camera::lookAt(K, Eigen::Vector3d(-3, -3, 0), Eigen::Vector3d(-3, 0, 0), Eigen::Vector3d::UnitZ());
   const Camera right = Camera::lookAt(K, Eigen::Vector3d(3, -3, 0), Eigen::Vector3d(3, 0, 0), Eigen::Vector3d::UnitZ());

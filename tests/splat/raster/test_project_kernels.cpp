@@ -9,6 +9,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <numeric>
 #include <random>
@@ -135,6 +136,33 @@ std::vector<ProjectCase> projectCases() {
   return cases;
 }
 
+// One (camera case, SH degree) of the per-Gaussian stage tests: n Gaussians of wideScene,
+// settings at that degree, and every Gaussian's scalar projection (the stage's input).
+struct StageCase {
+  StageCase(const ProjectCase& pc, int n, int degree, std::uint64_t seed)
+      : g(wideScene(n, degree, seed, pc.centre, pc.spread)), camT(pc.cam, s.guard_band), proj(g.size()) {
+    s.sh_degree = degree;
+    for (std::size_t i = 0; i < g.size(); ++i) proj[i] = projection::project(g, i, camT, s);
+  }
+  Gaussians g;
+  RasterSettings s;
+  projection::CameraT<float> camT;
+  std::vector<projection::Projected<float>> proj;
+};
+
+// Runs `stage` onto a copy of `start` with every kernel set this CPU runs, and asserts
+// that it gives `ref` bit for bit.
+void expectEveryKernelGives(const ProjectCase& pc, int degree, RasterSettings s, const Gaussians& start,
+                            const Gaussians& ref, const std::function<void(const RasterSettings&, Gaussians&)>& stage) {
+  for (const auto& [name, kernels] : test::runnableKernels()) {
+    SCOPED_TRACE(std::string(pc.name) + ", " + name + ", degree " + std::to_string(degree));
+    s.execution.kernels = kernels;
+    Gaussians got = start;
+    stage(s, got);
+    ASSERT_TRUE(test::arraysBitEqual(got, ref));
+  }
+}
+
 }  // namespace
 
 // Every kernel set, every SH degree, several cameras: the SIMD projection is project<float>.
@@ -204,19 +232,15 @@ TEST(ProjectKernels, BackwardEqualsProjectBackwardBitForBit) {
   int chained = 0, nonzero = 0;
   for (const ProjectCase& pc : projectCases()) {
     for (int degree = 0; degree <= 3; ++degree) {
-      const Gaussians g = wideScene(603, degree, 21 + degree, pc.centre, pc.spread);
-      RasterSettings s;
-      s.sh_degree = degree;
-      const projection::CameraT<float> camT(pc.cam, s.guard_band);
-      std::vector<projection::Projected<float>> proj(g.size());
+      const StageCase c(pc, 603, degree, 21 + degree);
+      const Gaussians& g = c.g;
       std::mt19937_64 rng(degree + 5);
       std::normal_distribution<float> nd(0, 1);
       std::vector<std::uint32_t> idx;
       std::vector<projection::ProjectedGrad<float>> dP;
       for (std::size_t i = 0; i < g.size(); ++i) {
-        proj[i] = projection::project(g, i, camT, s);
         // Visible Gaussians (as the backward sees them), two in three, in a shuffled order.
-        if (!proj[i].visible || i % 3 == 2) continue;
+        if (!c.proj[i].visible || i % 3 == 2) continue;
         idx.push_back(static_cast<std::uint32_t>(i));
         projection::ProjectedGrad<float> d;
         d.opacity = nd(rng);
@@ -232,17 +256,13 @@ TEST(ProjectKernels, BackwardEqualsProjectBackwardBitForBit) {
       });
       Gaussians ref = start;
       for (std::size_t j = 0; j < idx.size(); ++j)
-        projection::projectBackward(g, idx[j], camT, s, proj[idx[j]], dP[j],
+        projection::projectBackward(g, idx[j], c.camT, c.s, c.proj[idx[j]], dP[j],
                                     projection::ParamGradRef<float>::of(ref, idx[j]));
-      for (const auto& [name, kernels] : test::runnableKernels()) {
-        SCOPED_TRACE(std::string(pc.name) + ", " + name + ", degree " + std::to_string(degree));
-        s.execution.kernels = kernels;
-        Gaussians got = start;
-        projectBackwardFloat(g, pc.cam, s, idx, proj, dP, got);
-        ASSERT_TRUE(test::arraysBitEqual(got, ref));
-        if (::testing::Test::HasFatalFailure()) return;
-        chained += static_cast<int>(idx.size());
-      }
+      expectEveryKernelGives(pc, degree, c.s, start, ref, [&](const RasterSettings& s, Gaussians& got) {
+        projectBackwardFloat(g, pc.cam, s, idx, c.proj, dP, got);
+      });
+      if (::testing::Test::HasFatalFailure()) return;
+      chained += static_cast<int>(idx.size() * test::runnableKernels().size());
       nonzero += test::countChanged(start, ref);
     }
   }
@@ -270,18 +290,14 @@ TEST(ProjectKernels, FisherChainEqualsReferenceBitForBit) {
   int chained = 0, changed = 0;
   for (const ProjectCase& pc : projectCases()) {
     for (int degree = 0; degree <= 3; ++degree) {
-      const Gaussians g = wideScene(403, degree, 31 + degree, pc.centre, pc.spread);
-      RasterSettings s;
-      s.sh_degree = degree;
-      const projection::CameraT<float> camT(pc.cam, s.guard_band);
-      std::vector<projection::Projected<float>> proj(g.size());
+      const StageCase c(pc, 403, degree, 31 + degree);
+      const Gaussians& g = c.g;
       std::mt19937_64 rng(degree + 9);
       std::normal_distribution<double> nd(0, 1);
       std::vector<std::uint32_t> idx;
       std::vector<double> moments;
       for (std::size_t i = 0; i < g.size(); ++i) {
-        proj[i] = projection::project(g, i, camT, s);
-        if (!proj[i].visible || i % 4 == 3) continue;
+        if (!c.proj[i].visible || i % 4 == 3) continue;
         idx.push_back(static_cast<std::uint32_t>(i));
         // Even moments (E_ij with i + j even and W) non-negative, as sums of squares are.
         for (int m = 0; m < kSlot; ++m) {
@@ -307,16 +323,12 @@ TEST(ProjectKernels, FisherChainEqualsReferenceBitForBit) {
       });
       Gaussians ref = start;
       for (std::size_t j = 0; j < sidx.size(); ++j)
-        fisherChainReference(g, pc.cam, s, sidx[j], proj[sidx[j]], &smo[j * kSlot], ref);
-      for (const auto& [name, kernels] : test::runnableKernels()) {
-        SCOPED_TRACE(std::string(pc.name) + ", " + name + ", degree " + std::to_string(degree));
-        s.execution.kernels = kernels;
-        Gaussians got = start;
-        fisherChainFloat(g, pc.cam, s, sidx, proj, smo, got);
-        ASSERT_TRUE(test::arraysBitEqual(got, ref));
-        if (::testing::Test::HasFatalFailure()) return;
-        chained += static_cast<int>(sidx.size());
-      }
+        fisherChainReference(g, pc.cam, c.s, sidx[j], c.proj[sidx[j]], &smo[j * kSlot], ref);
+      expectEveryKernelGives(pc, degree, c.s, start, ref, [&](const RasterSettings& s, Gaussians& got) {
+        fisherChainFloat(g, pc.cam, s, sidx, c.proj, smo, got);
+      });
+      if (::testing::Test::HasFatalFailure()) return;
+      chained += static_cast<int>(sidx.size() * test::runnableKernels().size());
       changed += test::countChanged(start, ref);
     }
   }

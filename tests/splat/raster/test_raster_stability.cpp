@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "common/pinhole.h"
 #include "raster_test_scenes.h"
 #include "splat/raster/rasterize_detail.h"
 
@@ -78,27 +79,9 @@ TEST(RasterStability, ZeroQuaternionIsTheIdentity) {
 
 TEST(RasterStability, NearPlaneBehindTheCameraAndOnTheBorders) {
   const Camera cam = test::smallCamera(32, 24);
-  const Eigen::Vector3d C = cam.center(), f = cam.viewDirection();
-  RasterSettings s;
-  Gaussians g;
-  g.resize(6);
-  const Eigen::Vector3d means[6] = {
-      C + double(s.near_plane) * f,                 // exactly at the near plane
-      C + 0.5 * double(s.near_plane) * f,           // in front of the camera, before the near plane
-      C - 1.0 * f,                                  // behind the camera
-      cam.unproject(Eigen::Vector2d(0, 12), 2.0),   // on the left border
-      cam.unproject(Eigen::Vector2d(32, 24), 2.0),  // on the bottom-right corner
-      C,                                            // at the camera centre
-  };
-  for (int i = 0; i < 6; ++i) {
-    for (int k = 0; k < 3; ++k) {
-      g.means[3 * i + k] = static_cast<float>(means[i][k]);
-      g.log_scales[3 * i + k] = std::log(0.05f);
-    }
-    g.rotations[4 * i] = 1;
-    g.opacities[i] = 3.0f;
-    g.sh[3 * i] = 0.7f;
-  }
+  // In order: at the near plane, before it, behind the camera, on the left border, on the
+  // bottom-right corner, at the camera centre.
+  const Gaussians g = test::nearPlaneAndBorderScene(cam, RasterSettings{});
   const auto r = renderChecked(g, cam);
   EXPECT_EQ(r.visible[1], 0);
   EXPECT_EQ(r.visible[2], 0);
@@ -110,12 +93,7 @@ TEST(RasterStability, NearPlaneBehindTheCameraAndOnTheBorders) {
 TEST(RasterStability, OneByOneAndVeryWideImages) {
   for (auto [w, h] : {std::pair{1, 1}, std::pair{4096, 8}, std::pair{7, 4096}}) {
     SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h));
-    Intrinsics K;
-    K.width = w;
-    K.height = h;
-    K.fx = K.fy = 1.2 * std::max(w, h);
-    K.cx = 0.5 * w;
-    K.cy = 0.5 * h;
+    const Intrinsics K = test::pinhole(w, h, 1.2 * std::max(w, h));
     const Camera cam = Camera::lookAt(K, Eigen::Vector3d(0, -3, 0), Eigen::Vector3d::Zero());
     const Gaussians g = test::randomScene<double>(50, 2, 31).cast<float>();
     const auto r = renderChecked(g, cam, 2);

@@ -48,11 +48,7 @@ TEST_P(RasterGradient, EveryParameterMatchesFiniteDifferences) {
   rasterizeBackwardT(g, cam, s, fwd, w.data(), grad);
   auto loss = [&] { return linearLoss(rasterizeT(g, cam, s), w); };
   test::GradCheck gc;
-  test::checkGradientArray(g.means, grad.means, loss, "means", gc);
-  test::checkGradientArray(g.log_scales, grad.log_scales, loss, "log_scales", gc);
-  test::checkGradientArray(g.rotations, grad.rotations, loss, "rotations", gc);
-  test::checkGradientArray(g.opacities, grad.opacities, loss, "opacities", gc);
-  test::checkGradientArray(g.sh, grad.sh, loss, "sh", gc);
+  test::checkGradients(g, grad, loss, gc);
   EXPECT_EQ(gc.bad, 0);
   EXPECT_LE(gc.kinks, gc.checked / 20) << "too many parameters on kinks: " << gc.kinks;
   int visible = 0;
@@ -225,11 +221,7 @@ void checkFloatAgainstDouble(const FloatCase& fc, RasterKernels kernels) {
     }
     EXPECT_LE(diff, 2e-3 * scale + 1e-6) << name;
   };
-  compare(gradd.means, gradf.means, "means");
-  compare(gradd.log_scales, gradf.log_scales, "log_scales");
-  compare(gradd.rotations, gradf.rotations, "rotations");
-  compare(gradd.opacities, gradf.opacities, "opacities");
-  compare(gradd.sh, gradf.sh, "sh");
+  test::forEachArrayPair(gradd, gradf, compare);
 }
 }  // namespace
 

@@ -239,11 +239,7 @@ TEST(ReferenceRenderer, LowAlphaIsSkippedAndLowOpacityCulled) {
   const Camera cam = testCamera();
   RasterSettings s;
   // o = 0.005: alpha = 0.005 G, skipped where G < 0.784 though inside the rectangle.
-  Spec faint;
-  faint.mean = {0, 0, 2};
-  faint.scale = {0.1, 0.1, 0.1};
-  faint.opacity_logit = logit(0.005);
-  faint.dc = {1, 1, 1};
+  const Spec faint{.mean = {0, 0, 2}, .scale = {0.1, 0.1, 0.1}, .opacity_logit = logit(0.005), .dc = {1, 1, 1}};
   const ReferenceImage im = referenceRender(makeModel({faint}), cam, s);
   ASSERT_EQ(im.visible[0], 1);
   const double sig2 = std::pow(30 * 0.1 / 2, 2) + static_cast<double>(s.eps2d);
@@ -415,12 +411,11 @@ TEST(ReferenceRenderer, OffAxisProjectionWithRotatedCamera) {
   // An independent oracle with Eigen's quaternion and matrices, camera from lookAt.
   Intrinsics K{kW, kH, 28, 31, 14.2, 12.9};
   const Camera cam = Camera::lookAt(K, {1.0, -2.0, 0.5}, {0.1, 0.2, 0.3});
-  Spec sp;
-  sp.mean = {0.25, 0.1, 0.4};
-  sp.scale = {0.15, 0.04, 0.08};
-  sp.quat = {0.8, -0.3, 0.4, 0.2};
-  sp.opacity_logit = 1.2;
-  sp.dc = {0.3, 0.6, 0.9};
+  const Spec sp{.mean = {0.25, 0.1, 0.4},
+                .scale = {0.15, 0.04, 0.08},
+                .quat = {0.8, -0.3, 0.4, 0.2},
+                .opacity_logit = 1.2,
+                .dc = {0.3, 0.6, 0.9}};
   RasterSettings s;
   const ReferenceImage im = referenceRender(makeModel({sp}), cam, s);
   ASSERT_EQ(im.visible[0], 1);
@@ -527,11 +522,7 @@ TEST(ReferenceRenderer, DepthIsCameraZWhereCovered) {
 TEST(ReferenceRenderer, ZeroQuaternionIsIdentityAndNormIsIgnored) {
   const Camera cam = testCamera();
   RasterSettings s;
-  Spec sp;
-  sp.mean = {0.1, 0.05, 2};
-  sp.scale = {0.2, 0.05, 0.1};
-  sp.opacity_logit = 1;
-  sp.dc = {1, 0.5, 0};
+  Spec sp{.mean = {0.1, 0.05, 2}, .scale = {0.2, 0.05, 0.1}, .opacity_logit = 1, .dc = {1, 0.5, 0}};
   const ReferenceImage id = referenceRender(makeModel({sp}), cam, s);
   sp.quat = {0, 0, 0, 0};
   const ReferenceImage zero = referenceRender(makeModel({sp}), cam, s);

@@ -215,11 +215,7 @@ TEST(SubsetPair, BackwardEqualsTwoSeparateBackwardPasses) {
           EXPECT_LE(diff, 1e-4 * scale) << name;
         }
       };
-      close(ref.grad.means, got.grad.means, "means");
-      close(ref.grad.log_scales, got.grad.log_scales, "log_scales");
-      close(ref.grad.rotations, got.grad.rotations, "rotations");
-      close(ref.grad.opacities, got.grad.opacities, "opacities");
-      close(ref.grad.sh, got.grad.sh, "sh");
+      test::forEachArrayPair(ref.grad, got.grad, close);
       close(ref.mean2d, got.mean2d, "mean2d");
       EXPECT_TRUE(fused(1) == got);
       EXPECT_TRUE(fused(2) == got);
@@ -287,11 +283,7 @@ TEST(SubsetPair, BackwardMatchesTheDoublePath) {
       EXPECT_GT(scale, 0.0) << name;
       EXPECT_LE(diff, 2e-3 * scale + 1e-6) << name;
     };
-    compare(gradd.means, gradf.means, "means");
-    compare(gradd.log_scales, gradf.log_scales, "log_scales");
-    compare(gradd.rotations, gradf.rotations, "rotations");
-    compare(gradd.opacities, gradf.opacities, "opacities");
-    compare(gradd.sh, gradf.sh, "sh");
+    test::forEachArrayPair(gradd, gradf, compare);
     compare(m2d, m2f, "mean2d");
   }
 }

@@ -329,12 +329,6 @@ TEST(Trainer, ACheckpointWithEmptyViewListsLoads) {
   EXPECT_EQ(test::readBytes(d.file("again.bin")), test::readBytes(file));
 }
 
-}  // namespace
-}  // namespace saresgs
-
-namespace saresgs {
-namespace {
-
 TEST(Trainer, NoOpacityResetRightBeforeTheEndOfThePlan) {
   const Scene& s = tinyDataset();
   TrainerOptions o;
@@ -363,12 +357,6 @@ TEST(Trainer, NoOpacityResetRightBeforeTheEndOfThePlan) {
   c.train(s.train, 60);
   EXPECT_TRUE(bitIdentical(b.gaussians(), c.gaussians()));
 }
-
-}  // namespace
-}  // namespace saresgs
-
-namespace saresgs {
-namespace {
 
 float maxOpacityOf(const Gaussians& g) {
   float m = -1e30f;
@@ -404,12 +392,6 @@ TEST(Trainer, WhiteBackgroundResetOnlyWhereTheDataHasABackgroundAndRoomToRecover
   // The default guard is one reset interval, and schedules scale it with the rest.
   EXPECT_EQ(DensifyOptions{}.min_iterations_after_reset, DensifyOptions{}.opacity_reset_interval);
 }
-
-}  // namespace
-}  // namespace saresgs
-
-namespace saresgs {
-namespace {
 
 // The SH degree on an outer clock: after a reset at global iteration 950 with
 // sh_interval 100, the degree rises at global 1000, 1100, 1200 (iterations 50, 150, 250
@@ -492,22 +474,11 @@ TEST(Trainer, ResidualStepEqualsItsTwoBranches) {
       EXPECT_TRUE(bitIdentical(grad, ref_grad));
       EXPECT_EQ(g2d, ref_g2d);
     } else {
-      expectClose(ref_grad.means, grad.means, "means");
-      expectClose(ref_grad.log_scales, grad.log_scales, "log_scales");
-      expectClose(ref_grad.rotations, grad.rotations, "rotations");
-      expectClose(ref_grad.opacities, grad.opacities, "opacities");
-      expectClose(ref_grad.sh, grad.sh, "sh");
+      test::forEachArrayPair(ref_grad, grad, expectClose);
       expectClose(ref_g2d, g2d, "mean2d");
     }
   }
 }
-
-}  // namespace
-}  // namespace saresgs
-
-namespace saresgs {
-
-namespace {
 
 // Runs f as Embree's BVH builds leave TBB: flush-to-zero and denormals-are-zero set on the
 // calling thread while a new task arena starts, so that the arena's workers take that mode
