@@ -124,9 +124,8 @@ if [ "$mode" = accept ]; then
     k=$((k + 1))
     extra=""
     # The help is read whole before the test: under pipefail, `grep -q` leaving at its first
-    # match could end the writer by SIGPIPE and make the test false. Until 2026-11-28 it did,
-    # every time, so every sitting ran this tree's main job with the plain refit, a second
-    # 1600-iteration fit that scripts/main.sh leaves out and b0ae65c does not have.
+    # match could end the writer by SIGPIPE and make the test false (the main job would then
+    # run with the plain refit, a second 1600-iteration fit that scripts/main.sh leaves out).
     help=$($bin active --help)
     if grep -q -- --no-plain-refit <<< "$help"; then extra=--no-plain-refit; fi
     sec=$(timed $bin active --dataset out/builtin --method sa-resgs --preset quick --seed 0 $extra --out "$work/main_$k")

@@ -17,10 +17,10 @@
 # the Python module and the fuzz targets are left out as in
 # scripts/test_sanitizers.sh. Any report fails the test that made it (halt_on_error).
 # Usage: bash scripts/test_tsan.sh [extra ctest arguments, e.g. -R Rasterizer]
-# On two cores (2026-11-25, beside two single-thread ablation jobs): oneTBB built in 17 s,
-# the project in about 15 minutes, the suite in 1916 s (404 of 404 passed; the slowest
-# test, a whole training through the CLI, 1117 s). Not run by CI, whose budget it would
-# exceed; run it before resolving a change to threading.
+# On two cores beside two single-thread ablation jobs oneTBB builds in about 17 s, the
+# project in about 15 minutes and the suite in about 32 minutes (the slowest test, a whole
+# training through the CLI, about 19). Not run by CI, whose budget it would exceed; run it
+# before resolving a change to threading.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root="$(pwd)"

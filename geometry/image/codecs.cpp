@@ -160,6 +160,15 @@ void jpegErrorExit(j_common_ptr c) {
 }
 void jpegSilence(j_common_ptr, int) {}
 
+// libjpeg's errors as a longjmp to err.jump, the message kept in *message; no warnings.
+jpeg_error_mgr* jpegErrors(JpegError& err, std::string* message) {
+  jpeg_std_error(&err.mgr);
+  err.mgr.error_exit = jpegErrorExit;
+  err.mgr.emit_message = jpegSilence;
+  err.message = message;
+  return &err.mgr;
+}
+
 struct JpegState {
   Image8 img;
   std::string error;
@@ -192,13 +201,12 @@ int exifOrientation(const std::uint8_t* p, std::size_t n) {
   return 1;
 }
 
-bool jpegDecodeInto(std::span<const std::uint8_t> file, JpegState& st) {
+// The decode (or with `header_only` the header and its EXIF orientation alone), under
+// libjpeg's longjmp: every object it changes lives in `st`.
+bool jpegDecodeInto(std::span<const std::uint8_t> file, JpegState& st, bool header_only = false) {
   jpeg_decompress_struct c;
   JpegError err;
-  c.err = jpeg_std_error(&err.mgr);
-  err.mgr.error_exit = jpegErrorExit;
-  err.mgr.emit_message = jpegSilence;
-  err.message = &st.error;
+  c.err = jpegErrors(err, &st.error);
   if (setjmp(err.jump)) {
     jpeg_destroy_decompress(&c);
     return false;
@@ -209,6 +217,10 @@ bool jpegDecodeInto(std::span<const std::uint8_t> file, JpegState& st) {
   jpeg_read_header(&c, TRUE);
   for (jpeg_saved_marker_ptr m = c.marker_list; m; m = m->next)
     if (m->marker == JPEG_APP0 + 1) st.orientation = exifOrientation(m->data, m->data_length);
+  if (header_only) {
+    jpeg_destroy_decompress(&c);
+    return true;
+  }
   if (c.jpeg_color_space == JCS_CMYK || c.jpeg_color_space == JCS_YCCK) {
     st.error = "a CMYK JPEG (convert it to RGB)";
     jpeg_destroy_decompress(&c);
@@ -259,10 +271,7 @@ struct JpegWriteState {
 bool jpegEncodeInto(const Image8& img, int quality, JpegWriteState& st) {
   jpeg_compress_struct c;
   JpegError err;
-  c.err = jpeg_std_error(&err.mgr);
-  err.mgr.error_exit = jpegErrorExit;
-  err.mgr.emit_message = jpegSilence;
-  err.message = &st.error;
+  c.err = jpegErrors(err, &st.error);
   if (setjmp(err.jump)) {
     jpeg_destroy_compress(&c);
     return false;
@@ -318,25 +327,7 @@ std::optional<Image8> decodeJpeg(std::span<const std::uint8_t> file, bool exif_o
 
 int jpegExifOrientation(std::span<const std::uint8_t> file) {
   JpegState st;
-  std::string ignored;
-  jpeg_decompress_struct c;
-  JpegError err;
-  c.err = jpeg_std_error(&err.mgr);
-  err.mgr.error_exit = jpegErrorExit;
-  err.mgr.emit_message = jpegSilence;
-  err.message = &ignored;
-  if (setjmp(err.jump)) {
-    jpeg_destroy_decompress(&c);
-    return 1;
-  }
-  jpeg_create_decompress(&c);
-  jpeg_mem_src(&c, file.data(), static_cast<unsigned long>(file.size()));
-  jpeg_save_markers(&c, JPEG_APP0 + 1, 0xffff);
-  jpeg_read_header(&c, TRUE);
-  for (jpeg_saved_marker_ptr m = c.marker_list; m; m = m->next)
-    if (m->marker == JPEG_APP0 + 1) st.orientation = exifOrientation(m->data, m->data_length);
-  jpeg_destroy_decompress(&c);
-  return st.orientation;
+  return jpegDecodeInto(file, st, /*header_only=*/true) ? st.orientation : 1;
 }
 
 std::vector<std::uint8_t> encodePng(const Image8& img) {

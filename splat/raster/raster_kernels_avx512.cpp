@@ -7,18 +7,15 @@
 //   each block's two inputs and summing them in three later passes.
 // - compositeTilePair and backwardTilePair (residual supervision's two renders in one
 //   walk): the pair loops' Gaussian constants and the backward's nine gradient sums, which
-//   spill on AVX2's 16 registers, stay in registers. The pair backward lost on 32
-//   registers until 2026-11-27, late night (1.02-1.08x the AVX2 kernel's time): GCC built the select
-//   `gm ? G dL/dalpha : 0`, whose mask combines two compares, lane by lane in
-//   general-purpose registers (kmovw, shifts and cmov per lane) when it could use AVX-512's
-//   mask registers. The selects of backStep are now bitwise ands (maskOr0 in
-//   raster_kernels_impl.h, the same bits), and the pair backward on AVX-512VL takes
-//   0.75-0.78x the AVX2 kernel's time (bench train --residual, room360 256x192).
-// - backwardTile: since the lattice (G by products, forEachBlock) its nine gradient sums,
-//   the lattice's G, step and row factor and the Gaussian's constants outgrow AVX2's 16
-//   registers; on 32 the backward stage of bench train (room360 512x384) took 0.94-0.97x
-//   the AVX2 kernel's time (2026-11-27; before the lattice it gained nothing), and since
-//   maskOr0 less again.
+//   spill on AVX2's 16 registers, stay in registers. The selects of backStep are bitwise
+//   ands (maskOr0 in raster_kernels_impl.h, the same bits): written as `gm ? x : 0`, GCC
+//   builds their two-compare mask lane by lane in general-purpose registers instead of
+//   AVX-512's mask registers, and the kernel loses to AVX2's. The pair backward on
+//   AVX-512VL takes 0.75-0.78x the AVX2 kernel's time (bench train --residual, room360
+//   256x192).
+// - backwardTile: its nine gradient sums, the lattice's G, step and row factor and the
+//   Gaussian's constants outgrow AVX2's 16 registers; on 32 the backward stage of bench
+//   train (room360 512x384) takes 0.94-0.97x the AVX2 kernel's time.
 // Each value sees the same operations in the same order, so the outputs are bit-identical
 // to the AVX2 kernels' (tested: Fisher.Avx512WalkEqualsAvx2BitForBit,
 // FloatPath.Avx512BackwardEqualsAvx2BitForBit, SubsetPair.Avx512BackwardEqualsAvx2BitForBit,

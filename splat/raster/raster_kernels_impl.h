@@ -292,10 +292,9 @@ inline void tileSpan(std::int32_t span_lo, std::int32_t span_hi, int origin, int
 // half, max centre + widest half], plus 0.01 px for the centres' own rounding. One square
 // root per block row; empty (lo > hi) when no row of the block meets the ellipse. Loop
 // bounds only: the per-pixel test decides. L block rows per vector, with selects: one
-// row at a time in scalar code (before 2026-11-27; the same operations, so the same
-// bounds) it was a chain of conversions and compares per block row, about a tenth of the
-// backward kernel's cycles on room360 at 512x384, and with early returns its branches
-// mispredicted.
+// row at a time in scalar code (the same operations, so the same bounds) it would be a
+// chain of conversions and compares per block row, about a tenth of the backward
+// kernel's cycles on room360 at 512x384, with early returns whose branches mispredict.
 constexpr int kBlockRows = kTile / kBH;
 inline void blockRowSpans(const TileGaussian<float>& g, int x0, int y0, int rb0, int rbl, int c0, int c1, int* lo,
                           int* hi) {
@@ -621,8 +620,7 @@ void compositeTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1,
 // from a G that moves with the round count, cycling through [0.3, 0.8) so that every value
 // stays a normal float (offsets that grew without bound sent an earlier version of this
 // loop into denormal operands, whose assists made the "floor" 5-7 times slower than the
-// kernels' arithmetic); the checksum keeps the result alive. Before 2026-11-27 the floor
-// was evalLanes' exponent and exp2 per block, the kernels' arithmetic before the lattice.
+// kernels' arithmetic); the checksum keeps the result alive.
 float compositeFloor(long n) {
   ForwardBlock b[2];
   for (ForwardBlock& B : b) {
