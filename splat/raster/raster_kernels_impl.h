@@ -174,24 +174,18 @@ inline v4f rowOf(vf v, [[maybe_unused]] int half) {
 
 // a < b ? a : b and a > b ? a : b, lane by lane (b where unordered): one min/max
 // instruction where the target has it (GCC keeps a vector ternary as compare + blend).
-inline vf vmin(vf a, vf b) {
 #if SARESGS_KERNEL_FMA
-  return reinterpret_cast<vf>(_mm256_min_ps(reinterpret_cast<__m256>(a), reinterpret_cast<__m256>(b)));
+inline __m256 m256(vf v) { return reinterpret_cast<__m256>(v); }
+inline vf vmin(vf a, vf b) { return reinterpret_cast<vf>(_mm256_min_ps(m256(a), m256(b))); }
+inline vf vmax(vf a, vf b) { return reinterpret_cast<vf>(_mm256_max_ps(m256(a), m256(b))); }
 #elif defined(__SSE__) && SARESGS_KERNEL_LANES == 4
-  return reinterpret_cast<vf>(_mm_min_ps(reinterpret_cast<__m128>(a), reinterpret_cast<__m128>(b)));
+inline __m128 m128(vf v) { return reinterpret_cast<__m128>(v); }
+inline vf vmin(vf a, vf b) { return reinterpret_cast<vf>(_mm_min_ps(m128(a), m128(b))); }
+inline vf vmax(vf a, vf b) { return reinterpret_cast<vf>(_mm_max_ps(m128(a), m128(b))); }
 #else
-  return a < b ? a : b;
+inline vf vmin(vf a, vf b) { return a < b ? a : b; }
+inline vf vmax(vf a, vf b) { return a > b ? a : b; }
 #endif
-}
-inline vf vmax(vf a, vf b) {
-#if SARESGS_KERNEL_FMA
-  return reinterpret_cast<vf>(_mm256_max_ps(reinterpret_cast<__m256>(a), reinterpret_cast<__m256>(b)));
-#elif defined(__SSE__) && SARESGS_KERNEL_LANES == 4
-  return reinterpret_cast<vf>(_mm_max_ps(reinterpret_cast<__m128>(a), reinterpret_cast<__m128>(b)));
-#else
-  return a > b ? a : b;
-#endif
-}
 
 // The square root lane by lane (correctly rounded, as std::sqrt).
 inline vf vsqrt(vf a) {
