@@ -204,7 +204,7 @@ CLI::App* addActiveOptions(CLI::App& app, const std::shared_ptr<ActiveArgs>& a) 
                   "GB this run may use: refused before it starts if its images and initial models do not fit, the "
                   "models capped to fit (default: refused only beyond what the machine has available)")
       ->check(CLI::Range(0.001, 1e6));
-  addSettingFlags(sub, a->settings);
+  addSettingFlags(sub, a->settings, activeSettingFields());
   sub->add_option("--replay", a->replay,
                   "Fixed order: train with this method's training on the views of another run's results.json, in their "
                   "order, instead of selecting (the paper's ablation)");

@@ -15,6 +15,7 @@
 #include "apps/memory_budget.h"
 #include "splat/bench/machine.h"
 #include "apps/progress.h"
+#include "apps/settings_flags.h"
 #include "apps/view_list.h"
 #include "geometry/scene/dataset_checks.h"
 #include "geometry/error.h"
@@ -26,6 +27,7 @@
 #include "splat/raster_execution.h"
 #include "splat/train/schedule.h"
 #include "splat/train/test_renders.h"
+#include "splat/train/train_settings.h"
 #include "splat/train/trainer.h"
 
 namespace saresgs::apps {
@@ -34,17 +36,17 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// Where the training reads and writes, beside its settings (splat/train/train_settings.h).
 struct TrainArgs {
   std::string dataset, out;
   int iterations = 3000;
   int downscale = 1;
-  int threads = 0;
   int checkpoint_every = 1000;
   bool resume = false;
-  std::string ranking = "both", views, background;
-  double schedule_scale = 1.0;
-  TrainerOptions opt;
+  std::string views, background;
   std::optional<double> memory_budget_gb;
+  TrainSettings settings;
+  TrainerOptions opt;  // made from `settings` when the command runs
 };
 
 std::string shortCount(std::size_t n) {
@@ -57,15 +59,13 @@ std::string shortCount(std::size_t n) {
 }
 
 int runTrain(TrainArgs& a) {
-  const auto thread_limit = limitThreads(a.threads);
-  a.opt.raster.execution.threads = a.threads;
-  a.opt.residual.ranking = parseUncertaintyRanking(a.ranking);
+  const auto thread_limit = limitThreads(a.settings.threads);
+  a.opt = trainerOptionsFrom(a.settings);
   DatasetOptions dopt;
   dopt.load.downscale = a.downscale;
   if (!a.background.empty()) dopt.background = parseBackground(a.background, "--background");
   const Scene scene = loadDataset(a.dataset, dopt);
   std::cerr << formatWarnings(checkDataset(scene, a.opt.raster.near_plane)) << backgroundWarning(scene);
-  if (a.schedule_scale != 1.0) a.opt = scaledSchedule(a.opt, a.schedule_scale);
   const std::vector<int> views = a.views.empty() ? scene.train : parseTrainViews(a.views, scene, "--views");
   fs::create_directories(a.out);
   if (const int n = removeStaleTemporaries(a.out))
@@ -132,6 +132,7 @@ int runTrain(TrainArgs& a) {
   j["ssim"] = ev.ssim;
   j["gaussians"] = trainer.gaussians().size();
   j["max_gaussians"] = a.opt.densify.max_gaussians;
+  j["settings"] = trainSettingsJson(a.settings);
   j["memory"] = {{"estimate_at_start_bytes", memory.bytesFor(initial)},
                  {"estimate_at_end_bytes", memory.bytesFor(trainer.gaussians().size())},
                  {"budget_bytes", budget},
@@ -170,29 +171,14 @@ void addTrainCommand(CLI::App& app, Action& action) {
   addRanged(sub, "--iterations", a->iterations, "Training iterations", 1, 10000000);
   addRanged(sub, "--downscale", a->downscale, "Image downscale factor", 1, 64);
   sub->add_option("--background", a->background, kBackgroundHelp)->check(backgroundValue());
-  addRanged(sub, "--sh-degree", a->opt.max_sh_degree, "Maximum SH degree", 0, 3);
-  sub->add_option("--seed", a->opt.seed, "Random seed")->check(wholeNumberAtLeast(0))->capture_default_str();
-  sub->add_option("--threads", a->threads, "Threads (0: all cores)")->check(CLI::Range(0, 1024));
-  sub->add_option("--densify-until", a->opt.densify.until_iter, "Last densification iteration")
-      ->check(wholeNumberAtLeast(0))
-      ->capture_default_str();
-  addRanged(sub, "--max-gaussians", a->opt.densify.max_gaussians, "Cap on the model size (0: none)", 0.0, 1e9);
+  addSettingFlags(sub, a->settings, trainSettingFields());
   sub->add_option("--memory-budget", a->memory_budget_gb,
                   "GB this run may use: refused before it starts if its images and initial model do not fit, the model "
                   "capped to fit (default: refused only beyond what the machine has available)")
       ->check(CLI::Range(0.001, 1e6));
-  addRanged(sub, "--random-init", a->opt.random_init_points, "Random points when the dataset has none", 1, 10000000);
-  sub->add_flag("--residual", a->opt.residual.enabled, "Add SA-ResGS residual supervision");
   sub->add_option("--views", a->views,
                   "Train on these train views only, in this order (indices or image names, comma-separated; e.g. an "
                   "active run's selected_views to refit them)");
-  addRanged(sub, "--schedule-scale", a->schedule_scale,
-            "Scale the densification, opacity-reset and SH schedules (the quick preset's is 0.25)", 1e-4, 1e4);
-  addRanged(sub, "--residual-alpha", a->opt.residual.alpha, "Random fraction of G_sub", 0.0, 1.0);
-  addRanged(sub, "--residual-beta", a->opt.residual.beta, "Uncertain fraction of G_sub", 0.0, 1.0);
-  sub->add_option("--residual-ranking", a->ranking, "both | opacity | scale | random")
-      ->check(CLI::IsMember({"both", "opacity", "scale", "random"}))
-      ->capture_default_str();
   sub->add_option("--checkpoint-every", a->checkpoint_every, "Iterations between checkpoints (0: none)")
       ->check(wholeNumberAtLeast(0))
       ->capture_default_str();

@@ -19,18 +19,18 @@ namespace {
 using S = ActiveSettings;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-std::vector<SettingField> makeFields() {
-  std::vector<SettingField> f;
-  auto add = [&](std::string name, SettingMember m, std::string help) -> SettingField& {
-    SettingField r;
+std::vector<ActiveSettingField> makeFields() {
+  std::vector<ActiveSettingField> f;
+  auto add = [&](std::string name, SettingMember<S> m, std::string help) -> ActiveSettingField& {
+    ActiveSettingField r;
     r.name = std::move(name);
     r.member = m;
     r.help = std::move(help);
     f.push_back(std::move(r));
     return f.back();
   };
-  auto range = [](SettingField& r, double lo, double hi) { r.lo = lo, r.hi = hi; };
-  auto shown = [](SettingField& r, std::vector<std::string> choices = {}) {
+  auto range = [](ActiveSettingField& r, double lo, double hi) { r.lo = lo, r.hi = hi; };
+  auto shown = [](ActiveSettingField& r, std::vector<std::string> choices = {}) {
     r.show_default = true;
     r.choices = std::move(choices);
   };
@@ -102,125 +102,16 @@ std::vector<SettingField> makeFields() {
   return f;
 }
 
-std::string numberText(double v) {
-  std::ostringstream o;
-  o << v;
-  return o.str();
-}
-
-// The checks every number passes, whichever front end it came from.
-double checkedNumber(const SettingField& f, const nlohmann::json& v, bool whole, const std::string& label) {
-  if (!v.is_number() || (whole && !v.is_number_integer()))
-    throw InputError(label, "value",
-                     std::string("expected ") + (whole ? "a whole number" : "a number") + ", got " + v.dump());
-  const double x = v.get<double>();
-  if (!std::isfinite(x)) throw InputError(label, "value", "expected a finite number, got " + v.dump());
-  if (f.positive && !(x > 0)) throw InputError(label, "value", "expected a number > 0, got " + v.dump());
-  if (x < f.lo || x > f.hi)
-    throw InputError(label, "value",
-                     "expected " +
-                         (f.hi == kInf ? ">= " + numberText(f.lo)
-                                       : "a value in [" + numberText(f.lo) + ", " + numberText(f.hi) + "]") +
-                         ", got " + v.dump());
-  return x;
-}
-
-std::string checkedText(const SettingField& f, const nlohmann::json& v, const std::string& label) {
-  if (!v.is_string()) throw InputError(label, "value", "expected text, got " + v.dump());
-  const std::string t = v.get<std::string>();
-  if (!f.choices.empty()) {
-    bool ok = false;
-    std::string list;
-    for (const std::string& c : f.choices) {
-      ok = ok || c == t;
-      list += (list.empty() ? "" : " | ") + c;
-    }
-    if (!ok) throw InputError(label, "value", "expected " + list + ", got '" + t + "'");
-  }
-  return t;
-}
-
 }  // namespace
 
-const std::vector<SettingField>& activeSettingFields() {
-  static const std::vector<SettingField> fields = makeFields();
+const std::vector<ActiveSettingField>& activeSettingFields() {
+  static const std::vector<ActiveSettingField> fields = makeFields();
   return fields;
-}
-
-const SettingField* findActiveSetting(std::string_view name) {
-  for (const SettingField& f : activeSettingFields())
-    if (f.name == name) return &f;
-  return nullptr;
-}
-
-std::string settingFlag(const SettingField& f) {
-  std::string flag = f.name;
-  for (char& c : flag)
-    if (c == '_') c = '-';
-  const auto* b = std::get_if<bool S::*>(&f.member);
-  const bool on_by_default = b && ActiveSettings{}.**b;
-  return (on_by_default ? "--no-" : "--") + flag;
-}
-
-std::string settingLabel(const SettingField& f, SettingNaming naming) {
-  return naming == SettingNaming::kFlag ? settingFlag(f) : f.name;
-}
-
-void setActiveSetting(ActiveSettings& s, const SettingField& f, const nlohmann::json& v, SettingNaming naming) {
-  const std::string label = settingLabel(f, naming);
-  std::visit(
-      [&](auto member) {
-        using T = std::remove_reference_t<decltype(s.*member)>;
-        if constexpr (std::is_same_v<T, bool>) {
-          if (!v.is_boolean()) throw InputError(label, "value", "expected true or false, got " + v.dump());
-          s.*member = v.get<bool>();
-        } else if constexpr (std::is_same_v<T, std::string>) {
-          s.*member = checkedText(f, v, label);
-        } else if constexpr (std::is_same_v<T, std::optional<std::string>>) {
-          if (v.is_null())
-            s.*member = std::nullopt;
-          else
-            s.*member = checkedText(f, v, label);
-        } else if constexpr (std::is_same_v<T, Method>) {
-          s.*member = parseMethod(checkedText(f, v, label));
-        } else if constexpr (std::is_same_v<T, std::optional<double>>) {
-          if (v.is_null())
-            s.*member = std::nullopt;
-          else
-            s.*member = checkedNumber(f, v, false, label);
-        } else if constexpr (std::is_same_v<T, std::optional<int>> || std::is_same_v<T, std::optional<std::size_t>>) {
-          if (v.is_null())
-            s.*member = std::nullopt;
-          else
-            s.*member = static_cast<typename T::value_type>(checkedNumber(f, v, true, label));
-        } else {
-          s.*member = static_cast<T>(checkedNumber(f, v, true, label));
-        }
-      },
-      f.member);
-}
-
-nlohmann::json activeSettingsJson(const ActiveSettings& s) {
-  nlohmann::json j = nlohmann::json::object();
-  for (const SettingField& f : activeSettingFields())
-    std::visit(
-        [&](auto member) {
-          const auto& value = s.*member;
-          using T = std::remove_cv_t<std::remove_reference_t<decltype(value)>>;
-          if constexpr (std::is_same_v<T, Method>)
-            j[f.name] = toString(value);
-          else if constexpr (requires { value.has_value(); })
-            j[f.name] = value ? nlohmann::json(*value) : nlohmann::json(nullptr);
-          else
-            j[f.name] = value;
-        },
-        f.member);
-  return j;
 }
 
 ActiveOptions activeOptionsFrom(const ActiveSettings& s, const std::string& dataset, SettingNaming naming) {
   ActiveOptions o = presetOptions(parsePreset(s.preset));
-  o.method = s.method;
+  o.method = parseMethod(s.method);
   o.seed = s.seed;
   o.trainer.raster.execution.threads = s.threads;
   o.final_trainer.raster.execution.threads = s.threads;

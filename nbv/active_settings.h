@@ -5,28 +5,25 @@
 // activeOptionsFrom is the one place that turns settings into ActiveOptions, so the front
 // ends cannot drift apart. What only describes where a run reads and writes (the dataset,
 // the output folder, a checkpoint, the background, a replayed run) is not a setting.
-#include <nlohmann/json_fwd.hpp>
-
 #include <cstddef>
 #include <cstdint>
-#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
-#include <variant>
 #include <vector>
 
+#include "geometry/settings_table.h"
 #include "nbv/active_run.h"
 
 namespace saresgs {
 
 struct ActiveSettings {
   std::string preset = "quick";
-  Method method = Method::kAdaptive;
+  std::string method = "adaptive";  // a name of methodNames()
   std::uint64_t seed = 0;
   int threads = 0;  // 0: all cores
   std::optional<int> max_views, interval, min_iterations, final_iterations;
-  std::optional<std::size_t> max_gaussians;  // the loop's and the final fit's cap
+  std::optional<std::uint64_t> max_gaussians;  // the loop's and the final fit's cap
   bool plain_refit = true, final_residual = false;
   std::optional<double> fisher_lambda, gate_keep, path_variance_kappa, adaptive_clustering, hybrid_weight;
   bool continue_training = false;  // keep the model after each added view (no reset)
@@ -41,41 +38,21 @@ struct ActiveSettings {
   bool time_exhaustive_fisher = false;
 };
 
-// How a front end names a setting in its messages: `--max-views` or `max_views`.
-enum class SettingNaming { kFlag, kKeyword };
-
-using SettingMember =
-    std::variant<std::string ActiveSettings::*, Method ActiveSettings::*, std::uint64_t ActiveSettings::*,
-                 int ActiveSettings::*, bool ActiveSettings::*, std::optional<int> ActiveSettings::*,
-                 std::optional<std::size_t> ActiveSettings::*, std::optional<double> ActiveSettings::*,
-                 std::optional<std::string> ActiveSettings::*>;
-
-// One row of the table.
-struct SettingField {
-  std::string name;  // snake_case: the Python keyword and the results.json key
-  std::string help;
-  SettingMember member;
-  // Numbers: the closed range accepted (whole numbers for the integer members); `positive`
-  // asks > 0 instead of a lower bound.
-  double lo = -std::numeric_limits<double>::infinity(), hi = std::numeric_limits<double>::infinity();
-  bool positive = false;
-  std::vector<std::string> choices;  // text: the values accepted (empty: any; the options' parser checks)
-  bool show_default = false;         // --help shows the default (the others say "preset's" in their help)
-};
+using ActiveSettingField = SettingField<ActiveSettings>;
 
 // Every setting, in the order --help lists them.
-const std::vector<SettingField>& activeSettingFields();
-const SettingField* findActiveSetting(std::string_view name);
-// `--max-views` for `max_views`; `--no-plain-refit` for a switch that is on by default.
-std::string settingFlag(const SettingField& f);
-std::string settingLabel(const SettingField& f, SettingNaming naming);
-
-// Sets one field from a JSON value (what Python's keywords arrive as): checks its type, its
-// range and its choices, and throws InputError naming the setting otherwise. null empties
-// an optional setting.
-void setActiveSetting(ActiveSettings& s, const SettingField& f, const nlohmann::json& value, SettingNaming naming);
+const std::vector<ActiveSettingField>& activeSettingFields();
+inline const ActiveSettingField* findActiveSetting(std::string_view name) {
+  return findSetting(activeSettingFields(), name);
+}
+// Sets one setting from a JSON value (what Python's keywords arrive as): checks its type,
+// its range and its choices, and throws InputError naming the setting otherwise.
+inline void setActiveSetting(ActiveSettings& s, const ActiveSettingField& f, const nlohmann::json& value,
+                             SettingNaming naming) {
+  setSetting(s, f, value, naming);
+}
 // Every setting by name (null where left to the preset).
-nlohmann::json activeSettingsJson(const ActiveSettings& s);
+inline nlohmann::json activeSettingsJson(const ActiveSettings& s) { return settingsJson(s, activeSettingFields()); }
 
 // The preset's options with every setting given applied. Throws std::invalid_argument for
 // an unknown preset, InputError (named as `naming` says) for a bad prefilter setting.

@@ -43,10 +43,11 @@ from ._core import (  # noqa: F401,E402
     render,
     render_gradient,
     ssim,
+    train_settings,
 )
 
 __all__ = [
     "ActiveRun", "Camera", "Dataset", "Gaussians", "InputError", "SelectionContext", "Trainer",
     "active_settings", "coverage", "fisher_scores", "fvs_scores", "load_dataset", "loss_and_gradient", "make_scene",
-    "methods", "psnr", "render", "render_gradient", "ssim",
+    "methods", "psnr", "render", "render_gradient", "ssim", "train_settings",
 ]

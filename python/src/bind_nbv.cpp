@@ -25,8 +25,8 @@ namespace {
 
 py::object jsonToPython(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
 
-// A keyword's value as JSON (what the settings table checks); numpy scalars count as the
-// Python numbers they hold.
+}  // namespace
+
 nlohmann::json pythonToJson(const py::object& v, const std::string& name) {
   py::object plain = v;
   if (py::hasattr(v, "item") && py::hasattr(v, "dtype")) plain = v.attr("item")();
@@ -38,6 +38,8 @@ nlohmann::json pythonToJson(const py::object& v, const std::string& name) {
   }
 }
 
+namespace {
+
 // ActiveRun's docstring: its own arguments, then every setting of the table.
 const std::string& activeRunInitDoc() {
   static const std::string doc = [] {
@@ -47,7 +49,7 @@ const std::string& activeRunInitDoc() {
         "selection (method 'custom'); `checkpoint` names a checkpoint file written after every added view and resumed "
         "when present; background as load_dataset's (None: the dataset's own). The settings are `saresgs active`'s "
         "flags with underscores (the preset's value where not given):\n";
-    for (const SettingField& f : activeSettingFields()) d += "  " + f.name + ": " + f.help + "\n";
+    for (const auto& f : activeSettingFields()) d += "  " + f.name + ": " + f.help + "\n";
     return d;
   }();
   return doc;
@@ -148,15 +150,7 @@ struct PyActiveRun {
 void bindNbv(py::module_& m) {
   m.def("methods", &methodNames, "The built-in view-selection methods (`saresgs active --method`), plus custom.");
   m.def(
-      "active_settings",
-      [] {
-        const nlohmann::json defaults = activeSettingsJson(ActiveSettings{});
-        py::list out;
-        for (const SettingField& f : activeSettingFields())
-          out.append(py::dict(py::arg("name") = f.name, py::arg("flag") = settingFlag(f), py::arg("help") = f.help,
-                              py::arg("default") = jsonToPython(defaults.at(f.name)), py::arg("choices") = f.choices));
-        return out;
-      },
+      "active_settings", [] { return settingsList(activeSettingFields()); },
       "Every setting of an active run (ActiveRun's keywords, `saresgs active`'s flags, results.json's "
       "\"settings\"): a list of {name, flag, help, default (None: the preset's), choices}.");
 
@@ -315,16 +309,8 @@ void bindNbv(py::module_& m) {
              // The same table of settings as `saresgs active`'s flags, turned into options by
              // the same function (nbv/active_settings.h).
              ActiveSettings& settings = r->settings;
-             for (const auto& [key, value] : keywords) {
-               const std::string name = py::str(key);
-               const SettingField* f = findActiveSetting(name);
-               if (!f)
-                 throw py::type_error("ActiveRun: unknown keyword '" + name +
-                                      "' (saresgs.active_settings() lists the settings)");
-               setActiveSetting(settings, *f, pythonToJson(py::reinterpret_borrow<py::object>(value), name),
-                                SettingNaming::kKeyword);
-             }
-             if (!selector.is_none()) settings.method = Method::kCustom;
+             applyKeywords(settings, activeSettingFields(), keywords, "ActiveRun", "saresgs.active_settings()");
+             if (!selector.is_none()) settings.method = "custom";
              r->preset = settings.preset;
              ActiveOptions& o = r->opt;
              o = activeOptionsFrom(settings, dataset->source, SettingNaming::kKeyword);

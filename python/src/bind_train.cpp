@@ -5,6 +5,7 @@
 #include "splat/model_frame.h"
 #include "splat/ply.h"
 #include "splat/train/schedule.h"
+#include "splat/train/train_settings.h"
 #include "splat/thread_limit.h"
 #include "splat/train/trainer.h"
 
@@ -42,29 +43,26 @@ void checkViews(const Scene& s, const std::vector<int>& views) {
 }  // namespace
 
 void bindTrain(py::module_& m) {
+  m.def(
+      "train_settings", [] { return settingsList(trainSettingFields()); },
+      "Every setting of a training (Trainer's keywords, `saresgs train`'s flags, results.json's \"settings\"): a "
+      "list of {name, flag, help, default, choices}.");
   py::class_<Trainer>(m, "Trainer",
                       "3DGS training (3DGS's schedule, densification and Adam) on a dataset's views, from its SfM "
                       "points; optionally with SA-ResGS's residual supervision.")
-      .def(py::init([](const std::shared_ptr<Scene>& scene, std::uint64_t seed, double schedule_scale,
-                       std::size_t max_gaussians, int max_sh_degree, bool residual, int threads,
-                       const py::object& background) {
-             TrainerOptions o;
-             o.seed = seed;
-             o.max_sh_degree = max_sh_degree;
-             o.densify.max_gaussians = max_gaussians;
-             o.residual.enabled = residual;
-             o.raster.execution.threads = threads;
-             if (schedule_scale != 1.0) o = scaledSchedule(o, schedule_scale);
+      .def(py::init([](const std::shared_ptr<Scene>& scene, const py::object& background, const py::kwargs& keywords) {
+             // The same table as `saresgs train`'s flags (splat/train/train_settings.h).
+             TrainSettings settings;
+             applyKeywords(settings, trainSettingFields(), keywords, "Trainer", "saresgs.train_settings()");
+             const TrainerOptions o = trainerOptionsFrom(settings);
              const std::shared_ptr<Scene> dataset = withBackground(scene, background);
              py::gil_scoped_release nogil;
              return std::make_unique<Trainer>(*dataset, o);
            }),
-           py::arg("dataset"), py::arg("seed") = 0, py::arg("schedule_scale") = 1.0, py::arg("max_gaussians") = 0,
-           py::arg("max_sh_degree") = 3, py::arg("residual") = false, py::arg("threads") = 0,
-           py::arg("background") = py::none(),
-           "As `saresgs train`: schedule_scale scales the densification, opacity-reset and SH schedules (the quick "
-           "preset's is 0.25); max_gaussians caps the model (0: none); threads 0 uses every core; background as "
-           "load_dataset's (None: the dataset's own).")
+           py::arg("dataset"), py::kw_only(), py::arg("background") = py::none(),
+           "Trainer(dataset, *, background=None, **settings): the settings are `saresgs train`'s flags with "
+           "underscores (seed, max_sh_degree, schedule_scale, max_gaussians, residual, threads, ...; "
+           "saresgs.train_settings() lists them); background as load_dataset's (None: the dataset's own).")
       .def(
           "train",
           [](Trainer& t, const std::vector<int>& views, int iterations, py::object callback, int every) {

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "geometry/image/image.h"
+#include "geometry/settings_table.h"
 #include "geometry/scene/background.h"
 #include "geometry/scene/scene.h"
 
@@ -58,5 +59,35 @@ std::shared_ptr<Scene> withBackground(const std::shared_ptr<Scene>& dataset, con
 // Raises the pending Python exception (KeyboardInterrupt on Ctrl-C) in C++, so that a long
 // call stops at its next progress point. Call with the GIL held.
 void checkSignals();
+
+// A keyword's value as JSON (what a settings table checks); numpy scalars count as the
+// Python numbers they hold (bind_nbv.cpp).
+nlohmann::json pythonToJson(const py::object& v, const std::string& name);
+
+// Every keyword applied to `s` through its settings table (geometry/settings_table.h): a
+// name outside the table is a TypeError naming `lister` (the function that lists them), a
+// value outside its row an InputError naming the keyword.
+template <typename S>
+void applyKeywords(S& s, const std::vector<SettingField<S>>& table, const py::kwargs& keywords, const char* who,
+                   const char* lister) {
+  for (const auto& [key, value] : keywords) {
+    const std::string name = py::str(key);
+    const SettingField<S>* f = findSetting(table, name);
+    if (!f) throw py::type_error(std::string(who) + ": unknown keyword '" + name + "' (" + lister + " lists them)");
+    setSetting(s, *f, pythonToJson(py::reinterpret_borrow<py::object>(value), name), SettingNaming::kKeyword);
+  }
+}
+
+// A table's rows for Python: a list of {name, flag, help, default, choices}.
+template <typename S>
+py::list settingsList(const std::vector<SettingField<S>>& table) {
+  const nlohmann::json defaults = settingsJson(S{}, table);
+  py::list out;
+  for (const SettingField<S>& f : table)
+    out.append(py::dict(py::arg("name") = f.name, py::arg("flag") = settingFlag(f), py::arg("help") = f.help,
+                        py::arg("default") = py::module_::import("json").attr("loads")(defaults.at(f.name).dump()),
+                        py::arg("choices") = f.choices));
+  return out;
+}
 
 }  // namespace saresgs::python

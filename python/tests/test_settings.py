@@ -45,3 +45,19 @@ def test_numpy_numbers_count_as_the_numbers_they_hold(room):
     run = saresgs.ActiveRun(room, method="random", seed=np.int64(2), max_views=np.int32(6), gate_keep=np.float32(0.25),
                             threads=1)
     assert run.method == "random"
+
+
+def test_the_trainers_keywords_are_the_train_commands_flags(room):
+    settings = saresgs.train_settings()
+    help_text = run_cli("train", "--help").stdout
+    flags = set(re.findall(r"^\s+(--[a-z0-9-]+)", help_text, re.M))
+    assert {s["flag"] for s in settings} <= flags
+    by_name = {s["name"]: s for s in settings}
+    assert by_name["max_sh_degree"]["flag"] == "--sh-degree" and by_name["max_sh_degree"]["default"] == 3
+    t = saresgs.Trainer(room, seed=1, threads=1, densify_until=50, schedule_scale=0.5)
+    t.train(room.train[:3], 2)
+    assert t.iteration == 2
+    with pytest.raises(TypeError, match="sh_degree"):
+        saresgs.Trainer(room, sh_degree=2)
+    with pytest.raises(saresgs.InputError, match="max_sh_degree"):
+        saresgs.Trainer(room, max_sh_degree=4)

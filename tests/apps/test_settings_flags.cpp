@@ -21,7 +21,7 @@ saresgs::test::CommandResult activeWith(const std::string& flags) {
 }
 
 // A value the row accepts, as flag text; empty for a switch.
-std::string goodValue(const SettingField& f) {
+std::string goodValue(const ActiveSettingField& f) {
   if (!f.choices.empty()) return f.choices.back();
   if (std::holds_alternative<bool ActiveSettings::*>(f.member)) return "";
   if (std::holds_alternative<std::string ActiveSettings::*>(f.member)) {
@@ -34,7 +34,7 @@ std::string goodValue(const SettingField& f) {
 }
 
 TEST(SettingsFlags, EveryRowIsAFlagThatTakesWhatTheRowAllows) {
-  for (const SettingField& f : activeSettingFields()) {
+  for (const auto& f : activeSettingFields()) {
     const std::string v = goodValue(f);
     const auto r = activeWith(settingFlag(f) + (v.empty() ? "" : " '" + v + "'"));
     EXPECT_EQ(r.code, 1) << settingFlag(f) << " " << v << ": " << r.output;
@@ -44,9 +44,13 @@ TEST(SettingsFlags, EveryRowIsAFlagThatTakesWhatTheRowAllows) {
 }
 
 TEST(SettingsFlags, AValueOutsideTheRowIsRefusedNamingTheFlag) {
-  for (const auto& [flag, value] : std::vector<std::pair<std::string, std::string>>{
-           {"--max-views", "0"}, {"--gate-keep", "1.5"}, {"--fvs-metric", "manhattan"}, {"--threads", "-1"},
-           {"--seed", "-3"}, {"--method", "best"}, {"--fisher-lambda", "0"}}) {
+  for (const auto& [flag, value] : std::vector<std::pair<std::string, std::string>>{{"--max-views", "0"},
+                                                                                    {"--gate-keep", "1.5"},
+                                                                                    {"--fvs-metric", "manhattan"},
+                                                                                    {"--threads", "-1"},
+                                                                                    {"--seed", "-3"},
+                                                                                    {"--method", "best"},
+                                                                                    {"--fisher-lambda", "0"}}) {
     const auto r = activeWith(flag + " " + value);
     EXPECT_NE(r.code, 0) << flag << " " << value;
     EXPECT_NE(r.output.find(flag), std::string::npos) << r.output;

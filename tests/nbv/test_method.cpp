@@ -51,7 +51,7 @@ TEST(Method, UnknownNameListsTheChoices) {
 TEST(ActiveSettings, KeepThePresetWhereNothingIsGivenAndApplyWhatIs) {
   const ActiveOptions quick = presetOptions(Preset::kQuick);
   ActiveSettings s;
-  s.method = Method::kFisher;
+  s.method = "fisher";
   s.seed = 7;
   const ActiveOptions a = activeOptionsFrom(s);
   EXPECT_EQ(a.method, Method::kFisher);
