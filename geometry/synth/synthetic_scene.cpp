@@ -255,6 +255,17 @@ nlohmann::json toJson(const Eigen::Affine3f& T) {
 
 }  // namespace
 
+SyntheticOptions syntheticOptions(const std::string& layout, int width, int height, std::uint64_t seed,
+                                  int num_views) {
+  SyntheticOptions o;
+  o.layout = layout;
+  o.width = width;
+  o.height = height;
+  o.seed = seed;
+  o.num_views = num_views;
+  return o;
+}
+
 SyntheticScene makeSyntheticScene(const SyntheticOptions& opts) {
   if (opts.width <= 0 || opts.height <= 0)
     throw InputError(

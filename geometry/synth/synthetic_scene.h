@@ -110,4 +110,9 @@ class SyntheticScene {
 // Builds a scene; throws InputError for an unknown layout, unreadable mesh or texture.
 SyntheticScene makeSyntheticScene(const SyntheticOptions& opts);
 
+// `layout` rendered at width x height with `seed` and `num_views` views (0: the layout's
+// default count); everything else as SyntheticOptions has it (procedural meshes, textures).
+SyntheticOptions syntheticOptions(const std::string& layout, int width, int height, std::uint64_t seed = 0,
+                                  int num_views = 0);
+
 }  // namespace saresgs

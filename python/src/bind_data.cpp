@@ -232,12 +232,7 @@ void bindData(py::module_& m) {
   m.def(
       "make_scene",
       [](const std::string& layout, const std::string& out, int width, int height, std::uint64_t seed, int views) {
-        SyntheticOptions o;
-        o.layout = layout;
-        o.width = width;
-        o.height = height;
-        o.seed = seed;
-        o.num_views = views;
+        SyntheticOptions o = syntheticOptions(layout, width, height, seed, views);
         py::gil_scoped_release nogil;
         for (auto& mesh : o.meshes) mesh = resolveAsset(mesh);
         const SyntheticScene scene = makeSyntheticScene(o);
