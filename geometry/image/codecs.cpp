@@ -8,6 +8,8 @@
 #include <cstring>
 #include <memory>
 
+#include "geometry/io/byte_order.h"
+
 namespace saresgs {
 
 namespace {
@@ -181,12 +183,10 @@ int exifOrientation(const std::uint8_t* p, std::size_t n) {
   p += 6, n -= 6;
   const bool le = p[0] == 'I' && p[1] == 'I';
   if (!le && !(p[0] == 'M' && p[1] == 'M')) return 1;
-  auto u16 = [&](std::size_t at) -> unsigned { return le ? p[at] | p[at + 1] << 8 : p[at] << 8 | p[at + 1]; };
-  auto u32 = [&](std::size_t at) -> std::uint32_t {
-    return le ? std::uint32_t{p[at]} | std::uint32_t{p[at + 1]} << 8 | std::uint32_t{p[at + 2]} << 16 |
-                    std::uint32_t{p[at + 3]} << 24
-              : std::uint32_t{p[at]} << 24 | std::uint32_t{p[at + 1]} << 16 | std::uint32_t{p[at + 2]} << 8 | p[at + 3];
-  };
+  const std::endian order = le ? std::endian::little : std::endian::big;
+  const char* b = reinterpret_cast<const char*>(p);
+  auto u16 = [&](std::size_t at) -> unsigned { return byte_order::load<std::uint16_t>(b + at, order); };
+  auto u32 = [&](std::size_t at) { return byte_order::load<std::uint32_t>(b + at, order); };
   const std::uint32_t ifd = u32(4);
   if (ifd > n || n - ifd < 2) return 1;
   const unsigned entries = u16(ifd);
