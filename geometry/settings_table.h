@@ -45,6 +45,18 @@ struct SettingField : SettingRule {
   bool show_default = false;  // --help shows the default (the others say it in their help)
 };
 
+// Appends the row (name, member, help) to `table`; the caller sets its rule and flag on
+// the returned row before the next row is added.
+template <typename S>
+SettingField<S>& addSetting(std::vector<SettingField<S>>& table, std::string name, SettingMember<S> member,
+                            std::string help) {
+  SettingField<S>& r = table.emplace_back();
+  r.name = std::move(name);
+  r.member = member;
+  r.help = std::move(help);
+  return r;
+}
+
 // The checks of one value (what setSetting applies); InputError naming `label` otherwise.
 double checkedSettingNumber(const SettingRule& r, const nlohmann::json& v, bool whole, const std::string& label);
 std::string checkedSettingText(const SettingRule& r, const nlohmann::json& v, const std::string& label);

@@ -1,12 +1,7 @@
 #include "nbv/active_settings.h"
 
-#include <nlohmann/json.hpp>
+#include <limits>
 
-#include <cmath>
-#include <sstream>
-#include <stdexcept>
-
-#include "geometry/error.h"
 #include "nbv/method.h"
 #include "nbv/prefilter_options.h"
 #include "nbv/preset.h"
@@ -22,12 +17,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 std::vector<ActiveSettingField> makeFields() {
   std::vector<ActiveSettingField> f;
   auto add = [&](std::string name, SettingMember<S> m, std::string help) -> ActiveSettingField& {
-    ActiveSettingField r;
-    r.name = std::move(name);
-    r.member = m;
-    r.help = std::move(help);
-    f.push_back(std::move(r));
-    return f.back();
+    return addSetting(f, std::move(name), m, std::move(help));
   };
   auto range = [](ActiveSettingField& r, double lo, double hi) { r.lo = lo, r.hi = hi; };
   auto shown = [](ActiveSettingField& r, std::vector<std::string> choices = {}) {

@@ -13,14 +13,10 @@ std::vector<TrainSettingField> makeFields() {
   std::vector<TrainSettingField> f;
   auto add = [&](std::string name, SettingMember<S> m, std::string help, double lo, double hi,
                  bool shown = true) -> TrainSettingField& {
-    TrainSettingField r;
-    r.name = std::move(name);
-    r.member = m;
-    r.help = std::move(help);
+    TrainSettingField& r = addSetting(f, std::move(name), m, std::move(help));
     r.lo = lo, r.hi = hi;
     r.show_default = shown;
-    f.push_back(std::move(r));
-    return f.back();
+    return r;
   };
   constexpr double kInf = std::numeric_limits<double>::infinity();
   add("max_sh_degree", &S::max_sh_degree, "Maximum SH degree", 0, 3).flag = "--sh-degree";
