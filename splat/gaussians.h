@@ -15,11 +15,11 @@
 #include <cstddef>
 #include <vector>
 
+#include "splat/raster/constants.h"  // kShC0
+
 namespace saresgs {
 
 inline constexpr int shCoeffCount(int degree) { return (degree + 1) * (degree + 1); }
-// SH degree-0 basis constant: colour = SH_C0 * dc + 0.5 at degree 0.
-inline constexpr double kShC0 = 0.28209479177387814;
 
 // Templated on the scalar so that gradient tests can run the same code in double.
 template <typename T>

@@ -38,6 +38,7 @@
 #include "geometry/camera/camera.h"
 #include "geometry/image/image.h"
 #include "splat/gaussians.h"
+#include "splat/raster/constants.h"
 #include "splat/raster_execution.h"
 
 namespace saresgs {
@@ -59,11 +60,6 @@ struct RasterSettings {
   // included, is the same bit for bit.
   bool depth_and_contributors = true;
 };
-
-inline constexpr float kMinAlpha = 1.0f / 255.0f;
-inline constexpr float kMaxAlpha = 0.99f;
-inline constexpr float kMinTransmittance = 1e-4f;
-inline constexpr int kTileSize = 16;
 
 // Everything the forward pass knows that the backward pass needs (opaque to callers).
 template <typename T>

@@ -4,8 +4,7 @@
 //   g++ -std=c++20 -O3 -mavx2 -mfma -ffp-contract=off -DNDEBUG -I. \
 //       docs/experiments/forward_floor.cpp -o /tmp/forward_floor && /tmp/forward_floor
 //
-// It compiles splat/raster/raster_kernels_impl.h (the AVX2 eight-lane kernels) into its own
-// namespace and times, in ns per evaluated pixel lane:
+// It compiles splat/raster/raster_kernels_impl.h with the AVX2 options (Avx2Isa) and times, in ns per evaluated pixel lane:
 //   reg2  - compositeFloor: the kernel's per-lane arithmetic on two blocks held in registers
 //           (since the lattice of 2026-11-27 this is the lattice's arithmetic, G by products;
 //           the exponent and exp2 per block that the numbers in docs/DECISIONS.md
@@ -21,12 +20,15 @@
 #include <random>
 #include <vector>
 
-#define SARESGS_KERNEL_NS floorexp
-#define SARESGS_KERNEL_LANES 8
-#define SARESGS_KERNEL_FMA 1
+#include "splat/raster/raster_kernels.h"
+
+namespace saresgs::raster_kernels {
+using KernelIsa = Avx2Isa;
+}
+
 #include "splat/raster/raster_kernels_impl.h"
 
-namespace saresgs::raster_kernels::floorexp {
+namespace saresgs::raster_kernels {
 // compositeFloor's loop (raster_kernels_impl.h), its constants and per-lane work, with the
 // blocks' state in a tile's ForwardState instead of registers.
 __attribute__((noinline)) float memoryFloor(long n, int blocks) {
@@ -41,7 +43,7 @@ __attribute__((noinline)) float memoryFloor(long n, int blocks) {
     for (int k = 0; k < blocks; ++k) {
       ForwardBlock& B = F.b[k];
       const Lanes lanes = evalLanes(dx + vs(static_cast<float>(4 * (k & 1))), ha, qy, by, o, hx, all);
-      ForwardState::step(B, lanes, colour[0], colour[1], colour[2], vs(2.0f), vs(1.0f));
+      ForwardState::step<false>(B, lanes, colour[0], colour[1], colour[2], vs(2.0f), vs(1.0f));
       B.Tr = vmax(B.Tr, vs(0.5f));
     }
   }
@@ -55,9 +57,9 @@ long evaluatedLanes(const std::vector<TileGaussian<float>>& q) {
   for (const auto& g : q) forEachBlock(g, 0, 0, kTile, kTile, [&](int, const Lanes&, vf) { n += L; });
   return n;
 }
-}  // namespace saresgs::raster_kernels::floorexp
+}  // namespace saresgs::raster_kernels
 
-using namespace saresgs::raster_kernels::floorexp;
+using namespace saresgs::raster_kernels;
 using Clock = std::chrono::steady_clock;
 
 static double seconds(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }

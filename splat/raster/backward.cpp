@@ -52,7 +52,7 @@ void chainSlots(const GaussiansT<T>& g, const Camera& cam, const RasterStateT<T>
           },
           [&]([[maybe_unused]] const std::uint32_t* list, [[maybe_unused]] int listed) {
             if constexpr (std::is_same_v<T, float>)
-              kKernelSets[st.isa].project_backward(pin, list, listed, st.proj.data(), list_dP, pout);
+              st.kernels->project_backward(pin, list, listed, st.proj.data(), list_dP, pout);
           });
     });
   });
@@ -86,7 +86,7 @@ void backwardSlots<float>(const RasterStateT<float>& st, int W, int H, const flo
   const RasterSettings& rs = st.settings;
   const float bg[3] = {rs.background[0], rs.background[1], rs.background[2]};
   const raster_kernels::BackwardIn in{W, st.final_T.data(), st.n_walked.data(), dL_drgb};
-  const raster_kernels::BackwardFn kernel = kKernelSets[st.isa].backward;
+  const raster_kernels::BackwardFn kernel = st.kernels->backward;
   forEachTile(st, W, H, [&](int tile, const std::vector<TileGaussian<float>>& q, int x0, int y0, int x1, int y1) {
     if (q.empty()) return;
     kernel(q.data(), static_cast<int>(q.size()), x0, y0, x1, y1, bg, in,

@@ -7,6 +7,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -26,6 +27,9 @@ tbb::task_arena& arena(int threads) {
   return *a;
 }
 
+namespace {
+
+// The index of `kernels` among baseline (0), avx2 (1) and avx512 (2).
 int kernelIndex(RasterKernels kernels) {
   switch (kernels) {
     case RasterKernels::kBaseline:
@@ -61,6 +65,39 @@ int kernelIndex(RasterKernels kernels) {
   return index;
 }
 
+// AVX2's kernel set with the walks compiled for AVX-512VL (raster_kernels_avx512.cpp), or
+// null when this build lacks either.
+const raster_kernels::KernelSet* avx512Set() {
+  using raster_kernels::KernelSet;
+  static const std::optional<KernelSet> set = []() -> std::optional<KernelSet> {
+    if (!raster_kernels::CompiledKernels<raster_kernels::Avx2Isa>::set ||
+        !raster_kernels::CompiledKernels<raster_kernels::Avx512Isa>::set)
+      return std::nullopt;
+    KernelSet s = *raster_kernels::CompiledKernels<raster_kernels::Avx2Isa>::set;
+    const KernelSet& w = *raster_kernels::CompiledKernels<raster_kernels::Avx512Isa>::set;
+    s.name = w.name;
+    s.backward = w.backward;
+    s.fisher = w.fisher;
+    s.composite_pair = w.composite_pair;
+    s.backward_pair = w.backward_pair;
+    return s;
+  }();
+  return set ? &*set : nullptr;
+}
+
+}  // namespace
+
+const raster_kernels::KernelSet& kernelSet(RasterKernels kernels) {
+  switch (kernelIndex(kernels)) {
+    case 1:
+      return *raster_kernels::CompiledKernels<raster_kernels::Avx2Isa>::set;
+    case 2:
+      return *avx512Set();
+    default:
+      return *raster_kernels::CompiledKernels<raster_kernels::BaselineIsa>::set;
+  }
+}
+
 }  // namespace raster_execution
 
 std::optional<RasterKernels> parseRasterKernels(std::string_view name) {
@@ -73,8 +110,8 @@ std::optional<RasterKernels> parseRasterKernels(std::string_view name) {
 
 bool rasterCpuHasAvx2() {
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-  static const bool has =
-      raster_kernels::avx2::compiled() && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  static const bool has = raster_kernels::CompiledKernels<raster_kernels::Avx2Isa>::set &&
+                          __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
   return has;
 #else
   return false;
@@ -83,7 +120,7 @@ bool rasterCpuHasAvx2() {
 
 bool rasterCpuHasAvx512() {
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-  static const bool has = rasterCpuHasAvx2() && raster_kernels::avx512::compiled() &&
+  static const bool has = rasterCpuHasAvx2() && raster_kernels::CompiledKernels<raster_kernels::Avx512Isa>::set &&
                           __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl");
   return has;
 #else
@@ -92,12 +129,9 @@ bool rasterCpuHasAvx512() {
 }
 
 double rasterForwardFloorNsPerPair(const RasterExecution& e, double seconds) {
-  const int isa = raster_execution::kernelIndex(e.kernels);
-  auto run = [isa](long n) {
-    // avx512's forward kernel is avx2's.
-    return isa >= 1 ? raster_kernels::avx2::compositeFloor(n) : raster_kernels::base4::compositeFloor(n);
-  };
-  const int lanes = isa >= 1 ? 8 : 4;
+  const raster_kernels::KernelSet& kernels = raster_execution::kernelSet(e.kernels);
+  const raster_kernels::CompositeFloorFn run = kernels.composite_floor;  // avx512's is avx2's
+  const int lanes = kernels.lanes;
   volatile float sink = run(1000);  // warm up
   // Doubles the rounds until one timing lasts `seconds`, then takes the best of three.
   long n = 1 << 14;

@@ -7,13 +7,6 @@
 namespace saresgs::raster_stage {
 namespace {
 
-// FisherRF's squared gradients in float: the SIMD tile kernels give per-pair moments
-// (raster_kernels::FisherMoment), reduced per Gaussian in slot order, in double, and
-// turned into squared parameter gradients with the Gaussian's Jacobian. Indexed like
-// kKernelSets (raster_execution::kernelIndex).
-constexpr raster_kernels::FisherFn kFisherKernels[] = {
-    raster_kernels::base4::fisherTile, raster_kernels::avx2::fisherTile, raster_kernels::avx512::fisherTile};
-
 // A slot buffer of at least `size` floats, not cleared, taken from a process-wide pool
 // and given back when the lease ends. A fresh buffer per view (the selector runs one per
 // candidate) cost its page faults and clearing, as much as the kernels' own work; the
@@ -56,7 +49,7 @@ void fisherMoments(const RasterStateT<float>& st, int W, int H, float* slots) {
   const RasterSettings& rs = st.settings;
   const float bg[3] = {rs.background[0], rs.background[1], rs.background[2]};
   const raster_kernels::FisherIn in{W, st.final_T.data(), st.n_walked.data()};
-  const raster_kernels::FisherFn kernel = kFisherKernels[st.isa];
+  const raster_kernels::FisherFn kernel = st.kernels->fisher;
   forEachTile(st, W, H, [&](int tile, const std::vector<TileGaussian<float>>& q, int x0, int y0, int x1, int y1) {
     if (q.empty()) return;
     kernel(q.data(), static_cast<int>(q.size()), x0, y0, x1, y1, bg, in,
@@ -100,7 +93,7 @@ void squaredGradientsFloat(const Gaussians& g, const Camera& cam, const RenderOu
             }
           },
           [&](const std::uint32_t* list, int listed) {
-            kKernelSets[st.isa].fisher_chain(pin, list, listed, st.proj.data(), mo, out);
+            st.kernels->fisher_chain(pin, list, listed, st.proj.data(), mo, out);
           });
     });
   });
@@ -167,9 +160,8 @@ void fisherChainFloat(const Gaussians& g, const Camera& cam, const RasterSetting
   beginState(st, s, g.max_sh_degree, cam.K.width, cam.K.height);
   const CameraT<float> camT(cam, s.guard_band);
   const FloatEnvGuard fenv;
-  kKernelSets[st.isa].fisher_chain(projectInput(g, camT, st.settings), idx.data(), static_cast<int>(idx.size()),
-                                   proj.data(), moments.data(),
-                                   {sq.means.data(), sq.log_scales.data(), sq.opacities.data(), sq.sh.data()});
+  st.kernels->fisher_chain(projectInput(g, camT, st.settings), idx.data(), static_cast<int>(idx.size()), proj.data(),
+                           moments.data(), {sq.means.data(), sq.log_scales.data(), sq.opacities.data(), sq.sh.data()});
 }
 
 template <typename T>

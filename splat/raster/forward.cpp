@@ -161,7 +161,7 @@ RenderOutputT<float> fromRenderResult(RenderResult& r) {
 
 namespace {
 
-// Composites every tile front to back (float: the SIMD kernels of st.isa) into `out`,
+// Composites every tile front to back (float: the SIMD kernels of st.kernels) into `out`,
 // keeping each pixel's final transmittance and walk length for the backward pass.
 template <typename T>
 void compositeTiles(int W, int H, RasterStateT<T>& st, RenderOutputT<T>& out) {
@@ -183,7 +183,7 @@ void compositeTiles(int W, int H, RasterStateT<T>& st, RenderOutputT<T>& out) {
   forEachTile(st, W, H, [&](int, const std::vector<TileGaussian<T>>& q, int x0, int y0, int x1, int y1) {
     if constexpr (std::is_same_v<T, float>) {
       const raster_kernels::ForwardOut fo = forwardOut(W, out, st.final_T.data(), st.n_walked.data());
-      kKernelSets[st.isa].composite(q.data(), static_cast<int>(q.size()), x0, y0, x1, y1, bg, fo);
+      st.kernels->composite(q.data(), static_cast<int>(q.size()), x0, y0, x1, y1, bg, fo);
     } else {
       compositeTile(q, x0, y0, x1, y1, bg, W, out, st);
     }
@@ -203,9 +203,7 @@ void compositeTiles(int W, int H, RasterStateT<T>& st, RenderOutputT<T>& out) {
 namespace saresgs {
 using namespace raster_stage;
 
-const char* rasterKernelName(const RasterExecution& e) {
-  return kKernelSets[raster_execution::kernelIndex(e.kernels)].name;
-}
+const char* rasterKernelName(const RasterExecution& e) { return raster_execution::kernelSet(e.kernels).name; }
 
 // The forward pass into `out`, whose buffers (and state, when unshared) are reused: every
 // array is refilled with assign/resize, so the result is the same as into an empty

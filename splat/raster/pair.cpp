@@ -15,22 +15,6 @@ struct SubsetRasterState {
   std::vector<std::uint32_t> n_walked;        // per pixel: full-list entries walked
 };
 
-namespace {
-
-struct PairKernelSet {
-  raster_kernels::CompositePairFn composite;
-  raster_kernels::BackwardPairFn backward;
-};
-// Indexed like kKernelSets (raster_execution::kernelIndex).
-constexpr PairKernelSet kPairKernelSets[] = {
-    {raster_kernels::base4::compositeTilePair, raster_kernels::base4::backwardTilePair},
-    {raster_kernels::avx2::compositeTilePair, raster_kernels::avx2::backwardTilePair},
-    // avx512: both on 32 registers (raster_kernels_avx512.cpp).
-    {raster_kernels::avx512::compositeTilePair, raster_kernels::avx512::backwardTilePair},
-};
-
-}  // namespace
-
 using namespace raster_stage;
 
 void rasterizeWithSubset(const Gaussians& g, const Camera& cam, const RasterSettings& s,
@@ -71,7 +55,7 @@ void rasterizeWithSubset(const Gaussians& g, const Camera& cam, const RasterSett
   const float bg[3] = {s.background[0], s.background[1], s.background[2]};
   const raster_kernels::ForwardOut fo_full = forwardOut(W, full, st->final_T.data(), st->n_walked.data());
   const raster_kernels::ForwardOut fo_sub = forwardOut(W, sub, ss->final_T.data(), ss->n_walked.data());
-  const raster_kernels::CompositePairFn kernel = kPairKernelSets[st->isa].composite;
+  const raster_kernels::CompositePairFn kernel = st->kernels->composite_pair;
   forEachTile(*st, W, H, [&](int tile, const std::vector<TileGaussian<float>>& q, int x0, int y0, int x1, int y1) {
     kernel(q.data(), ss->entry_in_subset.data() + st->tile_start[tile], static_cast<int>(q.size()), x0, y0, x1, y1, bg,
            fo_full, fo_sub);
@@ -113,7 +97,7 @@ void rasterizeBackwardWithSubset(const Gaussians& g, const Camera& cam, const Ra
   const float bg[3] = {rs.background[0], rs.background[1], rs.background[2]};
   const raster_kernels::BackwardIn in_full{W, st.final_T.data(), st.n_walked.data(), dL_drgb_full.data.data()};
   const raster_kernels::BackwardIn in_sub{W, ss.final_T.data(), ss.n_walked.data(), dL_drgb_subset.data.data()};
-  const raster_kernels::BackwardPairFn kernel = kPairKernelSets[st.isa].backward;
+  const raster_kernels::BackwardPairFn kernel = st.kernels->backward_pair;
   forEachTile(st, W, H, [&](int tile, const std::vector<TileGaussian<float>>& q, int x0, int y0, int x1, int y1) {
     if (q.empty()) return;
     const std::uint32_t b = st.tile_start[tile];

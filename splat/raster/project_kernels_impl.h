@@ -1,8 +1,6 @@
 // The projection kernels (rules 1-5, splat/raster/raster_kernels.h's projectRange):
-// projection::project<float> with the opacity-aware extent, SARESGS_KERNEL_LANES Gaussians
-// at a time. Included right after splat/raster/raster_kernels_impl.h in the same
-// translation unit, with the same SARESGS_KERNEL_NS / SARESGS_KERNEL_LANES, and uses its
-// vector types.
+// projection::project<float> with the opacity-aware extent, KernelIsa::kLanes Gaussians
+// at a time, on splat/raster/raster_kernels_impl.h's vector types.
 //
 // Bit for bit project<float>: every lane runs project()'s operations in its order, each
 // correctly rounded (no FMA contraction here or there; sqrt and division are IEEE in both),
@@ -11,13 +9,11 @@
 // scalar code calls them. Where project() returns early (a cull) a lane carries on with
 // the values it has and ends with visible = false. Tests: ProjectKernels.*
 // (tests/splat/raster/test_project_kernels.cpp).
-#if !defined(SARESGS_KERNEL_NS) || !defined(SARESGS_KERNEL_LANES)
-#error "include raster_kernels_impl.h (with its macros) before project_kernels_impl.h"
-#endif
-
+#pragma once
+#include "splat/raster/raster_kernels_impl.h"
 #include "splat/raster/sh_constants.h"
 
-namespace saresgs::raster_kernels::SARESGS_KERNEL_NS {
+namespace saresgs::raster_kernels {
 namespace {
 
 // libm's expf and logf lane by lane (the scalar path's own calls).
@@ -39,7 +35,7 @@ inline vi finiteLanes(vf v) { return absLanes(v) <= vs(3.40282347e+38f); }
 // std::max(T(0), v): 0 < v ? v : 0 (NaN gives 0).
 inline vf maxZeroLanes(vf v) { return vs(0.0f) < v ? v : vs(0.0f); }
 
-constexpr float kProjShC0 = 0.28209479177387814f;  // splat/gaussians.h's kShC0 (raster_kernels_base.cpp checks)
+constexpr float kProjShC0 = static_cast<float>(kShC0);  // splat/raster/constants.h
 
 // The L Gaussians of a vector: their indices (a short last vector repeats its last
 // Gaussian; only the first n lanes are written back) and per-lane loads of their arrays.
@@ -242,8 +238,6 @@ inline vi inFrustum(const ProjectIn& in, const LaneSet& ls) {
 // Rules 1-5 for the Gaussians listed in ls (its first ls.n lanes written to out).
 void projectLanes(const ProjectIn& in, const LaneSet& ls, projection::Projected<float>* out);
 
-}  // namespace
-
 // Two passes per block of up to kProjectBlock Gaussians: the frustum test for all, then
 // the whole projection for those it keeps, gathered eight at a time (most of a room's
 // Gaussians are outside a view's frustum, and a lane computes its Gaussian's every value
@@ -273,8 +267,6 @@ void projectRange(const ProjectIn& in, std::size_t begin, std::size_t end, proje
     }
   }
 }
-
-namespace {
 
 void projectLanes(const ProjectIn& in, const LaneSet& ls, projection::Projected<float>* out) {
   const std::size_t stride = static_cast<std::size_t>(in.sh_stride);
@@ -350,8 +342,6 @@ void projectLanes(const ProjectIn& in, const LaneSet& ls, projection::Projected<
     }
   }
 }
-
-}  // namespace
 
 // projectBackward<float> (projection.h: backwardFrame, then colorBackward, conicBackward,
 // mean2dBackward, cameraToMean, scaleBackward and the rotation) for L Gaussians at a time,
@@ -626,4 +616,5 @@ void fisherChainList(const ProjectIn& in, const std::uint32_t* idx, int count, c
   }
 }
 
-}  // namespace saresgs::raster_kernels::SARESGS_KERNEL_NS
+}  // namespace
+}  // namespace saresgs::raster_kernels

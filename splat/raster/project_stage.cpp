@@ -36,10 +36,11 @@ raster_kernels::ProjectIn projectInput(const GaussiansT<float>& g, const CameraT
   return in;
 }
 
-void projectRangeWith(const GaussiansT<float>& g, const CameraT<float>& camT, const RasterSettings& rs, int isa,
-                      std::size_t begin, std::size_t end, Projected<float>* out) {
+void projectRangeWith(const GaussiansT<float>& g, const CameraT<float>& camT, const RasterSettings& rs,
+                      const raster_kernels::KernelSet& kernels, std::size_t begin, std::size_t end,
+                      Projected<float>* out) {
   if (rs.extent == ExtentRule::kOpacityAware) {
-    kKernelSets[isa].project(projectInput(g, camT, rs), begin, end, out);
+    kernels.project(projectInput(g, camT, rs), begin, end, out);
     return;
   }
   for (std::size_t i = begin; i < end; ++i) out[i] = projection::project(g, i, camT, rs);
@@ -62,7 +63,8 @@ void projectAll(const GaussiansT<T>& g, const CameraT<T>& camT, std::span<const 
       const FloatEnvGuard fenv;  // geometry/float_env.h
       // Float: the SIMD projection of the render's kernel set, bit for bit project()'s
       // (ProjectKernels.*); masked Gaussians are projected and then cleared.
-      if constexpr (std::is_same_v<T, float>) projectRangeWith(g, camT, rs, st.isa, r.begin(), r.end(), st.proj.data());
+      if constexpr (std::is_same_v<T, float>)
+        projectRangeWith(g, camT, rs, *st.kernels, r.begin(), r.end(), st.proj.data());
       for (std::size_t i = r.begin(); i < r.end(); ++i) {
         if (!mask.empty() && !mask[i]) {
           st.proj[i] = Projected<T>{};
@@ -117,7 +119,7 @@ void projectRangeFloat(const GaussiansT<float>& g, const Camera& cam, const Rast
   const CameraT<float> camT(cam, s.guard_band);
   out.resize(g.size());
   const FloatEnvGuard fenv;
-  projectRangeWith(g, camT, st.settings, st.isa, begin, end, out.data());
+  projectRangeWith(g, camT, st.settings, *st.kernels, begin, end, out.data());
 }
 
 void projectBackwardFloat(const GaussiansT<float>& g, const Camera& cam, const RasterSettings& s,
@@ -128,7 +130,7 @@ void projectBackwardFloat(const GaussiansT<float>& g, const Camera& cam, const R
   beginState(st, s, g.max_sh_degree, cam.K.width, cam.K.height);
   const CameraT<float> camT(cam, s.guard_band);
   const FloatEnvGuard fenv;
-  kKernelSets[st.isa].project_backward(
+  st.kernels->project_backward(
       projectInput(g, camT, st.settings), idx.data(), static_cast<int>(idx.size()), proj.data(), dP.data(),
       {grad.means.data(), grad.log_scales.data(), grad.rotations.data(), grad.opacities.data(), grad.sh.data()});
 }

@@ -1,11 +1,12 @@
 #pragma once
 // The float tile kernels of the fast rasterizer (internal). They are compiled from
-// splat/raster/raster_kernels_impl.h with four lanes for the baseline target (in
-// raster_kernels_base.cpp) and eight lanes with AVX2 (splat/raster/raster_kernels_avx2.cpp, its own
-// compile flags), chosen at run time; a third compilation, of the Fisher kernel alone, has
-// AVX2's eight lanes and arithmetic on AVX-512VL's 32 registers
-// (splat/raster/raster_kernels_avx512.cpp), bit-identical to the AVX2 one. Each
-// compilation lives in its own namespace and shares no code with the others, so no
+// splat/raster/raster_kernels_impl.h (and the backward, pair and projection parts beside
+// it) once per instruction set, each compilation choosing its options with a KernelIsa
+// traits type: four lanes for the baseline target (raster_kernels_base.cpp), eight with
+// AVX2 and FMA (raster_kernels_avx2.cpp, its own compile flags), and AVX2's eight lanes and
+// arithmetic on AVX-512VL's 32 registers for the walks that gain from them
+// (raster_kernels_avx512.cpp, bit-identical to AVX2's). Each compilation's functions have
+// internal linkage and reach the rasterizer only through its KernelSet below, so no
 // function compiled for AVX2 or AVX-512 can be picked by the linker for the baseline
 // path. No implicit FMA contraction in any; the AVX2 build fuses the multiply-adds
 // written as fma() and the baseline rounds them twice, so the baseline and AVX2 paths
@@ -138,7 +139,7 @@ struct ProjectIn {
 };
 
 // Rules 1-5 (projection::project<float> with the opacity-aware extent) for Gaussians
-// [begin, end), SARESGS_KERNEL_LANES at a time, into out[i] for each i: bit for bit what
+// [begin, end), KernelSet::lanes at a time, into out[i] for each i: bit for bit what
 // project() returns for every visible Gaussian, and visible = false where it culls (the
 // other fields of a culled Gaussian are unspecified there as here).
 using ProjectFn = void (*)(const ProjectIn& in, std::size_t begin, std::size_t end, projection::Projected<float>* out);
@@ -158,17 +159,6 @@ struct ProjectGradOut {
 using ProjectBackwardFn = void (*)(const ProjectIn& in, const std::uint32_t* idx, int count,
                                    const projection::Projected<float>* proj, const projection::ProjectedGrad<float>* dP,
                                    const ProjectGradOut& out);
-namespace base4 {
-void projectBackwardList(const ProjectIn& in, const std::uint32_t* idx, int count,
-                         const projection::Projected<float>* proj, const projection::ProjectedGrad<float>* dP,
-                         const ProjectGradOut& out);
-}
-namespace avx2 {
-void projectBackwardList(const ProjectIn& in, const std::uint32_t* idx, int count,
-                         const projection::Projected<float>* proj, const projection::ProjectedGrad<float>* dP,
-                         const ProjectGradOut& out);
-}
-
 // Where the Fisher chain adds a Gaussian's squared gradients (GaussiansT<float>'s storage).
 struct FisherGradOut {
   float* means;
@@ -185,69 +175,6 @@ struct FisherGradOut {
 using FisherChainFn = void (*)(const ProjectIn& in, const std::uint32_t* idx, int count,
                                const projection::Projected<float>* proj, const double* moments,
                                const FisherGradOut& out);
-namespace base4 {
-void fisherChainList(const ProjectIn& in, const std::uint32_t* idx, int count, const projection::Projected<float>* proj,
-                     const double* moments, const FisherGradOut& out);
-}
-namespace avx2 {
-void fisherChainList(const ProjectIn& in, const std::uint32_t* idx, int count, const projection::Projected<float>* proj,
-                     const double* moments, const FisherGradOut& out);
-}
-
-namespace base4 {
-void projectRange(const ProjectIn& in, std::size_t begin, std::size_t end, projection::Projected<float>* out);
-}
-namespace avx2 {
-void projectRange(const ProjectIn& in, std::size_t begin, std::size_t end, projection::Projected<float>* out);
-}
-
-namespace base4 {
-void fisherTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
-                const FisherIn& in, float* slots);
-}  // namespace base4
-
-namespace avx2 {
-void fisherTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
-                const FisherIn& in, float* slots);
-}  // namespace avx2
-
-// The AVX2 Fisher kernel's arithmetic on AVX-512VL's 32 registers, its moments summed in
-// one pass, and the AVX2 backward kernel on 32 registers (splat/raster/raster_kernels_avx512.cpp):
-// bit-identical to avx2::fisherTile and avx2::backwardTile.
-namespace avx512 {
-// False when this build has no AVX-512 kernel (not x86-64, or not GCC/Clang).
-bool compiled();
-void fisherTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
-                const FisherIn& in, float* slots);
-void backwardTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
-                  const BackwardIn& in, float* slots);
-}  // namespace avx512
-
-// compositeTile's per-lane arithmetic for n rounds of two blocks in registers (no memory
-// traffic): the floor a tile kernel could reach (raster_kernels_impl.h). Returns a checksum.
-namespace base4 {
-float compositeFloor(long n);
-}
-namespace avx2 {
-float compositeFloor(long n);
-}
-
-namespace base4 {
-void compositeTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
-                   const ForwardOut& out);
-void backwardTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
-                  const BackwardIn& in, float* slots);
-}  // namespace base4
-
-namespace avx2 {
-// False when this build has no AVX2 kernels (not x86-64, or not GCC/Clang).
-bool compiled();
-void compositeTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
-                   const ForwardOut& out);
-void backwardTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
-                  const BackwardIn& in, float* slots);
-}  // namespace avx2
-
 // A full render and the render of a subset of its Gaussians in one walk of the full tile
 // lists (splat/raster/raster_kernels_pair_impl.h): in_subset[j] (per tile entry) says
 // whether entry j is in the subset. Each render is bit-identical to the single-render
@@ -262,28 +189,62 @@ using BackwardPairFn = void (*)(const TileGaussian<float>* q, const std::uint8_t
                                 int x1, int y1, const float bg[3], const BackwardIn& full, const BackwardIn& subset,
                                 float* slots);
 
-namespace base4 {
-void compositeTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0, int x1,
-                       int y1, const float bg[3], const ForwardOut& full, const ForwardOut& subset);
-void backwardTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0, int x1,
-                      int y1, const float bg[3], const BackwardIn& full, const BackwardIn& subset, float* slots);
-}  // namespace base4
+// compositeTile's per-lane arithmetic for n rounds of two blocks in registers (no memory
+// traffic): the floor a tile kernel could reach (raster_kernels_impl.h). Returns a checksum.
+using CompositeFloorFn = float (*)(long n);
 
-namespace avx2 {
-void compositeTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0, int x1,
-                       int y1, const float bg[3], const ForwardOut& full, const ForwardOut& subset);
-void backwardTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0, int x1,
-                      int y1, const float bg[3], const BackwardIn& full, const BackwardIn& subset, float* slots);
-}  // namespace avx2
+// The options one compilation of the kernels is built with (splat/raster/raster_kernels_impl.h
+// reads them as KernelIsa): lanes per vector (4 or 8), AVX2 + FMA intrinsics (eight lanes,
+// x86-64 only), and the Fisher walk summing its 19 moments as it goes (for a target with
+// 32 vector registers; with 16 they spill and the three-pass form is faster).
+template <int Lanes, bool Fma, bool FisherOnePass>
+struct KernelOptions {
+  static constexpr int kLanes = Lanes;
+  static constexpr bool kFma = Fma;
+  static constexpr bool kFisherOnePass = FisherOnePass;
+};
+// The three compilations the rasterizer chooses from at run time.
+struct BaselineIsa : KernelOptions<4, false, false> {  // raster_kernels_base.cpp
+  static constexpr const char* kName = "baseline";
+};
+struct Avx2Isa : KernelOptions<8, true, false> {  // raster_kernels_avx2.cpp
+  static constexpr const char* kName = "avx2";
+};
+struct Avx512Isa : KernelOptions<8, true, true> {  // raster_kernels_avx512.cpp
+  static constexpr const char* kName = "avx512";
+};
 
-// The AVX2 pair kernels on AVX-512VL's 32 registers (raster_kernels_avx512.cpp):
-// bit-identical to avx2::compositeTilePair and avx2::backwardTilePair.
-namespace avx512 {
-void compositeTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0, int x1,
-                       int y1, const float bg[3], const ForwardOut& full, const ForwardOut& subset);
-void backwardTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0, int x1,
-                      int y1, const float bg[3], const BackwardIn& full, const BackwardIn& subset, float* slots);
-}  // namespace avx512
+// One compilation of the kernels: everything the rasterizer calls for one instruction set.
+struct KernelSet {
+  const char* name;  // "baseline", "avx2", "avx512"
+  int lanes;         // pixels (or Gaussians) per vector
+  CompositeFn composite;
+  BackwardFn backward;
+  FisherFn fisher;
+  CompositePairFn composite_pair;
+  BackwardPairFn backward_pair;
+  ProjectFn project;
+  ProjectBackwardFn project_backward;
+  FisherChainFn fisher_chain;
+  CompositeFloorFn composite_floor;
+};
+
+// The kernel set of the compilation with options Isa, as data that compilation defines
+// (constant-initialized, so that reading it runs no instruction of another instruction
+// set); null where this build has no such compilation (not x86-64, or not GCC/Clang).
+template <class Isa>
+struct CompiledKernels {
+  static const KernelSet* const set;
+};
+template <>
+const KernelSet* const CompiledKernels<BaselineIsa>::set;
+template <>
+const KernelSet* const CompiledKernels<Avx2Isa>::set;
+// Avx512Isa's set holds only the walks that gain from AVX-512VL's 32 registers (backward,
+// fisher, composite_pair, backward_pair; the other members null), bit-identical to AVX2's:
+// the rasterizer's avx512 set is the AVX2 set with these (raster_execution::kernelSet).
+template <>
+const KernelSet* const CompiledKernels<Avx512Isa>::set;
 
 }  // namespace raster_kernels
 }  // namespace saresgs

@@ -3,7 +3,7 @@
 // with -mavx512f -mavx512vl -mfma -ffp-contract=off (splat/CMakeLists.txt, which defines
 // SARESGS_RASTER_AVX512 on x86-64).
 // - fisherTile: the walk keeps all 19 moment accumulators in registers and sums them as
-//   it goes (SARESGS_KERNEL_FISHER_ONE_PASS in raster_kernels_impl.h), instead of storing
+//   it goes (KernelIsa::kFisherOnePass in raster_kernels_backward_impl.h), instead of storing
 //   each block's two inputs and summing them in three later passes.
 // - compositeTilePair and backwardTilePair (residual supervision's two renders in one
 //   walk): the pair loops' Gaussian constants and the backward's nine gradient sums, which
@@ -21,40 +21,26 @@
 // FloatPath.Avx512BackwardEqualsAvx2BitForBit, SubsetPair.Avx512BackwardEqualsAvx2BitForBit,
 // and SubsetPair.* against the single-render AVX2 kernel on every kernel set). The forward
 // kernel gained nothing or lost from the wider register file (docs/DECISIONS.md),
-// so the avx512 kernel set uses the AVX2 one.
+// so the avx512 kernel set takes it, and the projection kernels, from the AVX2 set.
 #include "splat/raster/raster_kernels.h"
 
 #if defined(SARESGS_RASTER_AVX512)
-#define SARESGS_KERNEL_NS avx512
-#define SARESGS_KERNEL_LANES 8
-#define SARESGS_KERNEL_FMA 1
-#define SARESGS_KERNEL_FISHER_ONE_PASS 1
-#define SARESGS_KERNEL_NO_COMPOSITE 1
-#include "splat/raster/raster_kernels_impl.h"
-#include "splat/raster/raster_kernels_backward_impl.h"
+namespace saresgs::raster_kernels {
+using KernelIsa = Avx512Isa;
+}
+
 #include "splat/raster/raster_kernels_pair_impl.h"
 
-namespace saresgs::raster_kernels::avx512 {
-bool compiled() { return true; }
-}  // namespace saresgs::raster_kernels::avx512
-#else
-#include <cstdlib>
+namespace saresgs::raster_kernels {
+namespace {
+constexpr KernelSet kWalks = walkKernels();
+}  // namespace
 
-namespace saresgs::raster_kernels::avx512 {
-bool compiled() { return false; }
-void fisherTile(const TileGaussian<float>*, int, int, int, int, int, const float*, const FisherIn&, float*) {
-  std::abort();
-}
-void compositeTilePair(const TileGaussian<float>*, const std::uint8_t*, int, int, int, int, int, const float*,
-                       const ForwardOut&, const ForwardOut&) {
-  std::abort();
-}
-void backwardTile(const TileGaussian<float>*, int, int, int, int, int, const float*, const BackwardIn&, float*) {
-  std::abort();
-}
-void backwardTilePair(const TileGaussian<float>*, const std::uint8_t*, int, int, int, int, int, const float*,
-                      const BackwardIn&, const BackwardIn&, float*) {
-  std::abort();
-}
-}  // namespace saresgs::raster_kernels::avx512
+template <>
+const KernelSet* const CompiledKernels<Avx512Isa>::set = &kWalks;
+}  // namespace saresgs::raster_kernels
+#else
+template <>
+const saresgs::raster_kernels::KernelSet* const
+    saresgs::raster_kernels::CompiledKernels<saresgs::raster_kernels::Avx512Isa>::set = nullptr;
 #endif

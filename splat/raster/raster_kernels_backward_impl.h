@@ -1,41 +1,36 @@
 // The float tile kernels' backward pass and FisherRF's squared-gradient pass (see
-// splat/raster/raster_kernels.h). Included right after splat/raster/raster_kernels_impl.h in
-// the same translation unit, with the same SARESGS_KERNEL_NS / SARESGS_KERNEL_LANES, and
-// built on its lanes, exponentials and tile walk (Lanes, evalLanes, forEachBlock); the
-// pair kernels (splat/raster/raster_kernels_pair_impl.h) come after it and reuse its
-// states.
-#if !defined(SARESGS_KERNEL_NS) || !defined(SARESGS_KERNEL_LANES)
-#error "include raster_kernels_impl.h (with its macros) before raster_kernels_backward_impl.h"
-#endif
+// splat/raster/raster_kernels.h). Built on splat/raster/raster_kernels_impl.h's lanes,
+// exponentials and tile walk (Lanes, evalLanes, forEachBlock), for the same KernelIsa; the
+// pair kernels (splat/raster/raster_kernels_pair_impl.h) reuse its states.
+#pragma once
+#include "splat/raster/raster_kernels_impl.h"
 
-namespace saresgs::raster_kernels::SARESGS_KERNEL_NS {
-
+namespace saresgs::raster_kernels {
 namespace {
 
 // --- Backward -----------------------------------------------------------------------
 // Pairwise lane sums of two vectors: [a0 + a1, a2 + a3, ..., b0 + b1, b2 + b3, ...].
-// (The preprocessor picks the lane count: shuffle indices must be constants even in a
-// discarded branch outside a template.)
-inline vf pairSums(vf a, vf b) {
-#if SARESGS_KERNEL_LANES == 4
-  return __builtin_shufflevector(a, b, 0, 2, 4, 6) + __builtin_shufflevector(a, b, 1, 3, 5, 7);
-#else
-  return __builtin_shufflevector(a, b, 0, 2, 4, 6, 8, 10, 12, 14) +
-         __builtin_shufflevector(a, b, 1, 3, 5, 7, 9, 11, 13, 15);
-#endif
+// (A template, so that the shuffle of the other lane count is never instantiated.)
+template <typename V>
+inline V pairSumsOf(V a, V b) {
+  if constexpr (L == 4)
+    return __builtin_shufflevector(a, b, 0, 2, 4, 6) + __builtin_shufflevector(a, b, 1, 3, 5, 7);
+  else
+    return __builtin_shufflevector(a, b, 0, 2, 4, 6, 8, 10, 12, 14) +
+           __builtin_shufflevector(a, b, 1, 3, 5, 7, 9, 11, 13, 15);
 }
+inline vf pairSums(vf a, vf b) { return pairSumsOf(a, b); }
 
 // The lane sums of L vectors v[0, L) as one vector (lane k: the sum of v[k]), in a
 // fixed tree order (the same tree as hsum): L - 1 shuffle-adds instead of L horizontal
 // sums of a dozen scalar instructions each, paid per (tile, Gaussian) pair, while the
 // small Gaussians of a trained model cover a tile in a few blocks.
 inline vf transposeSums(const vf* v) {
-#if SARESGS_KERNEL_LANES == 4
-  return pairSums(pairSums(v[0], v[1]), pairSums(v[2], v[3]));
-#else
-  return pairSums(pairSums(pairSums(v[0], v[1]), pairSums(v[2], v[3])),
-                  pairSums(pairSums(v[4], v[5]), pairSums(v[6], v[7])));
-#endif
+  if constexpr (L == 4)
+    return pairSums(pairSums(v[0], v[1]), pairSums(v[2], v[3]));
+  else
+    return pairSums(pairSums(pairSums(v[0], v[1]), pairSums(v[2], v[3])),
+                    pairSums(pairSums(v[4], v[5]), pairSums(v[6], v[7])));
 }
 
 // One vector block of a tile's back-to-front state: the transmittance in front of the
@@ -211,10 +206,8 @@ void backwardTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int 
   }
 }
 
-}  // namespace
-
-void backwardTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
-                  const BackwardIn& in, float* slots) {
+inline void backwardTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
+                         const BackwardIn& in, float* slots) {
   if (nq == 0) return;
   if (bg[0] != 0.0f || bg[1] != 0.0f || bg[2] != 0.0f)
     backwardTileImpl<true>(q, nq, x0, y0, x1, y1, bg, in, slots);
@@ -227,8 +220,6 @@ void backwardTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, 
 // Kept apart from the backward kernel: its weights are all 1, so the three colour
 // accumulators collapse into one (sum_c (col_c - acc_c) = sum col - sum acc, and each
 // acc_c is updated linearly), and the background term is the same for every pixel.
-namespace {
-
 template <bool kBg>
 void fisherTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, float bg_sum,
                     const FisherIn& in, float* slots) {
@@ -236,11 +227,11 @@ void fisherTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1
   constexpr int M = kFisherSlot;
   const int w = x1 - x0, h = y1 - y0;
   alignas(64) float Tr[P], finalT[P], walked[P], acc[P];
-#if !SARESGS_KERNEL_FISHER_ONE_PASS
-  alignas(64) float eb[P], wb[P];  // per block of the current Gaussian: e and wc
-  int block[P / L];                // and the block's storage index
-  const vf lane_x = laneColCentres(), lane_y = laneRowCentres();
-#endif
+  // The two-pass form's scratch: per block of the current Gaussian e and wc, and the
+  // block's storage index (unused by the one-pass form).
+  [[maybe_unused]] alignas(64) float eb[P], wb[P];
+  [[maybe_unused]] int block[P / L];
+  [[maybe_unused]] const vf lane_x = laneColCentres(), lane_y = laneRowCentres();
   std::uint32_t jmax = 0;
   for (int k = 0; k < P; ++k) {
     const int r = blockRow(k), c = blockCol(k);
@@ -282,114 +273,114 @@ void fisherTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1
     constexpr int kPadded = (M + L - 1) / L * L;
     vf m[kPadded];
     for (int k = M; k < kPadded; ++k) m[k] = zero;
-#if SARESGS_KERNEL_FISHER_ONE_PASS
-    // One pass: the walk's e and wc go straight into the 19 accumulators, each summed
-    // with the same operations, in the same block order, as in the three passes below.
-    vf e00 = zero, e20 = zero, e11 = zero, e02 = zero, f10 = zero, f01 = zero, ww = zero;
-    vf e30 = zero, e21 = zero, e12 = zero, e03 = zero, f20 = zero, f11 = zero, f02 = zero;
-    vf e40 = zero, e31 = zero, e22 = zero, e13 = zero, e04 = zero;
-    forEachBlock(g, x0, y0, x1, y1, [&](int blk, const Lanes& Ln, vf dy) {
-      vf e, wc;
-      step(blk * L, Ln, jv, colsum, e, wc);
-      const vf dx = Ln.dx;
-      const vf e2 = e * e, ew = e * wc;
-      const vf xx = dx * dx, xy = dx * dy, yy = dy * dy;
-      const vf e2xx = e2 * xx, e2yy = e2 * yy;
-      e00 += e2;
-      e20 += e2xx;
-      e11 = fma(e2 * dx, dy, e11);
-      e02 += e2yy;
-      f10 = fma(ew, dx, f10);
-      f01 = fma(ew, dy, f01);
-      ww = fma(wc, wc, ww);
-      e30 = fma(e2xx, dx, e30);
-      e21 = fma(e2xx, dy, e21);
-      e12 = fma(e2yy, dx, e12);
-      e03 = fma(e2yy, dy, e03);
-      f20 = fma(ew, xx, f20);
-      f11 = fma(ew, xy, f11);
-      f02 = fma(ew, yy, f02);
-      e40 = fma(e2xx, xx, e40);
-      e31 = fma(e2xx, xy, e31);
-      e22 = fma(e2xx, yy, e22);
-      e13 = fma(e2yy, xy, e13);
-      e04 = fma(e2yy, yy, e04);
-    });
-    m[kE00] = e00, m[kE20] = e20, m[kE11] = e11, m[kE02] = e02, m[kF10] = f10, m[kF01] = f01, m[kW] = ww;
-    m[kE30] = e30, m[kE21] = e21, m[kE12] = e12, m[kE03] = e03, m[kF20] = f20, m[kF11] = f11, m[kF02] = f02;
-    m[kE40] = e40, m[kE31] = e31, m[kE22] = e22, m[kE13] = e13, m[kE04] = e04;
-#else
-    const vf mx = vs(g.mx), my = vs(g.my);
-    // Two passes over the Gaussian's blocks. The walk keeps each block's e and wc in
-    // scratch; the moments are then summed in three groups small enough to stay in
-    // registers (nineteen accumulators spilled to the stack made every block pay
-    // nineteen stores, which bound the kernel).
-    int nb = 0;
-    forEachBlock(g, x0, y0, x1, y1, [&](int blk, const Lanes& Ln, vf) {
-      vf e, wc;
-      step(blk * L, Ln, jv, colsum, e, wc);
-      store(eb + nb * L, e);
-      store(wb + nb * L, wc);
-      block[nb++] = blk * L;
-    });
-    // The offsets of block n's pixels, as the walk computed them.
-    auto offsets = [&](int n, vf& dx, vf& dy) {
-      const int b = block[n] / L;
-      dx = (vs(static_cast<float>(x0 + b % kBX * kBW)) + lane_x) - mx;
-      dy = (vs(static_cast<float>(y0 + b / kBX * kBH)) + lane_y) - my;
-    };
-    {
+    if constexpr (KernelIsa::kFisherOnePass) {
+      // One pass: the walk's e and wc go straight into the 19 accumulators, each summed
+      // with the same operations, in the same block order, as in the three passes below.
       vf e00 = zero, e20 = zero, e11 = zero, e02 = zero, f10 = zero, f01 = zero, ww = zero;
-      for (int n = 0; n < nb; ++n) {
-        vf dx, dy;
-        offsets(n, dx, dy);
-        const vf e = load(eb + n * L), wc = load(wb + n * L);
+      vf e30 = zero, e21 = zero, e12 = zero, e03 = zero, f20 = zero, f11 = zero, f02 = zero;
+      vf e40 = zero, e31 = zero, e22 = zero, e13 = zero, e04 = zero;
+      forEachBlock(g, x0, y0, x1, y1, [&](int blk, const Lanes& Ln, vf dy) {
+        vf e, wc;
+        step(blk * L, Ln, jv, colsum, e, wc);
+        const vf dx = Ln.dx;
         const vf e2 = e * e, ew = e * wc;
+        const vf xx = dx * dx, xy = dx * dy, yy = dy * dy;
+        const vf e2xx = e2 * xx, e2yy = e2 * yy;
         e00 += e2;
-        e20 += e2 * (dx * dx);
+        e20 += e2xx;
         e11 = fma(e2 * dx, dy, e11);
-        e02 += e2 * (dy * dy);
+        e02 += e2yy;
         f10 = fma(ew, dx, f10);
         f01 = fma(ew, dy, f01);
         ww = fma(wc, wc, ww);
-      }
-      m[kE00] = e00, m[kE20] = e20, m[kE11] = e11, m[kE02] = e02, m[kF10] = f10, m[kF01] = f01, m[kW] = ww;
-    }
-    {
-      vf e30 = zero, e21 = zero, e12 = zero, e03 = zero, f20 = zero, f11 = zero, f02 = zero;
-      for (int n = 0; n < nb; ++n) {
-        vf dx, dy;
-        offsets(n, dx, dy);
-        const vf e = load(eb + n * L), wc = load(wb + n * L);
-        const vf e2 = e * e, ew = e * wc;
-        const vf e2xx = e2 * (dx * dx), e2yy = e2 * (dy * dy);
         e30 = fma(e2xx, dx, e30);
         e21 = fma(e2xx, dy, e21);
         e12 = fma(e2yy, dx, e12);
         e03 = fma(e2yy, dy, e03);
-        f20 = fma(ew, dx * dx, f20);
-        f11 = fma(ew, dx * dy, f11);
-        f02 = fma(ew, dy * dy, f02);
-      }
-      m[kE30] = e30, m[kE21] = e21, m[kE12] = e12, m[kE03] = e03, m[kF20] = f20, m[kF11] = f11, m[kF02] = f02;
-    }
-    {
-      vf e40 = zero, e31 = zero, e22 = zero, e13 = zero, e04 = zero;
-      for (int n = 0; n < nb; ++n) {
-        vf dx, dy;
-        offsets(n, dx, dy);
-        const vf e = load(eb + n * L);
-        const vf e2 = e * e, xx = dx * dx, xy = dx * dy, yy = dy * dy;
-        const vf e2xx = e2 * xx, e2yy = e2 * yy;
+        f20 = fma(ew, xx, f20);
+        f11 = fma(ew, xy, f11);
+        f02 = fma(ew, yy, f02);
         e40 = fma(e2xx, xx, e40);
         e31 = fma(e2xx, xy, e31);
         e22 = fma(e2xx, yy, e22);
         e13 = fma(e2yy, xy, e13);
         e04 = fma(e2yy, yy, e04);
-      }
+      });
+      m[kE00] = e00, m[kE20] = e20, m[kE11] = e11, m[kE02] = e02, m[kF10] = f10, m[kF01] = f01, m[kW] = ww;
+      m[kE30] = e30, m[kE21] = e21, m[kE12] = e12, m[kE03] = e03, m[kF20] = f20, m[kF11] = f11, m[kF02] = f02;
       m[kE40] = e40, m[kE31] = e31, m[kE22] = e22, m[kE13] = e13, m[kE04] = e04;
+    } else {
+      const vf mx = vs(g.mx), my = vs(g.my);
+      // Two passes over the Gaussian's blocks. The walk keeps each block's e and wc in
+      // scratch; the moments are then summed in three groups small enough to stay in
+      // registers (nineteen accumulators spilled to the stack made every block pay
+      // nineteen stores, which bound the kernel).
+      int nb = 0;
+      forEachBlock(g, x0, y0, x1, y1, [&](int blk, const Lanes& Ln, vf) {
+        vf e, wc;
+        step(blk * L, Ln, jv, colsum, e, wc);
+        store(eb + nb * L, e);
+        store(wb + nb * L, wc);
+        block[nb++] = blk * L;
+      });
+      // The offsets of block n's pixels, as the walk computed them.
+      auto offsets = [&](int n, vf& dx, vf& dy) {
+        const int b = block[n] / L;
+        dx = (vs(static_cast<float>(x0 + b % kBX * kBW)) + lane_x) - mx;
+        dy = (vs(static_cast<float>(y0 + b / kBX * kBH)) + lane_y) - my;
+      };
+      {
+        vf e00 = zero, e20 = zero, e11 = zero, e02 = zero, f10 = zero, f01 = zero, ww = zero;
+        for (int n = 0; n < nb; ++n) {
+          vf dx, dy;
+          offsets(n, dx, dy);
+          const vf e = load(eb + n * L), wc = load(wb + n * L);
+          const vf e2 = e * e, ew = e * wc;
+          e00 += e2;
+          e20 += e2 * (dx * dx);
+          e11 = fma(e2 * dx, dy, e11);
+          e02 += e2 * (dy * dy);
+          f10 = fma(ew, dx, f10);
+          f01 = fma(ew, dy, f01);
+          ww = fma(wc, wc, ww);
+        }
+        m[kE00] = e00, m[kE20] = e20, m[kE11] = e11, m[kE02] = e02, m[kF10] = f10, m[kF01] = f01, m[kW] = ww;
+      }
+      {
+        vf e30 = zero, e21 = zero, e12 = zero, e03 = zero, f20 = zero, f11 = zero, f02 = zero;
+        for (int n = 0; n < nb; ++n) {
+          vf dx, dy;
+          offsets(n, dx, dy);
+          const vf e = load(eb + n * L), wc = load(wb + n * L);
+          const vf e2 = e * e, ew = e * wc;
+          const vf e2xx = e2 * (dx * dx), e2yy = e2 * (dy * dy);
+          e30 = fma(e2xx, dx, e30);
+          e21 = fma(e2xx, dy, e21);
+          e12 = fma(e2yy, dx, e12);
+          e03 = fma(e2yy, dy, e03);
+          f20 = fma(ew, dx * dx, f20);
+          f11 = fma(ew, dx * dy, f11);
+          f02 = fma(ew, dy * dy, f02);
+        }
+        m[kE30] = e30, m[kE21] = e21, m[kE12] = e12, m[kE03] = e03, m[kF20] = f20, m[kF11] = f11, m[kF02] = f02;
+      }
+      {
+        vf e40 = zero, e31 = zero, e22 = zero, e13 = zero, e04 = zero;
+        for (int n = 0; n < nb; ++n) {
+          vf dx, dy;
+          offsets(n, dx, dy);
+          const vf e = load(eb + n * L);
+          const vf e2 = e * e, xx = dx * dx, xy = dx * dy, yy = dy * dy;
+          const vf e2xx = e2 * xx, e2yy = e2 * yy;
+          e40 = fma(e2xx, xx, e40);
+          e31 = fma(e2xx, xy, e31);
+          e22 = fma(e2xx, yy, e22);
+          e13 = fma(e2yy, xy, e13);
+          e04 = fma(e2yy, yy, e04);
+        }
+        m[kE40] = e40, m[kE31] = e31, m[kE22] = e22, m[kE13] = e13, m[kE04] = e04;
+      }
     }
-#endif
     // Straight into the slot, whole vectors and then the last few lanes. (Through a stack
     // array and memcpy, the copy's wide loads each spanned two of the vector stores just
     // made, which a store cannot forward: the load waited for both to reach the cache,
@@ -404,10 +395,8 @@ void fisherTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1
   }
 }
 
-}  // namespace
-
-void fisherTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
-                const FisherIn& in, float* slots) {
+inline void fisherTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
+                       const FisherIn& in, float* slots) {
   if (nq == 0) return;
   const float bg_sum = bg[0] + bg[1] + bg[2];
   if (bg_sum != 0.0f)
@@ -416,4 +405,5 @@ void fisherTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, in
     fisherTileImpl<false>(q, nq, x0, y0, x1, y1, bg_sum, in, slots);
 }
 
-}  // namespace saresgs::raster_kernels::SARESGS_KERNEL_NS
+}  // namespace
+}  // namespace saresgs::raster_kernels

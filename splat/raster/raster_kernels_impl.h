@@ -1,65 +1,61 @@
-// The float tile kernels (see splat/raster/raster_kernels.h), SARESGS_KERNEL_LANES pixels at a
-// time with GCC/Clang vector extensions, defined in namespace
-// saresgs::raster_kernels::SARESGS_KERNEL_NS: the lanes, the exponentials, the tile walk
-// and the forward composite here; the backward and Fisher passes in
+// The float tile kernels (see splat/raster/raster_kernels.h), KernelIsa::kLanes pixels at
+// a time with GCC/Clang vector extensions: the lanes, the exponentials, the tile walk and
+// the forward composite here; the backward and Fisher passes in
 // splat/raster/raster_kernels_backward_impl.h, the pair kernels in
-// splat/raster/raster_kernels_pair_impl.h. Included once per instruction set; it
-// deliberately includes no library header with inline code of its own beyond <cmath>
-// and <cstring> builtins, so that the AVX2 compilation emits no function the linker
-// could share with the baseline one.
+// splat/raster/raster_kernels_pair_impl.h, the projection in
+// splat/raster/project_kernels_impl.h. Included once per instruction set, by a file that
+// first names its options in namespace saresgs::raster_kernels (raster_kernels.h):
+//   using KernelIsa = Avx2Isa;  (or BaselineIsa, Avx512Isa, KernelOptions<8, false, false>)
+// Everything here has internal linkage (an unnamed namespace) and deliberately includes
+// no library header with inline code of its own beyond <cmath> and <cstring> builtins, so
+// that a compilation for AVX2 emits no function the linker could share with the baseline
+// one; the including file hands its kernels to the rasterizer as a KernelSet.
+#pragma once
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 
+#if defined(__x86_64__)
+#include <immintrin.h>  // intrinsics are always-inline, no symbols of their own
+#endif
+
+#include "splat/raster/constants.h"
 #include "splat/raster/raster_kernels.h"
 
-#if SARESGS_KERNEL_FMA
-#include <immintrin.h>  // intrinsics are always-inline, no symbols of their own
-#elif defined(__SSE__)
-#include <xmmintrin.h>
-#endif
-
-#ifndef SARESGS_KERNEL_FMA
-#define SARESGS_KERNEL_FMA 0
-#endif
-// SARESGS_KERNEL_FISHER_ONE_PASS: the Fisher walk sums its 19 moments as it goes (for a
-// target with 32 vector registers; with 16 they spill and the three-pass form is faster).
-// SARESGS_KERNEL_NO_COMPOSITE: compositeTile and compositeFloor are not defined (the
-// avx512 set uses the AVX2 ones: raster_kernels_avx512.cpp).
-#ifndef SARESGS_KERNEL_FISHER_ONE_PASS
-#define SARESGS_KERNEL_FISHER_ONE_PASS 0
-#endif
-#ifndef SARESGS_KERNEL_NO_COMPOSITE
-#define SARESGS_KERNEL_NO_COMPOSITE 0
-#endif
-#if !defined(SARESGS_KERNEL_NS) || !defined(SARESGS_KERNEL_LANES)
-#error "define SARESGS_KERNEL_NS and SARESGS_KERNEL_LANES before including raster_kernels_impl.h"
-#endif
-
-namespace saresgs::raster_kernels::SARESGS_KERNEL_NS {
+namespace saresgs::raster_kernels {
 namespace {
 
-constexpr int L = SARESGS_KERNEL_LANES;
+constexpr int L = KernelIsa::kLanes;
 static_assert(L == 4 || L == 8);
-// The contract's constants (splat/rasterize.h; raster_kernels_base.cpp checks they agree).
-constexpr int kTile = 16;
-constexpr float kMinA = 1.0f / 255.0f;
-constexpr float kMaxA = 0.99f;
-constexpr float kMinT = 1e-4f;
+static_assert(!KernelIsa::kFma || L == 8, "the FMA kernels are eight lanes wide");
+#if !defined(__x86_64__)
+static_assert(!KernelIsa::kFma, "the FMA kernels are x86-64's");
+#endif
+// The contract's constants (splat/raster/constants.h) under the kernels' short names.
+constexpr int kTile = kTileSize;
+constexpr float kMinA = kMinAlpha;
+constexpr float kMaxA = kMaxAlpha;
+constexpr float kMinT = kMinTransmittance;
 constexpr int kSlot = 9;
 
 typedef float vf __attribute__((vector_size(4 * L)));
 typedef std::int32_t vi __attribute__((vector_size(4 * L)));
 
-// a b + c: one fused rounding where the kernels are built for FMA, else two.
-inline vf fma(vf a, vf b, vf c) {
-#if SARESGS_KERNEL_FMA
-  return reinterpret_cast<vf>(
-      _mm256_fmadd_ps(reinterpret_cast<__m256>(a), reinterpret_cast<__m256>(b), reinterpret_cast<__m256>(c)));
-#else
-  return a * b + c;
+// a b + c: one fused rounding where the kernels are built for FMA, else two. (The
+// helpers that reach for intrinsics are templates on the vector type, so that the branch
+// another instruction set would take is never instantiated.)
+// Off x86-64 only the portable branches exist.
+template <typename V>
+inline V fmaOf(V a, V b, V c) {
+#if defined(__x86_64__)
+  if constexpr (KernelIsa::kFma)
+    return reinterpret_cast<V>(
+        _mm256_fmadd_ps(reinterpret_cast<__m256>(a), reinterpret_cast<__m256>(b), reinterpret_cast<__m256>(c)));
+  else
 #endif
+    return a * b + c;
 }
+inline vf fma(vf a, vf b, vf c) { return fmaOf(a, b, c); }
 
 // x in every lane. Written as a scalar-vector operation so that GCC emits one broadcast
 // (a per-lane loop became a chain of inserts); x - (+0) is x exactly, -0 included.
@@ -155,49 +151,66 @@ inline void interleave3(float* p, v4f c0, v4f c1, v4f c2) {
   std::memcpy(p + 4, &x1, 16);
   std::memcpy(p + 8, &x2, 16);
 }
-// Two rows' kBW lanes as one block vector, and back (the preprocessor picks the lane
-// count: shuffle indices must be constants even in a discarded branch outside a template).
-inline vf joinRows(v4f a, [[maybe_unused]] v4f b) {
-#if SARESGS_KERNEL_LANES == 4
-  return a;
-#else
-  return __builtin_shufflevector(a, b, 0, 1, 2, 3, 4, 5, 6, 7);
-#endif
+// Two rows' kBW lanes as one block vector, and back (templates, so that the shuffle of
+// the other lane count is never instantiated).
+template <typename V4>
+inline vf joinRows(V4 a, [[maybe_unused]] V4 b) {
+  if constexpr (L == 4)
+    return a;
+  else
+    return __builtin_shufflevector(a, b, 0, 1, 2, 3, 4, 5, 6, 7);
 }
-inline v4f rowOf(vf v, [[maybe_unused]] int half) {
-#if SARESGS_KERNEL_LANES == 4
-  return v;
-#else
-  return half == 0 ? __builtin_shufflevector(v, v, 0, 1, 2, 3) : __builtin_shufflevector(v, v, 4, 5, 6, 7);
-#endif
+template <typename V>
+inline v4f rowOf(V v, [[maybe_unused]] int half) {
+  if constexpr (L == 4)
+    return v;
+  else
+    return half == 0 ? __builtin_shufflevector(v, v, 0, 1, 2, 3) : __builtin_shufflevector(v, v, 4, 5, 6, 7);
 }
 
 // a < b ? a : b and a > b ? a : b, lane by lane (b where unordered): one min/max
 // instruction where the target has it (GCC keeps a vector ternary as compare + blend).
-#if SARESGS_KERNEL_FMA
-inline __m256 m256(vf v) { return reinterpret_cast<__m256>(v); }
-inline vf vmin(vf a, vf b) { return reinterpret_cast<vf>(_mm256_min_ps(m256(a), m256(b))); }
-inline vf vmax(vf a, vf b) { return reinterpret_cast<vf>(_mm256_max_ps(m256(a), m256(b))); }
-#elif defined(__SSE__) && SARESGS_KERNEL_LANES == 4
-inline __m128 m128(vf v) { return reinterpret_cast<__m128>(v); }
-inline vf vmin(vf a, vf b) { return reinterpret_cast<vf>(_mm_min_ps(m128(a), m128(b))); }
-inline vf vmax(vf a, vf b) { return reinterpret_cast<vf>(_mm_max_ps(m128(a), m128(b))); }
-#else
-inline vf vmin(vf a, vf b) { return a < b ? a : b; }
-inline vf vmax(vf a, vf b) { return a > b ? a : b; }
+template <typename V>
+inline V vminOf(V a, V b) {
+#if defined(__x86_64__)
+  if constexpr (KernelIsa::kFma)
+    return reinterpret_cast<V>(_mm256_min_ps(reinterpret_cast<__m256>(a), reinterpret_cast<__m256>(b)));
+  else if constexpr (L == 4)
+    return reinterpret_cast<V>(_mm_min_ps(reinterpret_cast<__m128>(a), reinterpret_cast<__m128>(b)));
+  else
 #endif
+    return a < b ? a : b;
+}
+template <typename V>
+inline V vmaxOf(V a, V b) {
+#if defined(__x86_64__)
+  if constexpr (KernelIsa::kFma)
+    return reinterpret_cast<V>(_mm256_max_ps(reinterpret_cast<__m256>(a), reinterpret_cast<__m256>(b)));
+  else if constexpr (L == 4)
+    return reinterpret_cast<V>(_mm_max_ps(reinterpret_cast<__m128>(a), reinterpret_cast<__m128>(b)));
+  else
+#endif
+    return a > b ? a : b;
+}
+inline vf vmin(vf a, vf b) { return vminOf(a, b); }
+inline vf vmax(vf a, vf b) { return vmaxOf(a, b); }
 
 // The square root lane by lane (correctly rounded, as std::sqrt).
-inline vf vsqrt(vf a) {
-#if SARESGS_KERNEL_FMA
-  return reinterpret_cast<vf>(_mm256_sqrt_ps(reinterpret_cast<__m256>(a)));
-#elif defined(__SSE__) && SARESGS_KERNEL_LANES == 4
-  return reinterpret_cast<vf>(_mm_sqrt_ps(reinterpret_cast<__m128>(a)));
-#else
-  for (int i = 0; i < L; ++i) a[i] = std::sqrt(a[i]);
-  return a;
+template <typename V>
+inline V vsqrtOf(V a) {
+#if defined(__x86_64__)
+  if constexpr (KernelIsa::kFma) {
+    return reinterpret_cast<V>(_mm256_sqrt_ps(reinterpret_cast<__m256>(a)));
+  } else if constexpr (L == 4) {
+    return reinterpret_cast<V>(_mm_sqrt_ps(reinterpret_cast<__m128>(a)));
+  } else
 #endif
+  {
+    for (int i = 0; i < L; ++i) a[i] = std::sqrt(a[i]);
+    return a;
+  }
 }
+inline vf vsqrt(vf a) { return vsqrtOf(a); }
 
 // 2^x for x <= 0 without a libm call, on a short dependency chain (the kernels are
 // bound by its latency, not by instruction count): x = n + r with n = round(x) by the
@@ -259,11 +272,11 @@ inline Lanes lanesOfG(vf dx, vf G, vf o, vf hx, vi row_in) {
 
 inline Lanes evalLanes(vf dx, vf ha, vf qy, vf by, vf o, vf hx, vi row_in) {
   // ((-0.5 a log2e) dx) dx + row_quad - row_cross dx: the exponent in base 2.
-#if SARESGS_KERNEL_FMA
-  const vf power = fma(-by, dx, fma(ha * dx, dx, qy));
-#else
-  const vf power = ha * dx * dx + qy - by * dx;
-#endif
+  vf power;
+  if constexpr (KernelIsa::kFma)
+    power = fma(-by, dx, fma(ha * dx, dx, qy));
+  else
+    power = ha * dx * dx + qy - by * dx;
   Lanes l = lanesOfG(dx, exp2NonPositive(vmin(power, vs(0.0f))), o, hx, row_in);  // power < 0 ? power : 0
   l.touches = l.touches & (power <= vs(0.0f));
   return l;
@@ -573,13 +586,9 @@ struct ForwardColour {
         jf(vs(static_cast<float>(j + 1))) {}
 };
 
-}  // namespace
-
-#if !SARESGS_KERNEL_NO_COMPOSITE
 // Front-to-back compositing, Gaussian by Gaussian over the blocks it may touch, so the
 // inner loop is branch-free vector code; each pixel sees exactly the per-pixel sequence
 // of rule 7.
-namespace {
 template <bool kAux>
 void compositeTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
                        const ForwardOut& out) {
@@ -596,10 +605,9 @@ void compositeTileImpl(const TileGaussian<float>* q, int nq, int x0, int y0, int
   }
   F.write<kAux>(x0, y0, w, h, bg, out);
 }
-}  // namespace
 
-void compositeTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
-                   const ForwardOut& out) {
+inline void compositeTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1, int y1, const float bg[3],
+                          const ForwardOut& out) {
   if (out.depth)
     compositeTileImpl<true>(q, nq, x0, y0, x1, y1, bg, out);
   else
@@ -615,7 +623,7 @@ void compositeTile(const TileGaussian<float>* q, int nq, int x0, int y0, int x1,
 // stays a normal float (offsets that grew without bound sent an earlier version of this
 // loop into denormal operands, whose assists made the "floor" 5-7 times slower than the
 // kernels' arithmetic); the checksum keeps the result alive.
-float compositeFloor(long n) {
+inline float compositeFloor(long n) {
   ForwardBlock b[2];
   for (ForwardBlock& B : b) {
     B.Tr = vs(1.0f);
@@ -638,6 +646,6 @@ float compositeFloor(long n) {
   }
   return hsum(b[0].C0 + b[1].C0 + b[0].C2 + b[1].C1 + b[0].walked + b[1].walked);
 }
-#endif  // !SARESGS_KERNEL_NO_COMPOSITE
 
-}  // namespace saresgs::raster_kernels::SARESGS_KERNEL_NS
+}  // namespace
+}  // namespace saresgs::raster_kernels

@@ -1,8 +1,8 @@
 // The float tile kernels that composite, and back-propagate, a full render and the render
-// of a subset of its Gaussians in one walk (see splat/raster/raster_kernels.h). Included
-// right after splat/raster/raster_kernels_impl.h and splat/raster/raster_kernels_backward_impl.h
-// in the same translation unit, with the same SARESGS_KERNEL_NS / SARESGS_KERNEL_LANES, and
-// reuses their states and steps (ForwardState, BackwardState, backStep, forEachBlock, ...).
+// of a subset of its Gaussians in one walk (see splat/raster/raster_kernels.h), for the
+// including file's KernelIsa: they reuse the states and steps of
+// splat/raster/raster_kernels_impl.h and raster_kernels_backward_impl.h (ForwardState,
+// BackwardState, backStep, forEachBlock, ...).
 //
 // Why one walk: a subset Gaussian's alpha at a pixel is the full render's alpha at that
 // pixel (rule 8 only removes Gaussians), and the kernels are bound by the exponential, so
@@ -14,17 +14,10 @@
 // in the contributions), so its sums equal the two single backward passes' added, up to
 // float rounding. Walked counts are kept as full-list positions, which are monotone in the
 // subset's own positions.
-#if !defined(SARESGS_KERNEL_NS) || !defined(SARESGS_KERNEL_LANES)
-#error "include raster_kernels_impl.h (with its macros) before raster_kernels_pair_impl.h"
-#endif
-// SARESGS_KERNEL_PAIR_COMPOSITE_ONLY: only compositeTilePair is defined
-// (raster_kernels_avx512.cpp).
-#ifndef SARESGS_KERNEL_PAIR_COMPOSITE_ONLY
-#define SARESGS_KERNEL_PAIR_COMPOSITE_ONLY 0
-#endif
+#pragma once
+#include "splat/raster/raster_kernels_backward_impl.h"
 
-namespace saresgs::raster_kernels::SARESGS_KERNEL_NS {
-
+namespace saresgs::raster_kernels {
 namespace {
 template <bool kAux>
 void compositeTilePairImpl(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0, int x1,
@@ -62,19 +55,15 @@ void compositeTilePairImpl(const TileGaussian<float>* q, const std::uint8_t* in_
   F.write<kAux>(x0, y0, w, h, bg, full);
   S.write<kAux>(x0, y0, w, h, bg, subset);
 }
-}  // namespace
 
 // Depth and contributors for both renders or for neither (full.depth decides).
-void compositeTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0, int x1,
-                       int y1, const float bg[3], const ForwardOut& full, const ForwardOut& subset) {
+inline void compositeTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0,
+                              int x1, int y1, const float bg[3], const ForwardOut& full, const ForwardOut& subset) {
   if (full.depth)
     compositeTilePairImpl<true>(q, in_subset, nq, x0, y0, x1, y1, bg, full, subset);
   else
     compositeTilePairImpl<false>(q, in_subset, nq, x0, y0, x1, y1, bg, full, subset);
 }
-
-#if !SARESGS_KERNEL_PAIR_COMPOSITE_ONLY
-namespace {
 
 template <bool kBg>
 void backwardTilePairImpl(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0, int x1,
@@ -131,16 +120,28 @@ void backwardTilePairImpl(const TileGaussian<float>* q, const std::uint8_t* in_s
   }
 }
 
-}  // namespace
-
-void backwardTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0, int x1,
-                      int y1, const float bg[3], const BackwardIn& full, const BackwardIn& subset, float* slots) {
+inline void backwardTilePair(const TileGaussian<float>* q, const std::uint8_t* in_subset, int nq, int x0, int y0,
+                             int x1, int y1, const float bg[3], const BackwardIn& full, const BackwardIn& subset,
+                             float* slots) {
   if (nq == 0) return;
   if (bg[0] != 0.0f || bg[1] != 0.0f || bg[2] != 0.0f)
     backwardTilePairImpl<true>(q, in_subset, nq, x0, y0, x1, y1, bg, full, subset, slots);
   else
     backwardTilePairImpl<false>(q, in_subset, nq, x0, y0, x1, y1, bg, full, subset, slots);
 }
-#endif  // !SARESGS_KERNEL_PAIR_COMPOSITE_ONLY
 
-}  // namespace saresgs::raster_kernels::SARESGS_KERNEL_NS
+// This compilation's tile walks (the backward, Fisher and pair kernels) as a KernelSet,
+// the other members null (raster_kernels_set_impl.h adds them).
+constexpr KernelSet walkKernels() {
+  KernelSet s{};
+  s.name = KernelIsa::kName;
+  s.lanes = L;
+  s.backward = backwardTile;
+  s.fisher = fisherTile;
+  s.composite_pair = compositeTilePair;
+  s.backward_pair = backwardTilePair;
+  return s;
+}
+
+}  // namespace
+}  // namespace saresgs::raster_kernels

@@ -45,9 +45,9 @@ struct RasterStateT {
   // the backward stage of bench step 512x384/100k took 1.1-1.2 times as long); the
   // per-Gaussian reductions read them through this map, in pair order.
   std::vector<std::uint32_t> pair_entry;
-  std::vector<T> final_T;               // per pixel
-  std::vector<std::uint32_t> n_walked;  // per pixel: tile entries walked (last contributor + 1)
-  int isa = 0;                          // the float kernels the forward pass used
+  std::vector<T> final_T;                              // per pixel
+  std::vector<std::uint32_t> n_walked;                 // per pixel: tile entries walked (last contributor + 1)
+  const raster_kernels::KernelSet* kernels = nullptr;  // the float kernels the forward pass used
 };
 
 namespace raster_stage {
@@ -62,28 +62,6 @@ template <typename T>
 tbb::task_arena& arena(const RasterStateT<T>& st) {
   return raster_execution::arena(st.settings.execution.threads);
 }
-
-// The float kernels, indexed by raster_execution::kernelIndex; index 0 is the baseline.
-struct KernelSet {
-  const char* name;
-  raster_kernels::CompositeFn composite;
-  raster_kernels::BackwardFn backward;
-  raster_kernels::ProjectFn project;
-  raster_kernels::ProjectBackwardFn project_backward;
-  raster_kernels::FisherChainFn fisher_chain;
-};
-inline constexpr KernelSet kKernelSets[] = {
-    {"baseline", raster_kernels::base4::compositeTile, raster_kernels::base4::backwardTile,
-     raster_kernels::base4::projectRange, raster_kernels::base4::projectBackwardList,
-     raster_kernels::base4::fisherChainList},
-    {"avx2", raster_kernels::avx2::compositeTile, raster_kernels::avx2::backwardTile,
-     raster_kernels::avx2::projectRange, raster_kernels::avx2::projectBackwardList,
-     raster_kernels::avx2::fisherChainList},
-    // avx512: AVX2's forward; its backward and Fisher walks on 32 registers, bit for bit AVX2's.
-    {"avx512", raster_kernels::avx2::compositeTile, raster_kernels::avx512::backwardTile,
-     raster_kernels::avx2::projectRange, raster_kernels::avx2::projectBackwardList,
-     raster_kernels::avx2::fisherChainList},
-};
 
 // Pixel range [lo, hi] whose centres (i + 0.5) lie within mean +- half, clipped to [0, n).
 template <typename T>
@@ -365,7 +343,7 @@ std::shared_ptr<S> reuseOrMake(std::shared_ptr<const S>& held) {
 template <typename T>
 void beginState(RasterStateT<T>& st, const RasterSettings& s, int max_sh_degree, int W, int H) {
   st.settings = s;
-  st.isa = raster_execution::kernelIndex(s.execution.kernels);
+  st.kernels = &raster_execution::kernelSet(s.execution.kernels);
   st.settings.sh_degree = std::clamp(s.sh_degree, 0, max_sh_degree);
   st.tiles_x = (W + kTileSize - 1) / kTileSize;
   st.tiles_y = (H + kTileSize - 1) / kTileSize;
@@ -375,8 +353,9 @@ void beginState(RasterStateT<T>& st, const RasterSettings& s, int max_sh_degree,
 raster_kernels::ProjectIn projectInput(const GaussiansT<float>& g, const CameraT<float>& cam, const RasterSettings& rs);
 
 // One Gaussian range of projectAll's projection (without its tile work).
-void projectRangeWith(const GaussiansT<float>& g, const CameraT<float>& camT, const RasterSettings& rs, int isa,
-                      std::size_t begin, std::size_t end, Projected<float>* out);
+void projectRangeWith(const GaussiansT<float>& g, const CameraT<float>& camT, const RasterSettings& rs,
+                      const raster_kernels::KernelSet& kernels, std::size_t begin, std::size_t end,
+                      Projected<float>* out);
 
 // Projects every unmasked Gaussian, culls, fills its tile data, radius and visibility,
 // and counts the tiles its pixel rectangle touches. `cover` is the caller's (kept between
