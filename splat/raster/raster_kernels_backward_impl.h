@@ -12,14 +12,13 @@ namespace {
 // Pairwise lane sums of two vectors: [a0 + a1, a2 + a3, ..., b0 + b1, b2 + b3, ...].
 // (A template, so that the shuffle of the other lane count is never instantiated.)
 template <typename V>
-inline V pairSumsOf(V a, V b) {
+inline V pairSums(V a, V b) {
   if constexpr (L == 4)
     return __builtin_shufflevector(a, b, 0, 2, 4, 6) + __builtin_shufflevector(a, b, 1, 3, 5, 7);
   else
     return __builtin_shufflevector(a, b, 0, 2, 4, 6, 8, 10, 12, 14) +
            __builtin_shufflevector(a, b, 1, 3, 5, 7, 9, 11, 13, 15);
 }
-inline vf pairSums(vf a, vf b) { return pairSumsOf(a, b); }
 
 // The lane sums of L vectors v[0, L) as one vector (lane k: the sum of v[k]), in a
 // fixed tree order (the same tree as hsum): L - 1 shuffle-adds instead of L horizontal

@@ -46,7 +46,7 @@ typedef std::int32_t vi __attribute__((vector_size(4 * L)));
 // another instruction set would take is never instantiated.)
 // Off x86-64 only the portable branches exist.
 template <typename V>
-inline V fmaOf(V a, V b, V c) {
+inline V fma(V a, V b, V c) {
 #if defined(__x86_64__)
   if constexpr (KernelIsa::kFma)
     return reinterpret_cast<V>(
@@ -55,7 +55,6 @@ inline V fmaOf(V a, V b, V c) {
 #endif
     return a * b + c;
 }
-inline vf fma(vf a, vf b, vf c) { return fmaOf(a, b, c); }
 
 // x in every lane. Written as a scalar-vector operation so that GCC emits one broadcast
 // (a per-lane loop became a chain of inserts); x - (+0) is x exactly, -0 included.
@@ -171,7 +170,7 @@ inline v4f rowOf(V v, [[maybe_unused]] int half) {
 // a < b ? a : b and a > b ? a : b, lane by lane (b where unordered): one min/max
 // instruction where the target has it (GCC keeps a vector ternary as compare + blend).
 template <typename V>
-inline V vminOf(V a, V b) {
+inline V vmin(V a, V b) {
 #if defined(__x86_64__)
   if constexpr (KernelIsa::kFma)
     return reinterpret_cast<V>(_mm256_min_ps(reinterpret_cast<__m256>(a), reinterpret_cast<__m256>(b)));
@@ -182,7 +181,7 @@ inline V vminOf(V a, V b) {
     return a < b ? a : b;
 }
 template <typename V>
-inline V vmaxOf(V a, V b) {
+inline V vmax(V a, V b) {
 #if defined(__x86_64__)
   if constexpr (KernelIsa::kFma)
     return reinterpret_cast<V>(_mm256_max_ps(reinterpret_cast<__m256>(a), reinterpret_cast<__m256>(b)));
@@ -192,12 +191,10 @@ inline V vmaxOf(V a, V b) {
 #endif
     return a > b ? a : b;
 }
-inline vf vmin(vf a, vf b) { return vminOf(a, b); }
-inline vf vmax(vf a, vf b) { return vmaxOf(a, b); }
 
 // The square root lane by lane (correctly rounded, as std::sqrt).
 template <typename V>
-inline V vsqrtOf(V a) {
+inline V vsqrt(V a) {
 #if defined(__x86_64__)
   if constexpr (KernelIsa::kFma) {
     return reinterpret_cast<V>(_mm256_sqrt_ps(reinterpret_cast<__m256>(a)));
@@ -210,7 +207,6 @@ inline V vsqrtOf(V a) {
     return a;
   }
 }
-inline vf vsqrt(vf a) { return vsqrtOf(a); }
 
 // 2^x for x <= 0 without a libm call, on a short dependency chain (the kernels are
 // bound by its latency, not by instruction count): x = n + r with n = round(x) by the
