@@ -18,6 +18,7 @@
 #include "geometry/io/json_file.h"
 #include "nbv/active_run.h"
 #include "nbv/eval/run_files.h"
+#include "nbv/active_settings.h"
 #include "nbv/preset.h"
 #include "nbv/run_report.h"
 #include "splat/raster_execution.h"

@@ -1,5 +1,4 @@
 #include "nbv/active_run.h"
-#include "geometry/enum_names.h"
 
 #include <nlohmann/json.hpp>
 
@@ -72,42 +71,12 @@ void ActiveRun::checkReplay() const {
   }
 }
 
-bool finalFitIsResidual(const ActiveOptions& o) { return needsOf(o.method).residual || o.final_residual; }
-
-TrainerOptions finalFitOptions(const ActiveOptions& o, bool method_training) {
-  TrainerOptions t = o.final_trainer;
-  t.seed = o.seed;
-  t.residual = o.trainer.residual;
-  t.residual.enabled = method_training && finalFitIsResidual(o);
-  return t;
-}
-
-const char* toString(ActivePhase p) {
-  static constexpr std::array<const char*, 8> kNames{"training",  "lifting",           "prefilter",
-                                                     "Fisher",    "exhaustive Fisher", "final evaluation",
-                                                     "final fit", "plain refit"};
-  return enumName(p, kNames);
-}
-
 void ActiveRun::report(ActivePhase phase, int done, int total) {
   last_.phase = phase;
   last_.phase_done = done;
   last_.phase_total = total;
   last_.gaussians = trainer_->gaussians().size();
   if (progress_) progress_(last_);
-}
-
-bool usesKmedianGate(const Scene& scene, const ActiveOptions& o) {
-  switch (o.method) {
-    case Method::kKmedianFisher:
-      return true;
-    case Method::kFvsFisher:
-      return false;
-    case Method::kAdaptive:
-      return captureClustering(scene) > o.adaptive_clustering;
-    default:
-      throw std::invalid_argument(std::string("usesKmedianGate: ") + toString(o.method) + " has no gate");
-  }
 }
 
 int ActiveRun::selectNext(SelectionLog& log) {

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "geometry/settings_table.h"
-#include "nbv/active_run.h"
+#include "nbv/active_options.h"
 
 namespace saresgs {
 

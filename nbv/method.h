@@ -1,5 +1,5 @@
 #pragma once
-// The view-selection methods of an active run. kMethodTable in method.cpp is the one
+// The view-selection methods of an active run. kMethodTable in method_table.cpp is the one
 // list: names, parsing, the CLI's choices, the ablation's checks, what each method
 // computes and the function that chooses its views all come from it, so adding a method
 // means adding its row (and its enum value) there, and its function

@@ -1,3 +1,5 @@
+// The method registry's table and what method.h answers from it (a file of its own: the
+// table names each method's selector, nbv/selection_step.h, whose context needs method.h).
 #include "nbv/method.h"
 
 #include <stdexcept>

@@ -8,8 +8,7 @@
 #include <string>
 #include <string_view>
 
-#include "nbv/active_run.h"
-#include "nbv/active_settings.h"  // the settings that pick a preset and override it
+#include "nbv/active_options.h"
 
 namespace saresgs {
 

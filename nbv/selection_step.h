@@ -1,6 +1,6 @@
 #pragma once
 // One selection step as a method sees it, and each method's way of choosing from it (the
-// `select` of its row in the method registry, nbv/method.cpp). ActiveRun::selectNext
+// `select` of its row in the method registry, nbv/method_table.cpp). ActiveRun::selectNext
 // builds the step (the candidates; for the coverage methods the SA-Point prefilter's
 // scores and cut, which need the run's state) and calls the method's function; a new
 // selector is its row there plus its function here, with its algorithm in a file of its own.
@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "nbv/active_run.h"
+#include "nbv/active_options.h"
 
 namespace saresgs {
 

@@ -68,17 +68,6 @@ JobName splitJob(const std::string& name) {
 
 }  // namespace
 
-std::vector<std::string> jobNameParts(const std::string& name) {
-  std::vector<std::string> parts;
-  for (std::size_t p = 0;;) {
-    const std::size_t q = name.find("__", p);
-    parts.push_back(name.substr(p, q == std::string::npos ? std::string::npos : q - p));
-    if (q == std::string::npos) break;
-    p = q + 2;
-  }
-  return parts;
-}
-
 std::vector<MarkdownBlock> parseMarkdown(const std::string& text) {
   std::vector<MarkdownBlock> blocks;
   std::istringstream in(text);

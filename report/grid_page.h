@@ -27,10 +27,6 @@ struct GridPageResult {
 // Throws InputError naming GRID_DIR when it has no runs/ folder.
 GridPageResult writeGridPage(const std::string& grid_dir, const GridPageOptions& options = {});
 
-// A job folder's name, SCENE__METHOD__VARIANT__sSEED (nbv/eval/ablation.cpp's job id), in
-// its parts (one part, the whole name, when it is not of that form).
-std::vector<std::string> jobNameParts(const std::string& name);
-
 // The Markdown the grid writes, read back: headings, paragraphs and pipe tables in order
 // (a table's cells trimmed, its alignment row dropped). Exposed for its tests.
 struct MarkdownBlock {

@@ -14,7 +14,6 @@
 #include "geometry/io/json_file.h"
 #include "geometry/scene/dataset_checks.h"
 #include "nbv/run_report.h"
-#include "report/grid_page.h"
 #include "report/html_page.h"
 #include "splat/model_frame.h"
 #include "splat/model_ops.h"
@@ -404,6 +403,17 @@ RunPageResult writeRunPage(const std::string& run_dir, const Scene* given, const
   writeFileAtomic(res.path, html);
   res.bytes = html.size();
   return res;
+}
+
+std::vector<std::string> jobNameParts(const std::string& name) {
+  std::vector<std::string> parts;
+  for (std::size_t p = 0;;) {
+    const std::size_t q = name.find("__", p);
+    parts.push_back(name.substr(p, q == std::string::npos ? std::string::npos : q - p));
+    if (q == std::string::npos) break;
+    p = q + 2;
+  }
+  return parts;
 }
 
 }  // namespace saresgs

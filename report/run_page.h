@@ -38,4 +38,8 @@ struct RunPageResult {
 // missing (a .ply, the dataset, the viewer script) is said on the page and in `missing`.
 RunPageResult writeRunPage(const std::string& run_dir, const Scene* scene, const RunPageOptions& options = {});
 
+// A job folder's name, SCENE__METHOD__VARIANT__sSEED (nbv/eval/ablation.cpp's job id), in
+// its parts (one part, the whole name, when it is not of that form).
+std::vector<std::string> jobNameParts(const std::string& name);
+
 }  // namespace saresgs

@@ -1,6 +1,7 @@
 #pragma once
 // Small image value types. Images live in memory as 8-bit (Image8) and are
-// converted to float linear RGB in [0,1] (ImageF) per use; depth maps are float.
+// converted to float linear RGB in [0,1] (ImageF) per use; depth maps are float. The file
+// functions (readImage, writeImage, ...) are defined in image_io.cpp, on the codecs.
 #include <cstdint>
 #include <string>
 #include <vector>

@@ -2,7 +2,12 @@
 // Rendering internals, visible to tests: the public SyntheticScene::render raises the
 // sample count to at least 4 and rounds it up to a square grid; these functions take
 // the grid as given.
-#include "geometry/synth/synthetic_scene.h"
+#include "geometry/camera/camera.h"
+#include "geometry/image/image.h"
+
+namespace saresgs {
+class SyntheticScene;  // geometry/synth/synthetic_scene.h
+}
 
 namespace saresgs::synth {
 

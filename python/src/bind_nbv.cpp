@@ -11,6 +11,7 @@
 #include "report/run_page.h"
 #include "nbv/eval/coverage_report.h"
 #include "nbv/method.h"
+#include "nbv/active_settings.h"
 #include "nbv/preset.h"
 #include "splat/thread_limit.h"
 #include "nbv/run_report.h"

@@ -148,7 +148,7 @@ TEST(Cli, TrainCoverageAndActiveOnASmallScene) {
   EXPECT_NE(r.output.find("--views"), std::string::npos) << r.output;
 }
 
-// Adding a method means adding it to nbv/method.cpp's table: the command line takes every
+// Adding a method means adding it to nbv/method_table.cpp's table: the command line takes every
 // method of allMethods() (the run then stops at the missing dataset, after the method was
 // accepted) and refuses a name that is not one, listing the choices.
 TEST(Cli, ActiveAcceptsEveryMethodOfTheList) {

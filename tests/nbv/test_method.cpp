@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "nbv/method.h"
+#include "nbv/active_settings.h"
 #include "nbv/preset.h"
 
 namespace saresgs {
