@@ -14,23 +14,26 @@ def run(root):
     return subprocess.run([sys.executable, SCRIPT, str(root)], capture_output=True, text=True)
 
 
-def make_tree(tmp_path, files):
-    for name, text in files.items():
-        path = tmp_path / name
+def make_tree(tmp_path, spec):
+    """spec: one line per file, "FILE: INCLUDED FILES" (quoted includes; <vector> as is)."""
+    for line in spec.strip().splitlines():
+        name, includes = line.split(":")
+        path = tmp_path / name.strip()
         path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(text)
+        path.write_text("".join(f"#include {i if i.startswith('<') else chr(34) + i + chr(34)}\n"
+                                for i in includes.split()))
     subprocess.run(["git", "init", "-q", str(tmp_path)], check=True)
     subprocess.run(["git", "-C", str(tmp_path), "add", "."], check=True)
 
 
 def test_a_circle_through_a_source_file_is_found(tmp_path):
-    make_tree(tmp_path, {
-        "a/x.h": "#pragma once\n#include \"a/y.h\"\n",
-        "a/y.h": "#pragma once\n",
-        "a/y.cpp": "#include \"a/y.h\"\n#include \"a/z.h\"\n",
-        "a/z.h": "#pragma once\n#include \"a/x.h\"\n",
-        "b/w.h": "#include <vector>\n",
-    })
+    make_tree(tmp_path, """
+        a/x.h: a/y.h
+        a/y.h:
+        a/y.cpp: a/y.h a/z.h
+        a/z.h: a/x.h
+        b/w.h: <vector>
+    """)
     r = run(tmp_path)
     assert r.returncode == 1, r.stdout + r.stderr
     assert "circle: a/x, a/y, a/z" in r.stdout
@@ -39,12 +42,12 @@ def test_a_circle_through_a_source_file_is_found(tmp_path):
 
 
 def test_includes_one_way_are_no_circle(tmp_path):
-    make_tree(tmp_path, {
-        "a/x.h": "#pragma once\n#include \"a/y.h\"\n",
-        "a/x.cpp": "#include \"a/x.h\"\n#include \"a/z.h\"\n",
-        "a/y.h": "#pragma once\n#include \"a/z.h\"\n",
-        "a/z.h": "#pragma once\n",
-    })
+    make_tree(tmp_path, """
+        a/x.h: a/y.h
+        a/x.cpp: a/x.h a/z.h
+        a/y.h: a/z.h
+        a/z.h:
+    """)
     r = run(tmp_path)
     assert r.returncode == 0, r.stdout + r.stderr
     assert "3 units, 0 circles" in r.stdout
