@@ -6,9 +6,9 @@
 //
 // It compiles splat/raster/raster_kernels_impl.h with the AVX2 options (Avx2Isa) and times, in ns per evaluated pixel lane:
 //   reg2  - compositeFloor: the kernel's per-lane arithmetic on two blocks held in registers
-//           (since the lattice of 2026-11-27 this is the lattice's arithmetic, G by products;
-//           the exponent and exp2 per block that the numbers in docs/DECISIONS.md
-//           were measured with are evalLanes, still used off the lattice);
+//           (the lattice's arithmetic, G by products; the exponent and exp2 per block
+//           that the numbers in docs/DECISIONS.md were measured with are evalLanes,
+//           still used off the lattice);
 //   mem17 - the same arithmetic with each block's state loaded and stored every step, over
 //           17 blocks of a tile (what a block-major loop order would save is mem17 - reg2);
 //   tile  - compositeTile itself on one synthetic 16x16 tile of 600 Gaussians (sigma 1-2,

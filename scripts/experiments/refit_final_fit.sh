@@ -5,9 +5,10 @@
 # with the final fit's options (the quick preset's: its iterations, the run's Gaussian cap,
 # SH degree 0, the run's seed, one thread), kept only when it gives the run's final-fit
 # test PSNR to the last digit, as the test Cli.FinalFitEqualsTrainOnTheChosenViews has
-# it (on 2026-11-26 a refit of room360 fvs seed 4 was the run's .ply byte for byte). Runs made by the binary of 864af66 or later (and adaptive's) reproduce so;
-# the earlier ones of results/verdict2 do not (their final fit ran inside an active process
-# of older code; on 2026-11-26 their refits differed by 0.004-0.26 dB) and are left
+# it (a refit of room360 fvs seed 4 gave the run's .ply byte for byte). Runs whose final fit
+# ran in the same code as `saresgs train` reproduce so; the earliest ones of results/verdict2
+# do not (their final fit ran inside an active process of older code; their refits differed
+# by 0.004-0.26 dB) and are left
 # without a model. Plain-training methods only (fisher, fvs, random, adaptive, ...): a
 # residual method's final fit would need --residual and the binary of its grid.
 #
