@@ -22,7 +22,7 @@ using namespace saresgs;
 
 namespace {
 
-ImageF randomImage(int w, int h, std::uint64_t seed, float lo = 0.0f, float hi = 1.0f) {
+ImageF randomLossImage(int w, int h, std::uint64_t seed, float lo = 0.0f, float hi = 1.0f) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<float> u(lo, hi);
   ImageF img(w, h, 3);
@@ -214,8 +214,8 @@ void checkGradient(const ImageF& render, const ImageF& target, double lambda, st
 // `seed` and seed + 1) kept apart by 0.01, with seed + 2 for the finite differences.
 void checkGradientOnRandomImages(int w, int h, std::uint64_t seed) {
   for (double lambda : {0.0, 0.2, 1.0}) {
-    const ImageF render = randomImage(w, h, seed);
-    ImageF target = randomImage(w, h, seed + 1);
+    const ImageF render = randomLossImage(w, h, seed);
+    ImageF target = randomLossImage(w, h, seed + 1);
     separate(render, target, 0.01f);
     checkGradient(render, target, lambda, seed + 2);
   }
@@ -251,8 +251,8 @@ TEST(PhotometricLoss, GradientMatchesFiniteDifferencesOnImagesSmallerThanTheWind
 
 TEST(PhotometricLoss, GradientIsNotClampedOutsideTheUnitRange) {
   // Renders may leave [0,1] during training; the loss must stay differentiable there.
-  const ImageF render = randomImage(24, 18, 41, -0.3f, 1.3f);
-  ImageF target = randomImage(24, 18, 42);
+  const ImageF render = randomLossImage(24, 18, 41, -0.3f, 1.3f);
+  ImageF target = randomLossImage(24, 18, 42);
   separate(render, target, 0.01f);
   checkGradient(render, target, 0.2, 43);
   checkGradient(render, target, 1.0, 44);
@@ -274,21 +274,21 @@ TEST(PhotometricLoss, MatchesTheDoubleReference) {
     double grad_rel;
   };
   const std::vector<Case> cases = {
-      {"random", randomImage(w, h, 101), randomImage(w, h, 102), 2e-6},
+      {"random", randomLossImage(w, h, 101), randomLossImage(w, h, 102), 2e-6},
       {"smooth", smoothImage(w, h, 0.0f), smoothImage(w, h, 0.4f), 5e-5},
       {"scene, noisy render", perturbed(scene, 103, 0.02f), scene, 5e-5},
       {"scene, slightly noisy render", perturbed(scene, 104, 0.002f), scene, 5e-5},
       {"scene, offset render", perturbed(scene, 105, 0.0f, -0.01f), scene, 5e-5},
       {"scene, gain and offset", perturbed(scene, 106, 0.0005f, 0.01f, 0.97f), scene, 5e-5},
-      {"render outside [0,1]", randomImage(w, h, 107, -0.3f, 1.3f), scene, 2e-6},
+      {"render outside [0,1]", randomLossImage(w, h, 107, -0.3f, 1.3f), scene, 2e-6},
   };
   for (const Case& c : cases)
     for (double lambda : {0.2, 1.0}) expectMatchesReference(c.render, c.target, lambda, 1e-6, c.grad_rel, c.what);
 }
 
 TEST(PhotometricLoss, SsimTermEqualsTheMetricForImagesInTheUnitRange) {
-  const ImageF render = randomImage(64, 48, 51);
-  const ImageF target = randomImage(64, 48, 52);
+  const ImageF render = randomLossImage(64, 48, 51);
+  const ImageF target = randomLossImage(64, 48, 52);
   const LossResult r = photometricLoss(render, target, 1.0, false);
   const double metric = ssim(render, target);
   EXPECT_NEAR(r.ssim, metric, 1e-12);  // one kernel, the same inputs
@@ -297,8 +297,8 @@ TEST(PhotometricLoss, SsimTermEqualsTheMetricForImagesInTheUnitRange) {
 }
 
 TEST(PhotometricLoss, L1TermAndMixing) {
-  const ImageF render = randomImage(33, 21, 61);
-  const ImageF target = randomImage(33, 21, 62);
+  const ImageF render = randomLossImage(33, 21, 61);
+  const ImageF target = randomLossImage(33, 21, 62);
   double sum = 0;
   for (std::size_t i = 0; i < render.data.size(); ++i)
     sum += std::abs(static_cast<double>(render.data[i]) - target.data[i]);
@@ -322,7 +322,7 @@ TEST(PhotometricLoss, L1TermAndMixing) {
 TEST(PhotometricLoss, ZeroAtEqualityWithZeroGradient) {
   // Render == target makes the difference maps exactly zero, so S = 1 and every gradient
   // term vanishes exactly, not just to rounding.
-  for (const ImageF& img : {randomImage(37, 23, 71), sceneImage(40, 30), smoothImage(20, 9, 1)})
+  for (const ImageF& img : {randomLossImage(37, 23, 71), sceneImage(40, 30), smoothImage(20, 9, 1)})
     for (double lambda : {0.0, 0.2, 1.0}) {
       const LossResult r = photometricLoss(img, img, lambda);
       EXPECT_EQ(r.l1, 0.0);
@@ -336,7 +336,7 @@ TEST(PhotometricLoss, ZeroAtEqualityWithZeroGradient) {
 TEST(PhotometricLoss, DeterministicAcrossCallsAndThreadCounts) {
   // Each row is computed by the same operations whichever thread runs it, and row sums
   // are reduced in row order: results must be bit-identical for any thread count.
-  const ImageF render = randomImage(160, 123, 81);
+  const ImageF render = randomLossImage(160, 123, 81);
   const ImageF target = perturbed(render, 82, 0.05f);
   for (bool want_grad : {true, false}) {
     const LossResult a = photometricLoss(render, target, 0.2, want_grad);
@@ -370,8 +370,8 @@ bool sameBits(const LossResult& a, const LossResult& b) {
 // (A call nested in another's wait on the same thread takes buffers of its own; this test
 // cannot force that nesting, so it does not show it.)
 TEST(PhotometricLoss, KeptBuffersLeakNothingBetweenCallsOrThreads) {
-  const ImageF big = randomImage(150, 97, 5), big_t = perturbed(big, 6, 0.1f);
-  const ImageF small = randomImage(23, 17, 7), small_t = perturbed(small, 8, 0.1f);
+  const ImageF big = randomLossImage(150, 97, 5), big_t = perturbed(big, 6, 0.1f);
+  const ImageF small = randomLossImage(23, 17, 7), small_t = perturbed(small, 8, 0.1f);
   const LossResult b1 = photometricLoss(big, big_t, 0.2, true);
   const LossResult s1 = photometricLoss(small, small_t, 0.2, true);
   EXPECT_TRUE(sameBits(photometricLoss(big, big_t, 0.2, true), b1));
@@ -393,7 +393,7 @@ TEST(PhotometricLoss, EveryVectorWidthGivesIdenticalBits) {
   if (ssimBestIsa() == SsimIsa::kAvx512) isas.push_back(SsimIsa::kAvx512);
   // Widths around the vector lengths and their multiples (the loops' remainders), and 1x1.
   for (const auto& [w, h] : std::vector<std::pair<int, int>>{{160, 123}, {13, 7}, {1, 1}, {17, 33}, {6, 5}}) {
-    const ImageF render = randomImage(w, h, 111 + w, -0.1f, 1.1f);
+    const ImageF render = randomLossImage(w, h, 111 + w, -0.1f, 1.1f);
     const ImageF target = perturbed(render, 112, 0.05f);
     for (double lambda : {0.0, 0.2}) {
       ssimLimitIsa(SsimIsa::kBaseline);
@@ -420,7 +420,7 @@ TEST(PhotometricLoss, TinyAndConstantImagesAreFinite) {
   const std::vector<std::pair<int, int>> sizes = {{1, 1}, {5, 3}, {3, 5}, {1, 12}, {12, 1}, {2, 2}, {11, 11}, {17, 6}};
   for (const auto& [w, h] : sizes) {
     SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h));
-    const ImageF render = randomImage(w, h, 91 + w), target = randomImage(w, h, 92 + h);
+    const ImageF render = randomLossImage(w, h, 91 + w), target = randomLossImage(w, h, 92 + h);
     for (double lambda : {0.0, 0.2, 1.0}) {
       const LossResult r = photometricLoss(render, target, lambda);
       EXPECT_TRUE(allFinite(r));
@@ -461,8 +461,8 @@ TEST(PhotometricLoss, HandlesOtherChannelCounts) {
 }
 
 TEST(PhotometricLoss, WithoutGradientSameLossAndEmptyGradient) {
-  const ImageF render = randomImage(20, 15, 91);
-  const ImageF target = randomImage(20, 15, 92);
+  const ImageF render = randomLossImage(20, 15, 91);
+  const ImageF target = randomLossImage(20, 15, 92);
   const LossResult with = photometricLoss(render, target, 0.2, true);
   const LossResult without = photometricLoss(render, target, 0.2, false);
   EXPECT_EQ(with.loss, without.loss);

@@ -60,7 +60,7 @@ ToolRun runTool(const std::string& args) {
 }
 
 // Values inside the ranges SPZ quantizes without clamping (colours, SH in [-1, 1]).
-Gaussians randomModel(std::size_t n, int degree, std::uint64_t seed) {
+Gaussians randomSplatModel(std::size_t n, int degree, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<float> pos(-2.0f, 3.0f), u(-1.0f, 1.0f), ls(-5.0f, -1.0f);
   Gaussians g;
@@ -93,7 +93,7 @@ TEST(SplatTransform, InfoReportsOurGaussianCountAndShBands) {
   ASSERT_TRUE(toolPresent());
   TempDir dir;
   for (int degree : {3, 0}) {
-    const Gaussians g = randomModel(777, degree, 10 + degree);
+    const Gaussians g = randomSplatModel(777, degree, 10 + degree);
     const std::string in = dir.file("in" + std::to_string(degree) + ".ply");
     writeGaussiansPly(in, g);
     const ToolRun r = runTool(quote(in) + " --info null");
@@ -109,7 +109,7 @@ TEST(SplatTransform, SpzRoundTripKeepsCountAndPositions) {
   TempDir dir;
   for (int degree : {3, 0}) {
     SCOPED_TRACE("degree " + std::to_string(degree));
-    const Gaussians g = randomModel(1500, degree, 20 + degree);
+    const Gaussians g = randomSplatModel(1500, degree, 20 + degree);
     const std::string in = dir.file("in.ply"), spz = dir.file("out.spz"), back = dir.file("back.ply");
     writeGaussiansPly(in, g);
     ToolRun r = runTool("-w " + quote(in) + " " + quote(spz));
@@ -165,7 +165,7 @@ TEST(SplatTransform, SpzRoundTripKeepsCountAndPositions) {
 TEST(SplatTransform, FilterHarmonicsKeepsOurBandOneCoefficients) {
   ASSERT_TRUE(toolPresent());
   TempDir dir;
-  const Gaussians g = randomModel(300, 3, 30);
+  const Gaussians g = randomSplatModel(300, 3, 30);
   const std::string in = dir.file("in.ply"), out = dir.file("h1.ply");
   writeGaussiansPly(in, g);
   const ToolRun r = runTool("-w " + quote(in) + " -H 1 " + quote(out));
@@ -188,7 +188,7 @@ TEST(SplatTransform, FilterHarmonicsKeepsOurBandOneCoefficients) {
 TEST(SplatTransform, ReadsOurSplatFileAsWritten) {
   ASSERT_TRUE(toolPresent());
   TempDir dir;
-  Gaussians g = randomModel(1200, 3, 31);
+  Gaussians g = randomSplatModel(1200, 3, 31);
   g.rotations[0] = g.rotations[1] = g.rotations[2] = g.rotations[3] = 0;  // a zero quaternion: identity
   const std::string bytes = splatFileBytes(g);
   ASSERT_EQ(bytes.size(), g.size() * kSplatRecordBytes);

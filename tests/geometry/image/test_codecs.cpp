@@ -20,7 +20,7 @@ namespace {
 
 using Bytes = std::vector<std::uint8_t>;
 
-Bytes readBytes(const std::string& path) {
+Bytes codecFileBytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return Bytes(std::istreambuf_iterator<char>(in), {});
 }
@@ -70,7 +70,7 @@ TEST(Codecs, EveryKindOfPngDecodesAsOpenCvReadsIt) {
       ASSERT_TRUE(cv::imwrite(path, c.m, c.params));
       const Image8 want = openCv(path, keep_alpha ? cv::IMREAD_UNCHANGED : cv::IMREAD_COLOR);
       ASSERT_FALSE(want.empty());
-      const auto got = decodePng(readBytes(path), keep_alpha);
+      const auto got = decodePng(codecFileBytes(path), keep_alpha);
       ASSERT_TRUE(got.has_value());
       EXPECT_EQ(got->channels, want.channels);
       EXPECT_EQ(got->data, want.data);

@@ -10,7 +10,7 @@
 using namespace saresgs;
 
 namespace {
-Image8 randomImage(int w, int h, int c, std::uint64_t seed) {
+Image8 randomImage8(int w, int h, int c, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   Image8 img(w, h, c);
   for (auto& v : img.data) v = static_cast<std::uint8_t>(rng() & 0xff);
@@ -21,7 +21,7 @@ Image8 randomImage(int w, int h, int c, std::uint64_t seed) {
 TEST(ImageIO, PngRoundTripIsExactForRgbAndRgba) {
   test::TempDir d;
   for (int c : {3, 4}) {
-    const Image8 img = randomImage(37, 23, c, c);
+    const Image8 img = randomImage8(37, 23, c, c);
     writeImage(d.file("x.png"), img);
     const Image8 back = readImage(d.file("x.png"), /*keep_alpha=*/true);
     EXPECT_EQ(back.channels, c);
@@ -64,7 +64,7 @@ TEST(ImageIO, FloatConversionIntoAReusedImageEqualsAFreshOne) {
   ImageF out;
   for (const auto& [w, h, c] :
        {std::tuple{31, 17, 3}, std::tuple{5, 4, 3}, std::tuple{40, 20, 4}, std::tuple{3, 2, 1}}) {
-    const Image8 img = randomImage(w, h, c, static_cast<std::uint64_t>(w * 100 + c));
+    const Image8 img = randomImage8(w, h, c, static_cast<std::uint64_t>(w * 100 + c));
     toFloatInto(img, out);
     const ImageF fresh = toFloat(img);
     EXPECT_EQ(out.width, w);
@@ -79,7 +79,7 @@ TEST(ImageIO, FloatConversionIntoAReusedImageEqualsAFreshOne) {
 // An 8-bit grey file comes back as RGB with each channel the grey value.
 TEST(ImageIO, GreyIsReplicatedIntoRgb) {
   test::TempDir d;
-  const Image8 grey = randomImage(13, 9, 1, 5);
+  const Image8 grey = randomImage8(13, 9, 1, 5);
   cv::Mat m(9, 13, CV_8UC1, const_cast<std::uint8_t*>(grey.data.data()));
   cv::imwrite(d.file("grey.png"), m);
   const Image8 img = readImage(d.file("grey.png"), /*keep_alpha=*/true);

@@ -140,18 +140,18 @@ Bytes withSize(Bytes b, std::uint32_t w, std::uint32_t h) {
   return b;
 }
 
-Image8 randomImage(int w, int h, int c, std::uint64_t seed) {
+Image8 randomPngImage(int w, int h, int c, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   Image8 img(w, h, c);
   for (auto& v : img.data) v = static_cast<std::uint8_t>(rng() & 0xff);
   return img;
 }
 
-void writeBytes(const std::string& path, const Bytes& b) {
+void writePngBytes(const std::string& path, const Bytes& b) {
   std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(b.data()), static_cast<long>(b.size()));
 }
 
-Bytes readBytes(const std::string& path) {
+Bytes pngFileBytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return Bytes(std::istreambuf_iterator<char>(in), {});
 }
@@ -177,7 +177,7 @@ TEST(PlainPng, EveryRowFilterDecodesAsLibpngDoes) {
       for (int filter : {-1, 0, 1, 2, 3, 4}) {
         // Noise reaches every wrap-around of the byte sums; a ramp makes Paeth's three
         // choices and the Average's rounding matter.
-        Image8 img = randomImage(w, h, c, static_cast<std::uint64_t>(w * 131 + h * 7 + c + filter * 1000 + 5000));
+        Image8 img = randomPngImage(w, h, c, static_cast<std::uint64_t>(w * 131 + h * 7 + c + filter * 1000 + 5000));
         if (filter == 4)
           for (std::size_t i = 0; i < img.data.size(); i += 2) img.data[i] = static_cast<std::uint8_t>(i * 3);
         PngSpec s;
@@ -185,7 +185,7 @@ TEST(PlainPng, EveryRowFilterDecodesAsLibpngDoes) {
         s.filter = filter;
         s.idat_chunks = (w * h) % 3 + 1;
         const Bytes file = encodePng(img, s);
-        writeBytes(d.file("f.png"), file);
+        writePngBytes(d.file("f.png"), file);
         for (bool keep_alpha : {true, false}) {
           SCOPED_TRACE(testing::Message() << "channels " << c << ", " << w << "x" << h << ", filter " << filter
                                           << ", keep_alpha " << keep_alpha);
@@ -209,12 +209,12 @@ TEST(PlainPng, FilesOpenCvWritesTakeTheFastPath) {
   // The datasets' own images: compressed by zlib (not stored), the filters OpenCV picks.
   test::TempDir d;
   for (int c : {3, 4}) {
-    Image8 img = randomImage(96, 40, c, 77 + c);
+    Image8 img = randomPngImage(96, 40, c, 77 + c);
     for (int y = 20; y < 40; ++y)  // a smooth half, so that the stream has real matches
       for (int x = 0; x < 96; ++x)
         for (int k = 0; k < c; ++k) img.at(x, y, k) = static_cast<std::uint8_t>(x + 2 * y + 40 * k);
     writeImage(d.file("cv.png"), img);
-    const Bytes file = readBytes(d.file("cv.png"));
+    const Bytes file = pngFileBytes(d.file("cv.png"));
     const auto got = decodePlainPng(file, true);
     ASSERT_TRUE(got.has_value()) << c;
     EXPECT_EQ(got->data, img.data);
@@ -223,7 +223,7 @@ TEST(PlainPng, FilesOpenCvWritesTakeTheFastPath) {
 }
 
 TEST(PlainPng, DeclinesWhatOpenCvMustInterpret) {
-  const Image8 rgb = randomImage(9, 6, 3, 1);
+  const Image8 rgb = randomPngImage(9, 6, 3, 1);
   const Bytes good = encodePng(rgb, {});
   ASSERT_TRUE(decodePlainPng(good, true).has_value());
   auto declined = [](const Bytes& b) { return !decodePlainPng(b, true).has_value(); };
@@ -243,15 +243,15 @@ TEST(PlainPng, DeclinesWhatOpenCvMustInterpret) {
   test::TempDir d;
   cv::Mat g16(5, 6, CV_16UC1, cv::Scalar(65535));
   cv::imwrite(d.file("g16.png"), g16);
-  EXPECT_TRUE(declined(readBytes(d.file("g16.png"))));
+  EXPECT_TRUE(declined(pngFileBytes(d.file("g16.png"))));
   EXPECT_EQ(readImage(d.file("g16.png")).at(2, 2, 1), 255);
   cv::Mat g8(5, 6, CV_8UC1, cv::Scalar(9));
   cv::imwrite(d.file("g8.png"), g8);
-  EXPECT_TRUE(declined(readBytes(d.file("g8.png"))));
+  EXPECT_TRUE(declined(pngFileBytes(d.file("g8.png"))));
 }
 
 TEST(PlainPng, DeclinesEveryDamageAndOpenCvJudgesIt) {
-  const Image8 rgb = randomImage(11, 8, 3, 2);
+  const Image8 rgb = randomPngImage(11, 8, 3, 2);
   const Bytes good = encodePng(rgb, {});
   test::TempDir d;
   std::vector<std::pair<std::string, Bytes>> bad;
@@ -278,7 +278,7 @@ TEST(PlainPng, DeclinesEveryDamageAndOpenCvJudgesIt) {
     SCOPED_TRACE(what);
     EXPECT_FALSE(decodePlainPng(b, true).has_value());
     // readImage gives OpenCV's verdict: its image, or InputError naming the file.
-    writeBytes(d.file("bad.png"), b);
+    writePngBytes(d.file("bad.png"), b);
     const Image8 want = openCvRead(d.file("bad.png"), true);
     if (want.empty()) {
       EXPECT_TRUE(test::throwsInputError([&] { readImage(d.file("bad.png"), true); }, "bad.png", "file"));

@@ -35,7 +35,7 @@ void addCamera(ColmapModel& m, std::uint32_t id, const std::string& model, std::
 
 // Random cameras of both pinhole models and one OPENCV, images with random unit
 // quaternions and 2D points, and points whose tracks match the images' point ids.
-ColmapModel randomModel(std::uint64_t seed) {
+ColmapModel randomColmapModel(std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(0, 1);
   std::normal_distribution<double> n(0, 1);
@@ -219,7 +219,7 @@ TEST(ColmapModels, TableMatchesColmap) {
 
 TEST(ColmapIo, TextRoundTripIsExact) {
   TempDir dir;
-  const ColmapModel m = randomModel(1);
+  const ColmapModel m = randomColmapModel(1);
   writeColmapText(dir.file("sparse/0"), m);  // creates the directories
   expectSameModel(m, readColmapText(dir.file("sparse/0")));
   expectSameModel(m, readColmapModel(dir.file("sparse/0")));
@@ -227,7 +227,7 @@ TEST(ColmapIo, TextRoundTripIsExact) {
 
 TEST(ColmapIo, BinaryRoundTripIsExact) {
   TempDir dir;
-  const ColmapModel m = randomModel(2);
+  const ColmapModel m = randomColmapModel(2);
   writeColmapBinary(dir.file("sparse/0"), m);
   expectSameModel(m, readColmapBinary(dir.file("sparse/0")));
   expectSameModel(m, readColmapModel(dir.file("sparse/0")));
@@ -235,7 +235,7 @@ TEST(ColmapIo, BinaryRoundTripIsExact) {
 
 TEST(ColmapIo, TextBinaryTextRoundTripIsExact) {
   TempDir dir;
-  const ColmapModel m = randomModel(3);
+  const ColmapModel m = randomColmapModel(3);
   writeColmapText(dir.file("text1"), m);
   writeColmapBinary(dir.file("bin"), readColmapText(dir.file("text1")));
   writeColmapText(dir.file("text2"), readColmapBinary(dir.file("bin")));
@@ -247,7 +247,7 @@ TEST(ColmapIo, TextBinaryTextRoundTripIsExact) {
 
 TEST(ColmapIo, WritersLeaveOnlyTheModelFiles) {
   TempDir dir;
-  const ColmapModel m = randomModel(4);
+  const ColmapModel m = randomColmapModel(4);
   writeColmapText(dir.str(), m);
   writeColmapBinary(dir.str(), m);
   writeColmapBinary(dir.str(), m);  // overwriting works too
@@ -270,8 +270,8 @@ TEST(ColmapIo, TextHeaderHasColmapComments) {
 
 TEST(ColmapIo, ReadModelPrefersBinary) {
   TempDir dir;
-  const ColmapModel text = randomModel(5);
-  const ColmapModel binary = randomModel(6);
+  const ColmapModel text = randomColmapModel(5);
+  const ColmapModel binary = randomColmapModel(6);
   writeColmapText(dir.str(), text);
   expectSameModel(text, readColmapModel(dir.str()));
   writeColmapBinary(dir.str(), binary);
@@ -404,7 +404,7 @@ TEST(ColmapErrors, TextCountDoesNotParse) {
 
 TEST(ColmapErrors, TextCountDisagreesWithRecords) {
   TempDir dir;
-  writeColmapText(dir.str(), randomModel(7));
+  writeColmapText(dir.str(), randomColmapModel(7));
   // Drop the last point line, as a truncated copy would.
   std::string points = readBytes(dir.file("points3D.txt"));
   points.erase(points.rfind('\n', points.size() - 2) + 1);

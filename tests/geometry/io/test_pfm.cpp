@@ -17,7 +17,7 @@ using saresgs::test::writeBytes;
 
 namespace {
 
-ImageF randomImage(int w, int h, int c, std::uint64_t seed) {
+ImageF randomPfmImage(int w, int h, int c, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<float> u(-1000, 1000);
   ImageF img(w, h, c);
@@ -57,14 +57,14 @@ void expectSameImage(const ImageF& a, const ImageF& b) {
 
 TEST(Pfm, RoundTripOneChannelIsExact) {
   TempDir dir;
-  const ImageF img = randomImage(7, 5, 1, 1);
+  const ImageF img = randomPfmImage(7, 5, 1, 1);
   writePfm(dir.file("depth/d.pfm"), img);  // creates the directory
   expectSameImage(img, readPfm(dir.file("depth/d.pfm")));
 }
 
 TEST(Pfm, RoundTripThreeChannelsIsExact) {
   TempDir dir;
-  const ImageF img = randomImage(4, 9, 3, 2);
+  const ImageF img = randomPfmImage(4, 9, 3, 2);
   writePfm(dir.file("c.pfm"), img);
   expectSameImage(img, readPfm(dir.file("c.pfm")));
 }
@@ -133,7 +133,7 @@ TEST(Pfm, MalformedHeader) {
 
 TEST(Pfm, TruncatedAtEveryOffset) {
   TempDir dir;
-  writePfm(dir.file("good.pfm"), randomImage(3, 2, 3, 3));
+  writePfm(dir.file("good.pfm"), randomPfmImage(3, 2, 3, 3));
   const std::string full = readBytes(dir.file("good.pfm"));
   const std::string path = dir.file("bad.pfm");
   for (size_t len = 0; len < full.size(); ++len) {

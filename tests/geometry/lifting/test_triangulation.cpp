@@ -12,14 +12,14 @@ using namespace saresgs;
 
 namespace {
 
-Intrinsics makeK(int w = 640, int h = 480, double f = 500) {
+Intrinsics triangulationK(int w = 640, int h = 480, double f = 500) {
   return Intrinsics{.width = w, .height = h, .fx = f, .fy = f * 1.01, .cx = 0.5 * w + 2.5, .cy = 0.5 * h - 1.5};
 }
 
 Camera randomRotationCamera(std::mt19937_64& rng, const Eigen::Vector3d& centre) {
   std::normal_distribution<double> n(0, 1);
   const Eigen::Quaterniond q = Eigen::Quaterniond(n(rng), n(rng), n(rng), n(rng)).normalized();
-  Camera c = Camera::fromQuaternion(makeK(), q, Eigen::Vector3d::Zero());
+  Camera c = Camera::fromQuaternion(triangulationK(), q, Eigen::Vector3d::Zero());
   c.t = -c.R * centre;
   return c;
 }
@@ -109,8 +109,8 @@ TEST(Triangulation, ExactCorrespondencesRecoverThePoint) {
         d1 = Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized();
       } while (d0.dot(d1) > std::cos(20 * std::numbers::pi / 180));
       const Eigen::Vector3d c0p = X + (4.5 + 1.5 * u(rng)) * d0, c1p = X + (4.5 + 1.5 * u(rng)) * d1;
-      const Camera c0 = Camera::lookAt(makeK(), c0p, X + 0.3 * Eigen::Vector3d(u(rng), u(rng), u(rng)));
-      const Camera c1 = Camera::lookAt(makeK(), c1p, X + 0.3 * Eigen::Vector3d(u(rng), u(rng), u(rng)));
+      const Camera c0 = Camera::lookAt(triangulationK(), c0p, X + 0.3 * Eigen::Vector3d(u(rng), u(rng), u(rng)));
+      const Camera c1 = Camera::lookAt(triangulationK(), c1p, X + 0.3 * Eigen::Vector3d(u(rng), u(rng), u(rng)));
       const auto x0 = c0.project(X), x1 = c1.project(X);
       ASSERT_TRUE(x0 && x1);
       const TriangulatedPoint p = triangulate(c0, c1, {*x0, *x1});
@@ -140,7 +140,7 @@ TEST(Triangulation, PixelNoiseGivesTheExpectedReprojectionStatistics) {
   std::mt19937_64 rng(12);
   std::normal_distribution<double> noise(0, sigma);
   std::uniform_real_distribution<double> u(0, 1);
-  const Camera c0 = Camera::fromQuaternion(makeK(), Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero());
+  const Camera c0 = Camera::fromQuaternion(triangulationK(), Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero());
   Camera c1 = c0;
   c1.t = -c1.R * Eigen::Vector3d(1.0, 0, 0);
   TriangulationOptions o;
@@ -185,7 +185,7 @@ TEST(Triangulation, PixelNoiseGivesTheExpectedReprojectionStatistics) {
 }
 
 TEST(Triangulation, NearParallelRaysAreRejected) {
-  const Camera c0 = Camera::fromQuaternion(makeK(), Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero());
+  const Camera c0 = Camera::fromQuaternion(triangulationK(), Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero());
   Camera c1 = c0;
   c1.t = -c1.R * Eigen::Vector3d(0.05, 0, 0);  // 5 cm baseline at 10 m: 0.29 degrees
   const Eigen::Vector3d X(0.3, -0.2, 10);
@@ -204,7 +204,7 @@ TEST(Triangulation, NearParallelRaysAreRejected) {
 
 TEST(Triangulation, ExactlyParallelRaysAreAtInfinity) {
   // Same rotation, different centres, the same pixel in both: the rays are parallel.
-  const Camera c0 = Camera::fromQuaternion(makeK(), Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero());
+  const Camera c0 = Camera::fromQuaternion(triangulationK(), Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero());
   const Camera c1 = extrapolatedCamera(c0, 0.3, 0.2, 0.5);
   const Eigen::Vector2d x(200.5, 100.5);
   const TriangulatedPoint p = triangulate(c0, c1, {x, x});
@@ -214,7 +214,7 @@ TEST(Triangulation, ExactlyParallelRaysAreAtInfinity) {
 }
 
 TEST(Triangulation, PointsBehindACameraAreRejected) {
-  const Camera c0 = Camera::fromQuaternion(makeK(), Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero());
+  const Camera c0 = Camera::fromQuaternion(triangulationK(), Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero());
   // Camera 1 looks the other way (rotated 180 degrees about y) from z = 20: a point at
   // z = 25 is in front of camera 0 and behind camera 1.
   Camera c1 = c0;
@@ -254,7 +254,7 @@ TEST(Triangulation, ZeroBaselineIsRejected) {
 }
 
 TEST(Triangulation, DegenerateSystemsAreRejected) {
-  const Camera c0 = Camera::fromQuaternion(makeK(), Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero());
+  const Camera c0 = Camera::fromQuaternion(triangulationK(), Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero());
   Camera c1 = c0;
   c1.t = -c1.R * Eigen::Vector3d(0.2, 0.1, 2.0);  // mostly forward: epipoles inside both images
   // Both points at their epipoles: both rays are the baseline, a whole line of solutions.
@@ -274,7 +274,7 @@ TEST(Triangulation, DegenerateSystemsAreRejected) {
 }
 
 TEST(Triangulation, CorrespondencesOnOrOutsideTheBorderAreRejected) {
-  const Camera c0 = Camera::fromQuaternion(makeK(), Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero());
+  const Camera c0 = Camera::fromQuaternion(triangulationK(), Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero());
   Camera c1 = c0;
   c1.t = -c1.R * Eigen::Vector3d(1, 0, 0);
   const Eigen::Vector3d X(0.1, 0.1, 5);
@@ -326,7 +326,7 @@ TEST(Triangulation, RandomInputsNeverProduceNaN) {
 TEST(Triangulation, ParallelResultIsInInputOrderAndMatchesTheSerialOne) {
   std::mt19937_64 rng(15);
   std::uniform_real_distribution<double> u(0, 1);
-  const Camera c0 = Camera::fromQuaternion(makeK(), Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero());
+  const Camera c0 = Camera::fromQuaternion(triangulationK(), Eigen::Quaterniond::Identity(), Eigen::Vector3d::Zero());
   const Camera c1 = extrapolatedCamera(c0, 0.4, 0.3, 0.8);
   std::vector<Correspondence> ms;
   for (int i = 0; i < 5000; ++i) {

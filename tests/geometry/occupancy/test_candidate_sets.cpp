@@ -17,7 +17,7 @@ using namespace saresgs;
 
 namespace {
 
-Intrinsics makeK(int w = 96, int h = 72) {
+Intrinsics candidateK(int w = 96, int h = 72) {
   return Intrinsics{.width = w, .height = h, .fx = 0.9 * w, .fy = 0.9 * w, .cx = 0.5 * w + 1.25, .cy = 0.5 * h - 0.75};
 }
 
@@ -62,7 +62,7 @@ std::vector<Camera> probeCameras(std::mt19937_64& rng, const AABB& box, int coun
         target = c + 0.2 * r * Eigen::Vector3d(n(rng), n(rng), n(rng));
         break;
     }
-    cams.push_back(Camera::lookAt(makeK(), eye, target, Eigen::Vector3d(n(rng), n(rng), n(rng))));
+    cams.push_back(Camera::lookAt(candidateK(), eye, target, Eigen::Vector3d(n(rng), n(rng), n(rng))));
   }
   return cams;
 }
@@ -197,7 +197,7 @@ TEST(FrustumSet, EqualsBruteForceOverAllVoxels) {
 TEST(FrustumSet, SceneDepthRangeCoversTheVoxelBox) {
   std::mt19937_64 rng(12);
   const OccupancyGrids g = randomGrid(rng, 0.3, 1);
-  const Camera outside = Camera::lookAt(makeK(), Eigen::Vector3d(12, -40, 6), g.box().center());
+  const Camera outside = Camera::lookAt(candidateK(), Eigen::Vector3d(12, -40, 6), g.box().center());
   const DepthRange r = sceneDepthRange(g, outside);
   ASSERT_FALSE(r.empty());
   for (const Voxel& v : g.sceneVoxels().voxels()) {
@@ -206,7 +206,7 @@ TEST(FrustumSet, SceneDepthRangeCoversTheVoxelBox) {
     EXPECT_LE(z, r.far);
   }
   // Inside the box: near is clamped to a positive depth, far stays finite.
-  const Camera inside = Camera::lookAt(makeK(), g.box().center(), Eigen::Vector3d(0, 0, 0));
+  const Camera inside = Camera::lookAt(candidateK(), g.box().center(), Eigen::Vector3d(0, 0, 0));
   const DepthRange ri = sceneDepthRange(g, inside);
   EXPECT_GT(ri.near, 0.0);
   EXPECT_TRUE(std::isfinite(ri.far));
@@ -266,7 +266,7 @@ TEST(VisibleSet, SetIsTheUnionOfRayHitsAndHidesOccludedVoxels) {
   o.upsample = 1;
   const OccupancyGrids g = OccupancyGrids::fromSfm(pts, o);
   ASSERT_EQ(g.sceneCount(), 2u * 256 + 2);  // the frame points occupy two more voxels
-  const Camera cam = Camera::lookAt(makeK(), Eigen::Vector3d(8, -20, 8), Eigen::Vector3d(8, 8, 8));
+  const Camera cam = Camera::lookAt(candidateK(), Eigen::Vector3d(8, -20, 8), Eigen::Vector3d(8, 8, 8));
   const VisibilityTracer tracer(g);
   const VoxelSet vis = tracer.visibleSet(cam, 1);
   const VoxelSet fr = frustumSet(g, cam);
@@ -289,7 +289,7 @@ TEST(VisibleSet, SetIsTheUnionOfRayHitsAndHidesOccludedVoxels) {
 }
 
 TEST(CandidateSets, SamplePixels) {
-  const Intrinsics K = makeK(10, 7);
+  const Intrinsics K = candidateK(10, 7);
   const auto all = samplePixels(K, 1);
   ASSERT_EQ(all.size(), 70u);
   EXPECT_EQ(all.front(), Eigen::Vector2d(0.5, 0.5));
@@ -307,7 +307,7 @@ TEST(CandidateSets, CameraThatSeesNothingAndDegenerateCameras) {
   const OccupancyGrids g = randomGrid(rng, 0.2, 2);
   const VisibilityTracer tracer(g);
   // Looking away from the box.
-  const Camera away = Camera::lookAt(makeK(), Eigen::Vector3d(12, -30, 6), Eigen::Vector3d(12, -60, 6));
+  const Camera away = Camera::lookAt(candidateK(), Eigen::Vector3d(12, -30, 6), Eigen::Vector3d(12, -60, 6));
   EXPECT_TRUE(sceneDepthRange(g, away).empty());
   EXPECT_TRUE(frustumSet(g, away).empty());
   EXPECT_TRUE(tracer.visibleSet(away, 1).empty());
@@ -327,10 +327,10 @@ TEST(CandidateSets, CameraThatSeesNothingAndDegenerateCameras) {
   EXPECT_TRUE(test::throwsInputError([&] { sceneDepthRange(g, bad); }, "candidate camera", "K/R/t"));
   EXPECT_TRUE(test::throwsInputError([&] { frustumSet(g, away, DepthRange{NAN, 1}); }, "candidate camera", "near/far"));
   // A 1x1 image and a camera inside a voxel work.
-  const Camera tiny = Camera::lookAt(makeK(1, 1), Eigen::Vector3d(12, -30, 6), g.box().center());
+  const Camera tiny = Camera::lookAt(candidateK(1, 1), Eigen::Vector3d(12, -30, 6), g.box().center());
   EXPECT_LE(tracer.visibleSet(tiny, 4).size(), 1u);
   const Voxel v0 = g.sceneVoxels().voxels().front();
-  const Camera in_voxel = Camera::lookAt(makeK(), g.voxelCenter(v0), g.box().center());
+  const Camera in_voxel = Camera::lookAt(candidateK(), g.voxelCenter(v0), g.box().center());
   const auto hits = tracer.tracePixels(in_voxel, 8);
   for (auto h : hits) EXPECT_EQ(h, 0) << "a ray from inside voxel 0 hits it first";
   // Rays with zero or non-finite direction miss.
@@ -344,7 +344,7 @@ TEST(CandidateSets, EmptySceneGrid) {
   const OccupancyGrids g =
       OccupancyGrids::fromSfm(std::vector<Eigen::Vector3d>{Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(10, 10, 10)}, o);
   ASSERT_EQ(g.sceneCount(), 0u);
-  const Camera cam = Camera::lookAt(makeK(), Eigen::Vector3d(5, -20, 5), Eigen::Vector3d(5, 5, 5));
+  const Camera cam = Camera::lookAt(candidateK(), Eigen::Vector3d(5, -20, 5), Eigen::Vector3d(5, 5, 5));
   EXPECT_TRUE(sceneDepthRange(g, cam).empty());
   EXPECT_TRUE(frustumSet(g, cam).empty());
   const VisibilityTracer tracer(g);
