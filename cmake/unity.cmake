@@ -4,7 +4,9 @@
 # object was CLI11's). Built as batches of `batch` files, each batch parses and compiles it
 # once. Files with compile options of their own are never batched (CMake leaves them out),
 # and neither are the rasterizer's kernels (splat) nor geometry, whose files are few per
-# shared header and keep file-local helpers of the same names.
+# shared header and keep file-local helpers of the same names. Within a batched target no
+# two files may define file-local functions of the same name (their unnamed namespaces
+# merge in a batch): scripts/unity_names.py, run by the test command, checks it.
 option(SARESGS_UNITY "Build nbv, nbv/eval, report, the command line and the Python module as unity batches" ON)
 function(saresgs_unity target batch)
   if(SARESGS_UNITY)

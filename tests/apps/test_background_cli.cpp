@@ -50,7 +50,7 @@ std::vector<Frame> blenderFrames(const std::string& blender) {
 
 // The Blender folder as nerfstudio's transforms.json; images copied as RGBA PNGs, or
 // flattened on white and written as JPEGs.
-void toNerfstudio(const std::string& blender, const std::string& out, bool jpeg) {
+void backgroundToNerfstudio(const std::string& blender, const std::string& out, bool jpeg) {
   fs::create_directories(fs::path(out) / "images");
   const saresgs::Scene b = saresgs::loadDataset(blender);
   const saresgs::Intrinsics& K = b.views[0].camera.K;
@@ -127,8 +127,8 @@ TEST(BackgroundCli, AnObjectWrittenFourWaysTrainsToTheSamePsnr) {
   auto r =
       runCli("scene --layout object --views 40 --width 96 --height 72 --format blender --out " + d.file("blender"));
   ASSERT_EQ(r.code, 0) << r.output;
-  toNerfstudio(d.file("blender"), d.file("ns_rgba"), /*jpeg=*/false);
-  toNerfstudio(d.file("blender"), d.file("ns_jpeg"), /*jpeg=*/true);
+  backgroundToNerfstudio(d.file("blender"), d.file("ns_rgba"), /*jpeg=*/false);
+  backgroundToNerfstudio(d.file("blender"), d.file("ns_jpeg"), /*jpeg=*/true);
   toColmap(d.file("blender"), d.file("colmap_rgba"));
 
   // What each folder's background is, and where it came from.

@@ -24,7 +24,7 @@ Camera ringCamera(double degrees, double radius = 3.0, int w = 32, int h = 24) {
 }
 
 // A scene of cameras at `degrees` on a ring about the origin, every one a train view.
-Scene ringScene(const std::vector<double>& degrees) {
+Scene pathRingScene(const std::vector<double>& degrees) {
   Scene s;
   for (std::size_t i = 0; i < degrees.size(); ++i) {
     SceneView v;
@@ -122,7 +122,7 @@ TEST(PathVariance, ScoreEqualsTheDoublePrecisionReference) {
   RasterSettings s;
   s.sh_degree = 1;
   s.background = {0.3f, 0.1f, 0.2f};
-  const Scene scene = ringScene({0, 40, 95, 150, 210, 260, 320});
+  const Scene scene = pathRingScene({0, 40, 95, 150, 210, 260, 320});
   const std::vector<int> held{0, 3}, candidates{1, 2, 4, 5, 6};
   for (double kappa : {0.0, 0.01, 1.0}) {
     const std::vector<double> ref = referenceScores(gd, s, scene, held, candidates, 1e-6, kappa);
@@ -181,7 +181,7 @@ TEST(PathVariance, UnseenShareIsTheScoreOfWhatNoHeldViewSaw) {
 TEST(PathVariance, ARingsLargestGapIsTaken) {
   std::vector<double> deg;
   for (int a = 0; a < 360; a += 15) deg.push_back(a);
-  const Scene scene = ringScene(deg);
+  const Scene scene = pathRingScene(deg);
   std::vector<int> held, candidates;
   for (int i = 0; i < static_cast<int>(deg.size()); ++i)
     (deg[static_cast<std::size_t>(i)] <= 150 ? held : candidates).push_back(i);
@@ -204,7 +204,7 @@ TEST(PathVariance, AClusteredPathGetsAViewInsideTheCluster) {
   std::vector<double> deg{270};                             // held
   for (int a = 0; a <= 48; a += 4) deg.push_back(a);        // the cluster: 13 views
   for (double a : {110.0, 140.0, 170.0}) deg.push_back(a);  // lone views
-  const Scene scene = ringScene(deg);
+  const Scene scene = pathRingScene(deg);
   std::vector<int> candidates;
   for (int i = 1; i < static_cast<int>(deg.size()); ++i) candidates.push_back(i);
   RasterSettings s;
@@ -222,7 +222,7 @@ TEST(PathVariance, AClusteredPathGetsAViewInsideTheCluster) {
 TEST(PathVariance, NothingHiddenBehindAWallIsRewarded) {
   // No view held (what a held view saw of the wall would change with the object in front
   // of it); the candidate looks from the back.
-  const Scene scene = ringScene({180});
+  const Scene scene = pathRingScene({180});
   RasterSettings s;
   s.sh_degree = 0;
   const Gaussians object = sphere(300, 0.5);

@@ -221,7 +221,7 @@ void checkGradientOnRandomImages(int w, int h, std::uint64_t seed) {
   }
 }
 
-bool allFinite(const LossResult& r) {
+bool allFiniteImage(const LossResult& r) {
   if (!std::isfinite(r.loss) || !std::isfinite(r.l1) || !std::isfinite(r.ssim)) return false;
   for (float g : r.grad.data)
     if (!std::isfinite(g)) return false;
@@ -423,14 +423,14 @@ TEST(PhotometricLoss, TinyAndConstantImagesAreFinite) {
     const ImageF render = randomLossImage(w, h, 91 + w), target = randomLossImage(w, h, 92 + h);
     for (double lambda : {0.0, 0.2, 1.0}) {
       const LossResult r = photometricLoss(render, target, lambda);
-      EXPECT_TRUE(allFinite(r));
+      EXPECT_TRUE(allFiniteImage(r));
       expectMatchesReference(render, target, lambda, 1e-6, 1e-5, "tiny");
     }
     for (float a : {0.0f, 0.5f, 1.0f})
       for (float b : {0.0f, 0.3f, 1.0f}) {
         const ImageF ca(w, h, 3, a), cb(w, h, 3, b);
         const LossResult r = photometricLoss(ca, cb, 0.2);
-        EXPECT_TRUE(allFinite(r)) << a << " vs " << b;
+        EXPECT_TRUE(allFiniteImage(r)) << a << " vs " << b;
         // Flat and far apart, vd = G*(d^2) - (G*d)^2 is a float difference of two values
         // near d^2 whose true value is ~0 inside: S is good to ~1e-5 there, the loss
         // (dominated by L1) to better than 1e-6.
@@ -443,7 +443,7 @@ TEST(PhotometricLoss, TinyAndConstantImagesAreFinite) {
     for (float b : {0.0f, 0.75f, 1.0f}) {
       const ImageF ca(64, 40, 3, a), cb(64, 40, 3, b);
       const LossResult r = photometricLoss(ca, cb, 0.2);
-      EXPECT_TRUE(allFinite(r)) << a << " vs " << b;
+      EXPECT_TRUE(allFiniteImage(r)) << a << " vs " << b;
       const RefLoss ref = referenceLoss(ca, cb, 0.2);
       EXPECT_NEAR(r.loss, ref.loss, 1e-6 * std::max(ref.loss, 1e-3)) << a << " vs " << b;
     }

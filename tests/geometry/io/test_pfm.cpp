@@ -30,7 +30,7 @@ ImageF randomPfmImage(int w, int h, int c, std::uint64_t seed) {
   return img;
 }
 
-std::vector<std::uint32_t> bits(const std::vector<float>& v) {
+std::vector<std::uint32_t> pfmBits(const std::vector<float>& v) {
   std::vector<std::uint32_t> out;
   for (float f : v) out.push_back(std::bit_cast<std::uint32_t>(f));
   return out;
@@ -50,7 +50,7 @@ void expectSameImage(const ImageF& a, const ImageF& b) {
   EXPECT_EQ(a.width, b.width);
   EXPECT_EQ(a.height, b.height);
   EXPECT_EQ(a.channels, b.channels);
-  EXPECT_EQ(bits(a.data), bits(b.data));
+  EXPECT_EQ(pfmBits(a.data), pfmBits(b.data));
 }
 
 }  // namespace

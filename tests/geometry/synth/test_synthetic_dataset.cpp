@@ -31,7 +31,7 @@ SyntheticOptions smallOptions(const std::string& layout) {
 
 // q_tol: COLMAP normalises every quaternion it reads from text, so a model it converted
 // may differ from ours in the last bit of q (seen on tworooms); our own round trips are exact.
-void expectSameModel(const ColmapModel& a, const ColmapModel& b, double q_tol = 0) {
+void expectSameSyntheticModel(const ColmapModel& a, const ColmapModel& b, double q_tol = 0) {
   ASSERT_EQ(a.cameras.size(), b.cameras.size());
   for (const auto& [id, c] : a.cameras) {
     const ColmapCamera& d = b.cameras.at(id);
@@ -97,9 +97,9 @@ double depthAgreement(const Scene& s, const SyntheticScene& world, int i, int j,
   return total ? static_cast<double>(agree) / total : 0.0;
 }
 
-class SyntheticDataset : public ::testing::TestWithParam<std::string> {};
-
 }  // namespace
+
+class SyntheticDataset : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(SyntheticDataset, ReadsBackIdenticallyAndColmapAgrees) {
   TempDir d;
@@ -124,7 +124,7 @@ TEST_P(SyntheticDataset, ReadsBackIdenticallyAndColmapAgrees) {
   const ColmapModel text = readColmapModel(d.file("ds/sparse/0"));
   {
     SCOPED_TRACE("generated vs written text");
-    expectSameModel(expected, text);
+    expectSameSyntheticModel(expected, text);
   }
   const Scene s = loadDataset(d.file("ds"));
   // The background is a property of the data: white where rays miss (object), none in an
@@ -152,7 +152,7 @@ TEST_P(SyntheticDataset, ReadsBackIdenticallyAndColmapAgrees) {
       << "colmap model_converter failed (is colmap installed? bash scripts/install_deps.sh)";
   ASSERT_TRUE(fs::exists(d.path() / "bin" / "points3D.bin"));
   SCOPED_TRACE("text vs COLMAP binary");
-  expectSameModel(text, readColmapBinary(d.file("bin")), 1e-15);
+  expectSameSyntheticModel(text, readColmapBinary(d.file("bin")), 1e-15);
 
   // (c) Ground-truth depth agrees between each view and its nearest neighbour.
   int pairs = 0;

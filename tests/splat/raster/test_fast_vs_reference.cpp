@@ -11,20 +11,17 @@
 
 using namespace saresgs;
 
-namespace {
-
-struct Case {
+// A scene of the parameterised test (a type with linkage: the fixture derives from it).
+struct FastVsReferenceCase {
   int gaussians, sh_degree, width, height;
   ExtentRule rule;
   std::uint64_t seed;
 };
 
-class FastVsReference : public ::testing::TestWithParam<Case> {};
-
-}  // namespace
+class FastVsReference : public ::testing::TestWithParam<FastVsReferenceCase> {};
 
 TEST_P(FastVsReference, ImagesAndPerGaussianOutputsAgree) {
-  const Case c = GetParam();
+  const FastVsReferenceCase c = GetParam();
   const Camera cam = test::smallCamera(c.width, c.height);
   const GaussiansD gd = test::randomScene<double>(c.gaussians, c.sh_degree, c.seed, 1.2);
   RasterSettings s;
@@ -65,11 +62,11 @@ TEST_P(FastVsReference, ImagesAndPerGaussianOutputsAgree) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, FastVsReference,
-                         ::testing::Values(Case{40, 0, 40, 30, ExtentRule::kOpacityAware, 1},
-                                           Case{80, 3, 48, 40, ExtentRule::kOpacityAware, 2},
-                                           Case{80, 1, 33, 17, ExtentRule::kThreeSigma, 3},
-                                           Case{150, 2, 64, 48, ExtentRule::kOpacityAware, 4},
-                                           Case{5, 0, 1, 1, ExtentRule::kOpacityAware, 5}));
+                         ::testing::Values(FastVsReferenceCase{40, 0, 40, 30, ExtentRule::kOpacityAware, 1},
+                                           FastVsReferenceCase{80, 3, 48, 40, ExtentRule::kOpacityAware, 2},
+                                           FastVsReferenceCase{80, 1, 33, 17, ExtentRule::kThreeSigma, 3},
+                                           FastVsReferenceCase{150, 2, 64, 48, ExtentRule::kOpacityAware, 4},
+                                           FastVsReferenceCase{5, 0, 1, 1, ExtentRule::kOpacityAware, 5}));
 
 TEST(FastVsReference, AnalyticGradientsMatchFiniteDifferencesOfTheReference) {
   const Camera cam = test::smallCamera(20, 16);

@@ -49,7 +49,7 @@ GaussiansD makeModel(const std::vector<Spec>& specs, int degree = 0) {
 
 std::size_t pix(int i, int j, int w = kW) { return static_cast<std::size_t>(j) * w + i; }
 
-bool allFinite(const ReferenceImage& im) {
+bool allFiniteRender(const ReferenceImage& im) {
   for (double v : im.rgb)
     if (!std::isfinite(v)) return false;
   for (double v : im.alpha)
@@ -337,7 +337,7 @@ TEST(ReferenceRenderer, CullingNearPlaneBehindAndGuardBand) {
     else
       EXPECT_GT(im.radii[k], 0.0) << k;
   }
-  EXPECT_TRUE(allFinite(im));
+  EXPECT_TRUE(allFiniteRender(im));
 
   // Inside a wide guard band but with a rectangle that misses the image: culled.
   RasterSettings wide = s;
@@ -576,18 +576,18 @@ TEST(ReferenceRenderer, ExtremeInputsStayFinite) {
     s.extent = rule;
     s.background = {0.3f, 0.6f, 0.9f};
     const ReferenceImage im = referenceRender(g, testCamera(), s);
-    EXPECT_TRUE(allFinite(im));
+    EXPECT_TRUE(allFiniteRender(im));
     // 1x1 image.
     Camera one;
     one.K = Intrinsics{1, 1, 1.0, 1.0, 0.5, 0.5};
     const ReferenceImage tiny = referenceRender(g, one, s);
     ASSERT_EQ(tiny.rgb.size(), 3u);
-    EXPECT_TRUE(allFinite(tiny));
+    EXPECT_TRUE(allFiniteRender(tiny));
     EXPECT_GT(tiny.contributors[0], 0);
     // Each extreme on its own, too (no neighbour to hide behind).
     for (std::size_t k = 0; k < specs.size(); ++k) {
       const ReferenceImage single = referenceRender(makeModel({specs[k]}), testCamera(), s);
-      ASSERT_TRUE(allFinite(single)) << k;
+      ASSERT_TRUE(allFiniteRender(single)) << k;
       if (specs[k].mean.z() < near) {
         EXPECT_EQ(single.visible[0], 0) << k;
       }

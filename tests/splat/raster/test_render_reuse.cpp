@@ -21,20 +21,20 @@ using namespace saresgs;
 namespace {
 
 template <typename V>
-bool sameBits(const V& a, const V& b) {
+bool sameRenderBits(const V& a, const V& b) {
   return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])) == 0);
 }
 
 bool sameRender(const RenderResult& a, const RenderResult& b) {
   return a.rgb.width == b.rgb.width && a.rgb.height == b.rgb.height && a.rgb.channels == b.rgb.channels &&
-         sameBits(a.rgb.data, b.rgb.data) && sameBits(a.alpha.data, b.alpha.data) &&
-         sameBits(a.depth.data, b.depth.data) && sameBits(a.contributors, b.contributors) &&
-         sameBits(a.radii, b.radii) && sameBits(a.visible, b.visible);
+         sameRenderBits(a.rgb.data, b.rgb.data) && sameRenderBits(a.alpha.data, b.alpha.data) &&
+         sameRenderBits(a.depth.data, b.depth.data) && sameRenderBits(a.contributors, b.contributors) &&
+         sameRenderBits(a.radii, b.radii) && sameRenderBits(a.visible, b.visible);
 }
 
 bool sameModel(const Gaussians& a, const Gaussians& b) {
-  return sameBits(a.means, b.means) && sameBits(a.log_scales, b.log_scales) && sameBits(a.rotations, b.rotations) &&
-         sameBits(a.opacities, b.opacities) && sameBits(a.sh, b.sh);
+  return sameRenderBits(a.means, b.means) && sameRenderBits(a.log_scales, b.log_scales) && sameRenderBits(a.rotations, b.rotations) &&
+         sameRenderBits(a.opacities, b.opacities) && sameRenderBits(a.sh, b.sh);
 }
 
 // A loss gradient that depends on every pixel, so backward passes read all of the state.
@@ -142,7 +142,7 @@ TEST(RenderReuse, RenderPairIntoAKeptPairEqualsAFreshPair) {
       rasterizeBackwardWithSubset(*j.g, j.cam, s, kept, d, d2, gk, &mk);
       rasterizeBackwardWithSubset(*j.g, j.cam, s, fresh, d, d2, gf, &mf);
       EXPECT_TRUE(sameModel(gk, gf));
-      EXPECT_TRUE(sameBits(mk, mf));
+      EXPECT_TRUE(sameRenderBits(mk, mf));
     }
   }
 }
@@ -167,7 +167,7 @@ TEST(RenderReuse, LossIntoAKeptResultEqualsAFreshLoss) {
     EXPECT_EQ(kept.grad.width, fresh.grad.width);
     EXPECT_EQ(kept.grad.height, fresh.grad.height);
     EXPECT_EQ(kept.grad.channels, fresh.grad.channels);
-    EXPECT_TRUE(sameBits(kept.grad.data, fresh.grad.data));
+    EXPECT_TRUE(sameRenderBits(kept.grad.data, fresh.grad.data));
   }
 }
 

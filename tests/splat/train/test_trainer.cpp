@@ -55,7 +55,7 @@ bool bitIdentical(const Gaussians& a, const Gaussians& b) {
   return same;
 }
 
-bool allFinite(const Gaussians& g) {
+bool allFiniteModel(const Gaussians& g) {
   bool ok = true;
   g.forEachArray([&](const std::vector<float>& a, std::size_t) {
     for (float x : a) ok = ok && std::isfinite(x);
@@ -124,7 +124,7 @@ TEST(Trainer, TrainingRaisesTrainPsnr) {
     EXPECT_EQ(kept.renders[i].data, toByte(t.render(s.views[static_cast<std::size_t>(s.train[i])].camera).rgb).data);
   EXPECT_TRUE(t.evaluate(s.train).renders.empty());
   EXPECT_NE(t.gaussians().size(), s.points.size());  // densification ran
-  EXPECT_TRUE(allFinite(t.gaussians()));
+  EXPECT_TRUE(allFiniteModel(t.gaussians()));
 }
 
 // The divergence guard: a non-finite value in the model is found and named (array and
@@ -164,7 +164,7 @@ TEST(Trainer, DivergenceIsStoppedAndNamed) {
     EXPECT_GT(e.iteration, 0);
   }
   if (!stopped) {
-    EXPECT_TRUE(allFinite(t.gaussians()));
+    EXPECT_TRUE(allFiniteModel(t.gaussians()));
   }
 }
 
@@ -296,15 +296,15 @@ TEST(Trainer, ExtremeModelsTrainWithoutNanOrInf) {
   {
     Gaussians H = g.zerosLike();
     addViewInformation(g, cam, t.rasterSettings(), H);
-    EXPECT_TRUE(allFinite(H));
+    EXPECT_TRUE(allFiniteModel(H));
   }
   t.train(s.train, 45);
-  EXPECT_TRUE(allFinite(t.gaussians()));
+  EXPECT_TRUE(allFiniteModel(t.gaussians()));
   const RenderResult r = t.render(cam);
   for (float x : r.rgb.data) ASSERT_TRUE(std::isfinite(x));
   Gaussians H = t.gaussians().zerosLike();
   addViewInformation(t.gaussians(), cam, t.rasterSettings(), H);
-  EXPECT_TRUE(allFinite(H));
+  EXPECT_TRUE(allFiniteModel(H));
 }
 
 // Found by fuzz/fuzz_trainer_checkpoint.cpp (UBSan: memcpy given the null data() of an
