@@ -54,7 +54,10 @@ def main():
         print(f"| {room} | {sec:.0f} | {100 * sec / total:.0f} % |")
     print("\nSlowest translation units:\n\n| seconds | unit |\n|---:|---|")
     for sec, output in sorted(units, reverse=True)[:15]:
-        unit = output.split(".dir/", 1)[-1].removesuffix(".o")
+        target, _, unit = output.partition(".dir/")
+        unit = unit.removesuffix(".o")
+        if unit.startswith("Unity/"):  # a unity batch (cmake/unity.cmake): name its target
+            unit = f"{target.rsplit('/', 1)[-1]}: {unit.removesuffix('.cxx')}"
         print(f"| {sec:.1f} | {unit} |")
 
 
