@@ -2,15 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cctype>
 #include <cstring>
-#include <filesystem>
-#include <optional>
-#include <stdexcept>
 #include <opencv2/imgproc.hpp>
-
-#include "geometry/error.h"
 
 namespace saresgs {
 

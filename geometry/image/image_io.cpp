@@ -1,6 +1,7 @@
 // readImage, writeImage and the other file functions of geometry/image/image.h, on the
 // codecs (geometry/image/codecs.h, png_decode.h), which build on image.h's types: a file
 // of their own, so that the types do not depend on the codecs that depend on them.
+#include <algorithm>
 #include <cstdio>
 #include <cctype>
 #include <cstring>
