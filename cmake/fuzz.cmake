@@ -24,10 +24,6 @@ endif()
 
 include(ExternalProject)
 include(${PROJECT_SOURCE_DIR}/fuzz/targets.cmake)
-foreach(r IN LISTS SARESGS_FUZZ_READERS)
-  set_source_files_properties(${PROJECT_SOURCE_DIR}/${r} TARGET_DIRECTORY saresgs_nbv saresgs_nbv_eval
-                              PROPERTIES SKIP_UNITY_BUILD_INCLUSION ON)
-endforeach()
 set(_main_libs saresgs_nbv_eval saresgs_nbv saresgs_splat saresgs_geometry saresgs_geometry_cgal)
 set(_main_lib_files "")
 foreach(l IN LISTS _main_libs)

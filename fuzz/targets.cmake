@@ -6,9 +6,9 @@ set(SARESGS_FUZZ_TARGETS
 
 # The readers: what the fuzzer's coverage feedback and the sanitizers watch (the file
 # formats and the dataset, checkpoint and config readers; not the geometry they call).
-# The fuzz project compiles them again, instrumented, and links them before the main
-# build's archives, so each must be an archive member of its own there (cmake/fuzz.cmake
-# keeps them out of the unity batches).
+# The fuzz project compiles them again, instrumented (in unity batches of its own), and
+# links them before the main build's archives, so each must be an archive member of its
+# own there (the top-level CMakeLists.txt keeps them out of the libraries' batches).
 set(SARESGS_FUZZ_READERS
   geometry/io/atomic_file.cpp geometry/io/colmap_binary.cpp geometry/io/colmap_models.cpp
   geometry/io/colmap_text.cpp geometry/io/colmap_validate.cpp geometry/io/json_file.cpp

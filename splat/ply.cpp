@@ -115,7 +115,7 @@ void addProperty(std::istringstream& ls, const std::string& line, const std::str
   e.props.push_back(std::move(p));
 }
 
-Header parseHeader(std::istream& in, const std::string& path) {
+Header parseGaussianHeader(std::istream& in, const std::string& path) {
   readMagic(in, path);
   Header h;
   bool have_format = false, ended = false;
@@ -220,7 +220,7 @@ void writeGaussiansPly(const std::string& path, const Gaussians& g) {
 Gaussians readGaussiansPly(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path, "file", "does not exist or cannot be read");
-  const Header h = parseHeader(in, path);
+  const Header h = parseGaussianHeader(in, path);
   std::error_code ec;
   const std::uint64_t file_size = std::filesystem::file_size(path, ec);
   if (ec) throw InputError(path, "file", "cannot determine its size");

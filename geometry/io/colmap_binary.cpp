@@ -26,8 +26,6 @@ constexpr size_t kPoint2DBytes = 8 + 8 + 8;             // x, y, point3D_id
 constexpr size_t kPointBytes = 8 + 3 * 8 + 3 + 8 + 8;   // id, xyz, rgb, error, length
 constexpr size_t kTrackElementBytes = 4 + 4;            // image_id, point2D_idx
 
-std::string pathIn(const std::string& dir, const char* name) { return (std::filesystem::path(dir) / name).string(); }
-
 // Names the record being read: "image 7" once its id is known, "image record 3"
 // (0-based position in the file) while reading the id itself, nothing for the
 // file's leading count. Formatted only when an error is thrown.
@@ -100,7 +98,7 @@ class ByteReader {
 };
 
 template <typename Map, typename Record>
-void insertUnique(Map& map, Record&& record, const ByteReader& in, const Where& where, std::string_view field) {
+void insertUniqueBinary(Map& map, Record&& record, const ByteReader& in, const Where& where, std::string_view field) {
   const auto id = record.id;
   if (!map.emplace(id, std::forward<Record>(record)).second)
     in.fail(where, field, "expected unique ids, " + std::to_string(id) + " appears twice");
@@ -109,11 +107,11 @@ void insertUnique(Map& map, Record&& record, const ByteReader& in, const Where& 
 // One .bin file of records: their count, each record read and kept once by its id, and
 // nothing after the last.
 template <typename Map, typename ReadRecord>
-void readRecords(const std::string& dir, const char* file, const char* count_field, size_t min_bytes, Map& into,
-                 ReadRecord read, const char* kind, const char* id_field, const char* things) {
+void readBinaryRecords(const std::string& dir, const char* file, const char* count_field, size_t min_bytes, Map& into,
+                       ReadRecord read, const char* kind, const char* id_field, const char* things) {
   ByteReader in(pathIn(dir, file));
   const std::uint64_t count = in.readCount({}, count_field, min_bytes);
-  for (std::uint64_t i = 0; i < count; ++i) insertUnique(into, read(in, i), in, {kind, i, true}, id_field);
+  for (std::uint64_t i = 0; i < count; ++i) insertUniqueBinary(into, read(in, i), in, {kind, i, true}, id_field);
   in.expectEnd(count, things);
 }
 
@@ -212,7 +210,7 @@ class ByteWriter {
   std::string buf_;
 };
 
-void writeCameras(std::ostream& o, const ColmapModel& model) {
+void writeCamerasBinary(std::ostream& o, const ColmapModel& model) {
   ByteWriter w(o);
   w.put<std::uint64_t>(model.cameras.size());
   for (const auto& [id, cam] : model.cameras) {
@@ -225,7 +223,7 @@ void writeCameras(std::ostream& o, const ColmapModel& model) {
   w.flush();
 }
 
-void writeImages(std::ostream& o, const ColmapModel& model) {
+void writeImagesBinary(std::ostream& o, const ColmapModel& model) {
   ByteWriter w(o);
   w.put<std::uint64_t>(model.images.size());
   for (const auto& [id, img] : model.images) {
@@ -244,7 +242,7 @@ void writeImages(std::ostream& o, const ColmapModel& model) {
   w.flush();
 }
 
-void writePoints(std::ostream& o, const ColmapModel& model) {
+void writePointsBinary(std::ostream& o, const ColmapModel& model) {
   ByteWriter w(o);
   w.put<std::uint64_t>(model.points.size());
   for (const auto& [id, pt] : model.points) {
@@ -264,7 +262,7 @@ void writePoints(std::ostream& o, const ColmapModel& model) {
 // Refuses, before anything is written, what the binary format cannot encode:
 // unknown models or parameter counts (the reader takes the count from the model),
 // names with '\0', point3D ids that do not fit images.bin's int64.
-void checkWritable(const ColmapModel& model, const std::string& dir) {
+void checkBinaryWritable(const ColmapModel& model, const std::string& dir) {
   for (const auto& [id, cam] : model.cameras) {
     const std::string where = "camera " + std::to_string(id);
     const int model_id = colmapModelId(cam.model);
@@ -293,23 +291,24 @@ void checkWritable(const ColmapModel& model, const std::string& dir) {
 
 ColmapModel readColmapBinary(const std::string& dir) {
   ColmapModel model;
-  readRecords(dir, "cameras.bin", "num_cameras", kCameraBytes, model.cameras, readCamera, "camera", "camera_id",
-              "cameras");
-  readRecords(dir, "images.bin", "num_images", kImageBytes, model.images, readImage, "image", "image_id", "images");
-  readRecords(dir, "points3D.bin", "num_points3D", kPointBytes, model.points, readPoint, "point", "point3D_id",
-              "points");
+  readBinaryRecords(dir, "cameras.bin", "num_cameras", kCameraBytes, model.cameras, readCamera, "camera", "camera_id",
+                    "cameras");
+  readBinaryRecords(dir, "images.bin", "num_images", kImageBytes, model.images, readImage, "image", "image_id",
+                    "images");
+  readBinaryRecords(dir, "points3D.bin", "num_points3D", kPointBytes, model.points, readPoint, "point", "point3D_id",
+                    "points");
   return model;
 }
 
 void writeColmapBinary(const std::string& dir, const ColmapModel& model) {
-  checkWritable(model, dir);
+  checkBinaryWritable(model, dir);
   const auto write = [&](const char* name, void (*writer)(std::ostream&, const ColmapModel&)) {
     writeStreamAtomic(
         pathIn(dir, name), [&](std::ostream& o) { writer(o, model); }, /*binary=*/true);
   };
-  write("cameras.bin", writeCameras);
-  write("images.bin", writeImages);
-  write("points3D.bin", writePoints);
+  write("cameras.bin", writeCamerasBinary);
+  write("images.bin", writeImagesBinary);
+  write("points3D.bin", writePointsBinary);
 }
 
 }  // namespace saresgs

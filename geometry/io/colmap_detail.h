@@ -3,11 +3,17 @@
 // the per-record checks that the text reader, the binary reader and
 // validateColmapModel share, so that all three accept and refuse the same records.
 // `where` names the record ("line 7", "image 3"); errors read "<where>: <field>".
+#include <filesystem>
 #include <string>
 
 #include "geometry/io/colmap.h"
 
 namespace saresgs::colmap_detail {
+
+// dir/name, the path of one of a model's files.
+inline std::string pathIn(const std::string& dir, const char* name) {
+  return (std::filesystem::path(dir) / name).string();
+}
 
 // 1 for models with a single focal length f (SIMPLE_*, RADIAL*), 2 for fx, fy; -1 if unknown.
 int focalLengthCount(int model_id);

@@ -24,8 +24,6 @@ using namespace colmap_detail;  // the checks both readers share
 
 constexpr std::string_view kSpace = " \t\r\v\f";
 
-std::string pathIn(const std::string& dir, const char* name) { return (std::filesystem::path(dir) / name).string(); }
-
 std::string_view trim(std::string_view s) {
   const size_t b = s.find_first_not_of(kSpace);
   if (b == std::string_view::npos) return {};

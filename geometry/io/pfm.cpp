@@ -17,7 +17,7 @@ namespace saresgs {
 
 namespace {
 
-bool isSpace(char c) { return c == ' ' || c == '\n' || c == '\r' || c == '\t'; }
+bool isPfmSpace(char c) { return c == ' ' || c == '\n' || c == '\r' || c == '\t'; }
 
 // The header after the magic: "<ws>width<ws>height<ws>scale<one ws>", then data.
 class HeaderReader {
@@ -54,7 +54,7 @@ class HeaderReader {
       fail("header: scale", "expected a non-zero number (negative: little-endian), got '" + std::string(tok) + "'");
     // Exactly one whitespace character ends the header: the data may start with a
     // byte that looks like whitespace.
-    if (pos_ >= data_.size() || !isSpace(data_[pos_]))
+    if (pos_ >= data_.size() || !isPfmSpace(data_[pos_]))
       fail("header: scale", "expected one whitespace character after the scale");
     ++pos_;
     return v;
@@ -68,10 +68,10 @@ class HeaderReader {
   // Whitespace (at least one character), then a token of at most 32 characters.
   std::string_view token(const char* field) {
     const size_t start = pos_;
-    while (pos_ < data_.size() && isSpace(data_[pos_])) ++pos_;
+    while (pos_ < data_.size() && isPfmSpace(data_[pos_])) ++pos_;
     if (pos_ == start) fail(field, "expected whitespace before it");
     const size_t begin = pos_;
-    while (pos_ < data_.size() && !isSpace(data_[pos_]) && pos_ - begin <= 32) ++pos_;
+    while (pos_ < data_.size() && !isPfmSpace(data_[pos_]) && pos_ - begin <= 32) ++pos_;
     if (pos_ == begin) fail(field, "expected a value, the file ends");
     return std::string_view(data_).substr(begin, pos_ - begin);
   }

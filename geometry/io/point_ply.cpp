@@ -27,7 +27,7 @@ struct VertexLayout {
 };
 
 // The header up to end_header; the vertex element must come first (its data does).
-VertexLayout parseHeader(const std::string& bytes, const std::string& path) {
+VertexLayout parsePointHeader(const std::string& bytes, const std::string& path) {
   VertexLayout L;
   std::size_t pos = 0;
   auto nextLine = [&]() -> std::optional<std::string> {
@@ -118,7 +118,7 @@ void writePointsPly(const std::string& path, const std::vector<PlyPoint>& points
 
 std::vector<PlyPoint> readPointsPly(const std::string& path) {
   const std::string bytes = readFile(path);
-  const VertexLayout L = parseHeader(bytes, path);
+  const VertexLayout L = parsePointHeader(bytes, path);
   const std::size_t left = bytes.size() - L.data_offset, n_props = L.types.size();
   // Each vertex needs its bytes (binary) or one character and a separator per value (ascii).
   const std::uint64_t least = L.ascii ? 2 * n_props : L.stride;

@@ -14,7 +14,7 @@ namespace saresgs {
 
 namespace {
 
-bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+bool isSpaceInLine(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
 
 // Splits on commas and/or blanks. An empty field (",," or a leading/trailing comma) is an
 // error: it is almost always a column lost by the program that wrote the file.
@@ -23,7 +23,7 @@ bool splitFields(std::string_view line, std::vector<std::string_view>& fields) {
   std::size_t i = 0;
   bool need_field = false;  // a comma was seen and no field has followed it yet
   while (i < line.size()) {
-    if (isSpace(line[i])) {
+    if (isSpaceInLine(line[i])) {
       ++i;
     } else if (line[i] == ',') {
       if (fields.empty() || need_field) return false;
@@ -31,7 +31,7 @@ bool splitFields(std::string_view line, std::vector<std::string_view>& fields) {
       ++i;
     } else {
       std::size_t j = i;
-      while (j < line.size() && !isSpace(line[j]) && line[j] != ',') ++j;
+      while (j < line.size() && !isSpaceInLine(line[j]) && line[j] != ',') ++j;
       fields.push_back(line.substr(i, j - i));
       need_field = false;
       i = j;
@@ -69,7 +69,7 @@ std::vector<Correspondence> readMatches(const std::string& path, const MatchesFi
     pos = eol + 1;
     ++line_no;
     std::size_t first = 0;
-    while (first < line.size() && isSpace(line[first])) ++first;
+    while (first < line.size() && isSpaceInLine(line[first])) ++first;
     if (first == line.size() || line[first] == '#') continue;
     const std::string field = "line " + std::to_string(line_no);
     if (!have_header) {

@@ -41,7 +41,7 @@ struct Luma {
   }
 };
 
-struct PairGeometry {
+struct EpipolarMap {
   Eigen::Matrix3d M;   // K1 A K0^-1: maps a homogeneous pixel of image 0 at unit depth
   Eigen::Vector3d hb;  // K1 b: the image-1 direction that inverse depth rho scales
 };
@@ -49,9 +49,9 @@ struct PairGeometry {
 // In camera-1 coordinates a point at depth z on the ray of pixel x0 is
 //   X1 = z A K0^-1 x0 + b,  A = R1 R0^T,  b = t1 - A t0,
 // so X1 / z = M x0 + rho hb with rho = 1/z: a homogeneous image point linear in rho.
-PairGeometry pairGeometry(const Camera& c0, const Camera& c1) {
+EpipolarMap pairGeometry(const Camera& c0, const Camera& c1) {
   const Eigen::Matrix3d A = c1.R * c0.R.transpose();
-  PairGeometry g;
+  EpipolarMap g;
   g.M = c1.K.matrix() * A * c0.K.matrix().inverse();
   g.hb = c1.K.matrix() * (c1.t - A * c0.t);
   return g;
@@ -64,7 +64,7 @@ std::optional<Eigen::Vector2d> dehom(const Eigen::Vector3d& h) {
   return p;
 }
 
-std::optional<Correspondence> refineOne(const PairGeometry& g, const Luma& l0, const Luma& l1, const Correspondence& m,
+std::optional<Correspondence> refineOne(const EpipolarMap& g, const Luma& l0, const Luma& l1, const Correspondence& m,
                                         const EpipolarRefineOptions& o) {
   if (!m.x0.allFinite() || !m.x1.allFinite()) return std::nullopt;
   const Eigen::Vector3d h0 = g.M * Eigen::Vector3d(m.x0.x(), m.x0.y(), 1.0);
@@ -167,7 +167,7 @@ std::vector<Correspondence> refineOnEpipolarLines(const Camera& cam0, const Imag
   if (image0.empty() || image1.empty() || image0.width < 2 || image0.height < 2 || image1.width < 2 ||
       image1.height < 2)
     return {};
-  const PairGeometry g = pairGeometry(cam0, cam1);
+  const EpipolarMap g = pairGeometry(cam0, cam1);
   if (!g.M.allFinite() || !g.hb.allFinite()) return {};
   const Luma l0(image0), l1(image1);
   std::vector<std::optional<Correspondence>> slot(matches.size());

@@ -13,7 +13,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double elapsedSeconds(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 void checkImage(const ImageF& img, const Camera& cam, const std::string& what) {
   if (img.width != cam.K.width || img.height != cam.K.height || img.channels < 1 ||
@@ -154,7 +154,7 @@ LiftingResult liftView(const Camera& real, const ImageF& real_image, double exte
     if (module.needs_render) {
       const auto t0 = Clock::now();
       rendered = render(cam);
-      rep.seconds_render += secondsSince(t0);
+      rep.seconds_render += elapsedSeconds(t0);
       checkImage(rendered, cam, "extrapolated render");
     }
 
@@ -162,7 +162,7 @@ LiftingResult liftView(const Camera& real, const ImageF& real_image, double exte
     const LiftingPair pair{real, real_image, cam, rendered, view, static_cast<int>(k), opts.stride};
     const CorrespondenceSet set = module.correspond(pair);
     const std::vector<Correspondence> sub = subsampleByStride(set.matches, opts.stride, real.K.width, real.K.height);
-    rep.seconds_correspondence += secondsSince(t0);
+    rep.seconds_correspondence += elapsedSeconds(t0);
 
     t0 = Clock::now();
     const std::vector<TriangulatedPoint> tp = triangulateAll(real, cam, sub, tri);
@@ -175,7 +175,7 @@ LiftingResult liftView(const Camera& real, const ImageF& real_image, double exte
           {tp[i].X, colourAt(real_image, sub[i].x0), sub[i].x0, static_cast<float>(tp[i].reprojection_px)});
       errors.push_back(tp[i].reprojection_px);
     }
-    rep.seconds_triangulation += secondsSince(t0);
+    rep.seconds_triangulation += elapsedSeconds(t0);
 
     ++rep.extrapolated_views;
     rep.candidates += set.candidates;

@@ -34,11 +34,11 @@ bool insideImage(const Eigen::Vector2d& x, const Intrinsics& K, double border) {
   return x.allFinite() && x.x() >= border && x.y() >= border && x.x() <= K.width - border && x.y() <= K.height - border;
 }
 
-struct PairGeometry {
+struct ProjectionPair {
   Matrix34d P0, P1;
 };
 
-TriangulatedPoint triangulateWith(const Camera& cam0, const Camera& cam1, const PairGeometry& g,
+TriangulatedPoint triangulateWith(const Camera& cam0, const Camera& cam1, const ProjectionPair& g,
                                   const Correspondence& m, const TriangulationOptions& opts) {
   TriangulatedPoint out;
   if (!insideImage(m.x0, cam0.K, opts.border_px) || !insideImage(m.x1, cam1.K, opts.border_px)) {
@@ -139,14 +139,14 @@ DltSolution triangulateDLT(const Matrix34d& P0, const Matrix34d& P1, const Eigen
 
 TriangulatedPoint triangulate(const Camera& cam0, const Camera& cam1, const Correspondence& m,
                               const TriangulationOptions& opts) {
-  const PairGeometry g{cam0.projectionMatrix(), cam1.projectionMatrix()};
+  const ProjectionPair g{cam0.projectionMatrix(), cam1.projectionMatrix()};
   return triangulateWith(cam0, cam1, g, m, opts);
 }
 
 std::vector<TriangulatedPoint> triangulateAll(const Camera& cam0, const Camera& cam1,
                                               std::span<const Correspondence> matches,
                                               const TriangulationOptions& opts) {
-  const PairGeometry g{cam0.projectionMatrix(), cam1.projectionMatrix()};
+  const ProjectionPair g{cam0.projectionMatrix(), cam1.projectionMatrix()};
   std::vector<TriangulatedPoint> out(matches.size());
   // Each result goes to its own slot: no reduction, so the output is independent of
   // how TBB splits the range.

@@ -117,11 +117,15 @@ std::vector<Eigen::Vector2d> samplePixels(const Intrinsics& K, int stride) {
 
 // ---------------------------------------------------------------- Embree tracer
 
-namespace {
-
-struct Boxes {
+// The tracer's user geometry: a member of VisibilityTracer::Impl, so a type with linkage
+// (in a unity batch an unnamed namespace's type in a member is GCC's -Wsubobject-linkage).
+struct VisibilityBoxes {
   std::vector<std::array<float, 3>> lower;  // voxel corner in local voxel units
 };
+
+namespace {
+
+using Boxes = VisibilityBoxes;
 
 void boxBounds(const RTCBoundsFunctionArguments* args) {
   const auto* boxes = static_cast<const Boxes*>(args->geometryUserPtr);

@@ -12,7 +12,7 @@ namespace saresgs::synth {
 
 namespace {
 
-constexpr float kPi = std::numbers::pi_v<float>;
+constexpr float kPiF = std::numbers::pi_v<float>;
 
 // Adds triangle (a, b, c), reversed if needed so that its normal has a positive
 // component along `outward`.
@@ -62,7 +62,7 @@ TriangleMesh makeSphere(float radius, int slices, int stacks) {
   return polarSurface(
       slices, stacks,
       [&](float u, float v) {
-        const float th = kPi * v, ph = 2 * kPi * u;
+        const float th = kPiF * v, ph = 2 * kPiF * u;
         return Eigen::Vector3f(radius * std::sin(th) * std::cos(ph), radius * std::sin(th) * std::sin(ph),
                                radius * std::cos(th));
       },
@@ -73,7 +73,7 @@ TriangleMesh makeSuperquadric(const Eigen::Vector3f& radii, float e1, float e2, 
   return polarSurface(
       slices, stacks,
       [&](float u, float v) {
-        const float eta = kPi * (0.5f - v), om = 2 * kPi * u - kPi;
+        const float eta = kPiF * (0.5f - v), om = 2 * kPiF * u - kPiF;
         const float ce = signedPow(std::cos(eta), e1), se = signedPow(std::sin(eta), e1);
         return Eigen::Vector3f(radii.x() * ce * signedPow(std::cos(om), e2),
                                radii.y() * ce * signedPow(std::sin(om), e2), radii.z() * se);
@@ -85,7 +85,7 @@ TriangleMesh makeBumpyBlob(float radius, float amplitude, float frequency, std::
   return polarSurface(
       slices, stacks,
       [&](float u, float v) {
-        const float th = kPi * v, ph = 2 * kPi * u;
+        const float th = kPiF * v, ph = 2 * kPiF * u;
         const Eigen::Vector3f d(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th));
         // Noise sampled on the unit sphere, so the seam and the poles match up.
         const float n = fbm(d * frequency, 3, seed);
@@ -99,7 +99,7 @@ TriangleMesh makeTorus(float major, float minor, int ring_segments, int tube_seg
   TriangleMesh m;
   for (int i = 0; i < nu; ++i)
     for (int j = 0; j < nv; ++j) {
-      const float ph = 2 * kPi * i / nu, th = 2 * kPi * j / nv;
+      const float ph = 2 * kPiF * i / nu, th = 2 * kPiF * j / nv;
       const float r = major + minor * std::cos(th);
       m.vertices.emplace_back(r * std::cos(ph), r * std::sin(ph), minor * std::sin(th));
     }
@@ -153,7 +153,7 @@ void addDisc(TriangleMesh& m, float radius, float z, int segments, float up) {
   const int centre = static_cast<int>(m.vertices.size());
   m.vertices.emplace_back(0, 0, z);
   for (int i = 0; i < segments; ++i) {
-    const float ph = 2 * kPi * i / segments;
+    const float ph = 2 * kPiF * i / segments;
     m.vertices.emplace_back(radius * std::cos(ph), radius * std::sin(ph), z);
   }
   for (int i = 0; i < segments; ++i)
@@ -188,7 +188,7 @@ TriangleMesh makeCylinder(float radius, float height, int segments) {
   const int base = 0;
   for (int k = 0; k < 2; ++k)
     for (int i = 0; i < segments; ++i) {
-      const float ph = 2 * kPi * i / segments;
+      const float ph = 2 * kPiF * i / segments;
       m.vertices.emplace_back(radius * std::cos(ph), radius * std::sin(ph), k * height);
     }
   for (int i = 0; i < segments; ++i) {
@@ -213,7 +213,7 @@ TriangleMesh makeCone(float radius, float height, int segments) {
   for (int k = 0; k < rings; ++k) {
     const float s = static_cast<float>(k) / rings;
     for (int i = 0; i < segments; ++i) {
-      const float ph = 2 * kPi * i / segments;
+      const float ph = 2 * kPiF * i / segments;
       m.vertices.emplace_back((1 - s) * radius * std::cos(ph), (1 - s) * radius * std::sin(ph), s * height);
     }
   }

@@ -48,8 +48,11 @@ def labels(grid):
 
 def tracked_files(out):
     """The results.json files under OUT/runs that git tracks (the committed runs), or None
-    outside a git work tree."""
+    outside a git work tree or in a folder git ignores (a build folder: nothing there is
+    committed, so what is on disk counts)."""
     try:
+        if subprocess.run(["git", "check-ignore", "-q", "--", out], capture_output=True).returncode == 0:
+            return None
         listed = subprocess.run(["git", "ls-files", "--", os.path.join(out, "runs")], capture_output=True, text=True,
                                 check=True).stdout
     except (OSError, subprocess.CalledProcessError):
