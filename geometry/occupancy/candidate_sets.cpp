@@ -125,10 +125,8 @@ struct VisibilityBoxes {
 
 namespace {
 
-using Boxes = VisibilityBoxes;
-
 void boxBounds(const RTCBoundsFunctionArguments* args) {
-  const auto* boxes = static_cast<const Boxes*>(args->geometryUserPtr);
+  const auto* boxes = static_cast<const VisibilityBoxes*>(args->geometryUserPtr);
   const auto& l = boxes->lower[args->primID];
   RTCBounds* b = args->bounds_o;
   b->lower_x = l[0];
@@ -162,7 +160,7 @@ double slabEntry(const double o[3], const double d[3], const std::array<float, 3
 }
 
 void boxIntersect(const RTCIntersectFunctionNArguments* args) {
-  const auto* boxes = static_cast<const Boxes*>(args->geometryUserPtr);
+  const auto* boxes = static_cast<const VisibilityBoxes*>(args->geometryUserPtr);
   const unsigned N = args->N;
   const unsigned prim = args->primID;
   RTCRayN* ray = RTCRayHitN_RayN(args->rayhit, N);
@@ -198,7 +196,7 @@ void boxIntersect(const RTCIntersectFunctionNArguments* args) {
 struct VisibilityTracer::Impl {
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
-  Boxes boxes;
+  VisibilityBoxes boxes;
   std::vector<VoxelKey> keys;
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();
   double h = 1.0;
