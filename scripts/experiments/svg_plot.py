@@ -87,6 +87,14 @@ def panelSvg(panel, x0, y0, w, h):
 def writeSvg(path, panels, caption="", width=1100, panel_h=300):
     """Panels stacked top to bottom, an optional caption line on top; written to a
     temporary name, then renamed."""
+    os.makedirs(os.path.dirname(path) or ".", exist_ok=True)
+    with open(path + ".tmp", "w") as fh:
+        fh.write(svgText(panels, caption, width, panel_h))
+    os.replace(path + ".tmp", path)
+
+
+def svgText(panels, caption="", width=1100, panel_h=300):
+    """writeSvg's file text (for a script that compares it with a committed file)."""
     head = 24 if caption else 0
     height = head + panel_h * len(panels)
     parts = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" '
@@ -96,7 +104,4 @@ def writeSvg(path, panels, caption="", width=1100, panel_h=300):
     for i, p in enumerate(panels):
         parts += panelSvg(p, 0, head + i * panel_h, width, panel_h)
     parts.append("</svg>")
-    os.makedirs(os.path.dirname(path) or ".", exist_ok=True)
-    with open(path + ".tmp", "w") as fh:
-        fh.write("\n".join(parts) + "\n")
-    os.replace(path + ".tmp", path)
+    return "\n".join(parts) + "\n"

@@ -20,6 +20,12 @@ within each drawn scene, the statistic the mean of the scene means; 10000 draws 
 generator, the 2.5 and 97.5 percentiles. A deterministic selector's luck with one scene thus
 counts as the variance of scenes. The oracle's share: (method - random) / (oracle - random)
 of the mean along-path PSNR.
+
+Beside each capture type's tables: every method's difference scene by scene (is a deficit one
+scene's or all of them?) and a figure, OUT/plots/NAME_per_view_CAPTURE.svg, of the judged
+selectors' and the oracle's difference view by view along each scene's path. Last, the judged
+selectors (JUDGED: the default and the selector issue 49 adds) against the issue's bar: a low
+end above -0.1 dB on every capture type, clear of zero on at least two.
 """
 import argparse
 import csv
@@ -32,6 +38,14 @@ import sys
 
 DRAWS = 10000
 BASELINES = ("fisher", "fvs")
+# The selectors held to issue 49's bar: `saresgs active`'s default and the selector aimed at
+# the path's views.
+JUDGED = ("adaptive", "path-variance")
+BAR_LOW = -0.1  # every capture type's low end above this
+BAR_CLEAR = 2  # capture types clear of zero, at least
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from svg_plot import svgText  # noqa: E402  (beside this script)
 
 
 def labels(grid):
@@ -115,8 +129,56 @@ def fmt(x, digits=3):
     return "n/a" if x != x else f"{x:.{digits}f}"
 
 
-def tables(grid, out, only=None):
+def path_by_name(r):
+    return {v["name"]: v["psnr"] for v in r["final_fit"]["path"]}
+
+
+def per_view_panel(scene, have, better, series_methods, seeds):
+    """One scene's panel: for each method, view by view along the path, its final fit's PSNR
+    minus the better baseline's, the mean over the trainer seeds where neither run held the
+    view (a gap where every seed held it); dashed: the test views; under the axis the views
+    each method held (opacity: share of seeds). None when the baseline has no run here."""
+    base_runs = {seed: have[(scene, better, seed)] for seed in seeds if (scene, better, seed) in have}
+    if not base_runs:
+        return None
+    order = [v["name"] for v in next(iter(base_runs.values()))["final_fit"]["path"]]
+    index = {n: i for i, n in enumerate(order)}
+    test = sorted({index[v["name"]] for r in base_runs.values() for v in r.get("views", []) if v["name"] in index})
+    series, strips, legend = [], [], []
+    for m in [better] + list(series_methods):
+        runs = {seed: have[(scene, m, seed)] for seed in seeds if (scene, m, seed) in have}
+        if not runs:
+            continue
+        share = {}
+        for r in runs.values():
+            for n in held(r):
+                if n in index:
+                    share[index[n]] = share.get(index[n], 0.0) + 1.0 / len(runs)
+        strips.append((m, share))
+        if m == better:
+            continue
+        ys = []
+        for n in order:
+            d = [path_by_name(a)[n] - path_by_name(base_runs[seed])[n] for seed, a in runs.items()
+                 if seed in base_runs and n not in held(a) | held(base_runs[seed])]
+            ys.append(sum(d) / len(d) if d else float("nan"))
+        finite = [y for y in ys if y == y]
+        series.append((m, ys))
+        legend.append(f"{m} {sum(finite) / len(finite):+.2f}" if finite else m)
+    if not series:
+        return None
+    return {"title": f"{scene}: final-fit PSNR minus {better}'s, view by view (mean over views: "
+                     f"{', '.join(legend)} dB)",
+            "xlabel": "view along the capture path; under the axis: the views each method held (opacity: share of "
+                      "trainer seeds)",
+            "ylabel": "difference (dB)", "n": len(order), "series": series, "marks": test, "strips": strips}
+
+
+def tables(grid, out, only=None, figures=None):
+    """(markdown, csv) of the tables; `figures`, a dict, gets {capture type: SVG text} of the
+    per-view figures."""
     runs, missing = load_runs(grid, out, only)
+    judged = {}  # (capture, method): (pairs, scenes, diff, low, high)
     layouts = list(dict.fromkeys(sc["layout"] for sc in grid["scenes"]))
     methods = [label for label, _, _ in labels(grid)]
     method_of = {label: m for label, m, _ in labels(grid)}
@@ -165,6 +227,7 @@ def tables(grid, out, only=None):
         md.append("")
         md.append("| method | pairs | scenes | along path: diff | low | high | test PSNR: diff | low | high | verdict |")
         md.append("|---|---:|---:|---:|---:|---:|---:|---:|---:|---|")
+        by_scene = {}
         for m in methods:
             if m == better:
                 continue
@@ -196,10 +259,38 @@ def tables(grid, out, only=None):
                 verdict = "not shown level"
             md.append(f"| {m} | {pairs} | {len(path_by)} | {fmt(d)} | {fmt(lo)} | {fmt(hi)} | {fmt(td)} | {fmt(tlo)} | "
                       f"{fmt(thi)} | {verdict} |")
+            by_scene[m] = {sc: sum(v) / len(v) for sc, v in path_by.items()}
+            if m in JUDGED:
+                judged[(lay, m)] = (pairs, len(path_by), d, lo, hi)
             rows.append({"table": "vs_better", "capture": lay, "method": m, "baseline": better, "pairs": pairs,
                          "scenes": len(path_by), "path_diff": d, "path_low": lo, "path_high": hi, "test_diff": td,
                          "test_low": tlo, "test_high": thi, "verdict": verdict})
         md.append("")
+        # Scene by scene: whether a capture type's difference is one scene's or every scene's.
+        md.append(f"Scene by scene (along the path, minus {better}, the mean over trainer seeds; first row: "
+                  f"{better}'s own along-path PSNR):")
+        md.append("")
+        md.append("| method | " + " | ".join(scenes) + " |")
+        md.append("|---|" + "---:|" * len(scenes))
+        own = []
+        for sc in scenes:
+            rs = [r for (s2, mm, seed), r in have.items() if s2 == sc and mm == better]
+            own.append(fmt(sum(path_psnr(r, held(r)) for r in rs) / len(rs)) if rs else "n/a")
+        md.append(f"| {better} (dB) | " + " | ".join(own) + " |")
+        for m in methods:
+            if m in by_scene:
+                md.append(f"| {m} | " + " | ".join(f"{by_scene[m][sc]:+.3f}" if sc in by_scene[m] else "n/a"
+                                                   for sc in scenes) + " |")
+        md.append("")
+        if figures is not None:
+            seeds = sorted({seed for (_, _, seed) in have})
+            panels = [p for p in (per_view_panel(sc, have, better, [m for m in methods if m in JUDGED or
+                                                                     method_of[m] == "oracle"], seeds)
+                                  for sc in scenes) if p]
+            if panels:
+                figures[lay] = svgText(panels, f"{lay}: the final fit's PSNR at every view of the path, each "
+                                               f"method minus {better} (scripts/experiments/verdict3_tables.py)")
+    md += bar_section(judged, layouts)
     if missing:
         md.append(f"Jobs not finished ({len(missing)}): " + ", ".join(missing))
         md.append("")
@@ -211,6 +302,40 @@ def tables(grid, out, only=None):
     for r in rows:
         w.writerow({k: (f"{v:.6f}" if isinstance(v, float) else v) for k, v in r.items()})
     return text, buf.getvalue()
+
+
+def bar_section(judged, layouts):
+    """The judged selectors against issue 49's bar, capture type by capture type (nothing
+    when none of them has a pair: a grid of other methods)."""
+    if not judged:
+        return []
+    md = ["## The default and the new selector against the bar", "",
+          f"Along the path against the better of fisher and fvs: the bar is a low end above {BAR_LOW} dB on every "
+          f"capture type and clear of zero (low end above 0) on at least {BAR_CLEAR}.", "",
+          "| method | capture | pairs | scenes | diff | low | high | low above " + f"{BAR_LOW}" + " | clear of 0 |",
+          "|---|---|---:|---:|---:|---:|---:|---|---|"]
+    for m in JUDGED:
+        caps = [lay for lay in layouts if (lay, m) in judged]
+        for lay in caps:
+            pairs, nsc, d, lo, hi = judged[(lay, m)]
+            md.append(f"| {m} | {lay} | {pairs} | {nsc} | {fmt(d)} | {fmt(lo)} | {fmt(hi)} | "
+                      f"{'yes' if lo > BAR_LOW else 'no'} | {'yes' if lo > 0 else 'no'} |")
+    md.append("")
+    for m in JUDGED:
+        caps = [lay for lay in layouts if (lay, m) in judged]
+        if not caps:
+            continue
+        low_fail = [lay for lay in caps if not judged[(lay, m)][3] > BAR_LOW]
+        clear = [lay for lay in caps if judged[(lay, m)][3] > 0]
+        absent = [lay for lay in layouts if lay not in caps]
+        met = not low_fail and len(clear) >= BAR_CLEAR and not absent
+        md.append(f"- **{m}**: low end above {BAR_LOW} on {len(caps) - len(low_fail)} of {len(caps)} capture types"
+                  + (f" (not on {', '.join(low_fail)})" if low_fail else "")
+                  + f"; clear of zero on {len(clear)}" + (f" ({', '.join(clear)})" if clear else "")
+                  + (f"; no pairs yet on {', '.join(absent)}" if absent else "")
+                  + f": the bar is {'met' if met else 'not met'}.")
+    md.append("")
+    return md
 
 
 def main():
@@ -225,8 +350,11 @@ def main():
     # --check judges the committed runs alone (a grid still running leaves others on disk);
     # writing uses every finished run, to be committed with the tables.
     only = tracked_files(a.out) if a.check else None
-    md, csv_text = tables(grid, a.out, only)
+    figures = {}
+    md, csv_text = tables(grid, a.out, only, figures)
     files = {os.path.join(a.out, "tables", a.name + ".md"): md + "\n", os.path.join(a.out, "tables", a.name + ".csv"): csv_text}
+    for lay, svg in figures.items():
+        files[os.path.join(a.out, "plots", f"{a.name}_per_view_{lay}.svg")] = svg
     if a.check:
         stale = []
         for path, text in files.items():
@@ -241,8 +369,8 @@ def main():
             return 1
         print(f"verdict3 tables match the runs ({md.count(chr(10)) + 1} lines)")
         return 0
-    os.makedirs(os.path.join(a.out, "tables"), exist_ok=True)
     for path, text in files.items():
+        os.makedirs(os.path.dirname(path), exist_ok=True)
         with open(path + ".tmp", "w") as fh:
             fh.write(text)
         os.replace(path + ".tmp", path)

@@ -107,3 +107,67 @@ def test_check_fails_on_a_stale_table_and_passes_on_a_fresh_one(tmp_path):
     p.write_text(json.dumps(r))
     out = subprocess.run(cmd + ["--check"], capture_output=True, text=True)
     assert out.returncode == 1 and "stale" in out.stdout
+
+
+def test_scene_by_scene_shows_whose_deficit_it_is(tmp_path):
+    # fisher trails fvs by 2 dB in o-s2 and by nothing in o-s3: the capture type's mean is
+    # -1, the scene-by-scene row says where it comes from.
+    views = ["i", "a", "b", "c"]
+    jobs = {}
+    for seed in (0, 1):
+        for s, gap in (("o-s2", 2.0), ("o-s3", 0.0)):
+            jobs[f"{s}__fvs__default__s{seed}"] = run(views, ["a"], [30, 30, 22, 22], initial=["i"])
+            jobs[f"{s}__fisher__default__s{seed}"] = run(views, ["a"], [30, 30, 22 - gap, 22 - gap], initial=["i"])
+    grid = write_grid(str(tmp_path), ["fisher", "fvs"], jobs)
+    md, _ = v3.tables(grid, str(tmp_path))
+    by_scene = md.split("Scene by scene")[1]
+    assert "| fvs (dB) | 22.000 | 22.000 |" in by_scene
+    assert "| fisher | -2.000 | +0.000 |" in by_scene
+
+
+def test_the_bar_names_the_capture_types_that_fail_it(tmp_path):
+    # Two capture types, two scenes each: adaptive 1 dB above the better baseline everywhere
+    # on "object"; on "room" 0.5 dB below in one scene and level in the other.
+    grid = {"scenes": [{"name": "o-s2", "layout": "object"}, {"name": "o-s3", "layout": "object"},
+                       {"name": "r-s2", "layout": "room"}, {"name": "r-s3", "layout": "room"}],
+            "methods": ["fisher", "fvs", "adaptive"], "seeds": [0, 1]}
+    views = ["i", "a", "b", "c"]
+    for s in ("o-s2", "o-s3", "r-s2", "r-s3"):
+        lift = 1.0 if s.startswith("o") else (-0.5 if s == "r-s2" else 0.0)
+        for seed in (0, 1):
+            for m, p in (("fvs", 25.0), ("fisher", 24.0), ("adaptive", 25.0 + lift)):
+                d = tmp_path / "runs" / f"{s}__{m}__default__s{seed}"
+                d.mkdir(parents=True)
+                (d / "results.json").write_text(json.dumps(run(views, ["a"], [30, 30, p, p], initial=["i"])))
+    md, _ = v3.tables(grid, str(tmp_path))
+    bar = md.split("## The default and the new selector against the bar")[1]
+    assert "| adaptive | object | 4 | 2 | 1.000 | 1.000 | 1.000 | yes | yes |" in bar
+    assert "| adaptive | room | 4 | 2 | -0.250 | -0.500 | 0.000 | no | no |" in bar
+    line = [l for l in bar.splitlines() if l.startswith("- **adaptive**")][0]
+    assert "above -0.1 on 1 of 2 capture types (not on room)" in line and "clear of zero on 1 (object)" in line
+    assert line.endswith("the bar is not met.")
+
+
+def test_the_per_view_figure_leaves_out_the_views_either_run_held(tmp_path):
+    views = ["i", "a", "b", "c"]
+    jobs = {}
+    for s in ("o-s2", "o-s3"):
+        for seed in (0, 1):
+            jobs[f"{s}__fvs__default__s{seed}"] = run(views, ["a"], [30, 30, 20, 20], initial=["i"])
+            # adaptive holds b in seed 0 only: b's difference is seed 1's alone.
+            held_b = ["b"] if seed == 0 else ["c"]
+            jobs[f"{s}__adaptive__default__s{seed}"] = run(views, held_b, [30, 31, 21 + seed, 22], initial=["i"])
+    for r in jobs.values():
+        r["views"] = [{"name": "c", "psnr": 0.0}]  # the test views
+    grid = write_grid(str(tmp_path), ["fvs", "adaptive"], jobs)
+    figures = {}
+    v3.tables(grid, str(tmp_path), figures=figures)
+    panel = v3.per_view_panel("o-s2", {(s, m, seed): r for (s, m, seed), r in
+                                       ((tuple(k.split("__")[0:1]) + (k.split("__")[1], int(k[-1])), v)
+                                        for k, v in jobs.items())}, "fvs", ["adaptive"], [0, 1])
+    (label, ys), = panel["series"]
+    # i and a: held by both runs -> gaps; b: seed 1 only (22 - 20); c: seed 0 only (22 - 20).
+    assert label == "adaptive" and ys[0] != ys[0] and ys[1] != ys[1] and ys[2] == 2.0 and ys[3] == 2.0
+    assert panel["marks"] == [3]
+    assert dict(panel["strips"])["adaptive"] == {0: 1.0, 2: 0.5, 3: 0.5}
+    assert set(figures) == {"object"} and figures["object"].startswith("<svg") and "o-s3" in figures["object"]
