@@ -144,8 +144,10 @@ def per_view_panel(scene, have, better, series_methods, seeds):
     order = [v["name"] for v in next(iter(base_runs.values()))["final_fit"]["path"]]
     index = {n: i for i, n in enumerate(order)}
     test = sorted({index[v["name"]] for r in base_runs.values() for v in r.get("views", []) if v["name"] in index})
+    # The strips in the series' order, the baseline's last, so that each method's ticks take
+    # its line's colour (svg_plot colours both by position).
     series, strips, legend = [], [], []
-    for m in [better] + list(series_methods):
+    for m in list(series_methods) + [better]:
         runs = {seed: have[(scene, m, seed)] for seed in seeds if (scene, m, seed) in have}
         if not runs:
             continue
