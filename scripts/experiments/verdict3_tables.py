@@ -159,10 +159,12 @@ def per_view_panel(scene, have, better, series_methods, seeds):
         strips.append((m, share))
         if m == better:
             continue
+        # Per paired seed, once: both runs' PSNR by view name and the views either held.
+        paired = [(path_by_name(a), path_by_name(base_runs[seed]), held(a) | held(base_runs[seed]))
+                  for seed, a in runs.items() if seed in base_runs]
         ys = []
         for n in order:
-            d = [path_by_name(a)[n] - path_by_name(base_runs[seed])[n] for seed, a in runs.items()
-                 if seed in base_runs and n not in held(a) | held(base_runs[seed])]
+            d = [pa[n] - pb[n] for pa, pb, both in paired if n not in both]
             ys.append(sum(d) / len(d) if d else float("nan"))
         finite = [y for y in ys if y == y]
         series.append((m, ys))
