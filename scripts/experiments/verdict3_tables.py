@@ -19,13 +19,15 @@ mean along-path PSNR over the capture type's runs), each method's paired differe
 within each drawn scene, the statistic the mean of the scene means; 10000 draws from a fixed
 generator, the 2.5 and 97.5 percentiles. A deterministic selector's luck with one scene thus
 counts as the variance of scenes. The oracle's share: (method - random) / (oracle - random)
-of the mean along-path PSNR.
+of the mean along-path PSNR. The longest unheld stretch: the mean over runs of the most
+consecutive path views a run held none of, how much of the path a selection left unseen.
 
 Beside each capture type's tables: every method's difference scene by scene (is a deficit one
 scene's or all of them?) and a figure, OUT/plots/NAME_per_view_CAPTURE.svg, of the judged
 selectors' and the oracle's difference view by view along each scene's path. Last, the judged
 selectors (JUDGED: the default and the selector issue 49 adds) against the issue's bar: a low
-end above -0.1 dB on every capture type, clear of zero on at least two.
+end above -0.1 dB on every capture type, clear of zero on at least two; and the two judged
+selectors against each other, paired the same way.
 """
 import argparse
 import csv
@@ -98,6 +100,18 @@ def load_runs(grid, out, only=None):
 def held(r):
     """Every view the run trained on: its initial views and the ones it chose."""
     return set(r.get("initial_views", [])) | set(r["selected_views"])
+
+
+def longest_unheld_stretch(r):
+    """The most consecutive views of the path, in the dataset's order, that the run held none
+    of (the stretches before the first and after the last held view count; no wrapping)."""
+    names = [v["name"] for v in r["final_fit"]["path"]]
+    h = held(r)
+    longest = run = 0
+    for n in names:
+        run = 0 if n in h else run + 1
+        longest = max(longest, run)
+    return longest
 
 
 def path_psnr(r, exclude):
@@ -183,6 +197,7 @@ def tables(grid, out, only=None, figures=None):
     per-view figures."""
     runs, missing = load_runs(grid, out, only)
     judged = {}  # (capture, method): (pairs, scenes, diff, low, high)
+    head = {}  # capture: (pairs, scenes, diff, low, high) of JUDGED[1] minus JUDGED[0]
     layouts = list(dict.fromkeys(sc["layout"] for sc in grid["scenes"]))
     methods = [label for label, _, _ in labels(grid)]
     method_of = {label: m for label, m, _ in labels(grid)}
@@ -201,8 +216,8 @@ def tables(grid, out, only=None, figures=None):
             continue
         md.append(f"## {lay} ({len(scenes)} scene{'' if len(scenes) == 1 else 's'}: {', '.join(scenes)})")
         md.append("")
-        md.append("| method | runs | along path, dB | test PSNR, dB | test SSIM | oracle's share |")
-        md.append("|---|---:|---:|---:|---:|---:|")
+        md.append("| method | runs | along path, dB | test PSNR, dB | test SSIM | oracle's share | longest unheld stretch |")
+        md.append("|---|---:|---:|---:|---:|---:|---:|")
         mean_path = {}
         for m in methods:
             rs = [r for (s, mm, seed), r in have.items() if mm == m]
@@ -218,9 +233,12 @@ def tables(grid, out, only=None, figures=None):
             share = float("nan")
             if "random" in mean_path and "oracle" in mean_path and mean_path["oracle"] != mean_path["random"]:
                 share = (mean_path[m] - mean_path["random"]) / (mean_path["oracle"] - mean_path["random"])
-            md.append(f"| {m} | {len(rs)} | {fmt(mean_path[m])} | {fmt(test_psnr)} | {fmt(test_ssim, 4)} | {fmt(share, 2)} |")
+            stretch = sum(longest_unheld_stretch(r) for r in rs) / len(rs)
+            md.append(f"| {m} | {len(rs)} | {fmt(mean_path[m])} | {fmt(test_psnr)} | {fmt(test_ssim, 4)} | {fmt(share, 2)} | "
+                      f"{stretch:.1f} |")
             rows.append({"table": "methods", "capture": lay, "method": m, "runs": len(rs), "path_psnr": mean_path[m],
-                         "test_psnr": test_psnr, "test_ssim": test_ssim, "oracle_share": share})
+                         "test_psnr": test_psnr, "test_ssim": test_ssim, "oracle_share": share,
+                         "longest_unheld": stretch})
         md.append("")
         base = [b for b in BASELINES if b in mean_path]
         if not base:
@@ -286,6 +304,18 @@ def tables(grid, out, only=None, figures=None):
                 md.append(f"| {m} | " + " | ".join(f"{by_scene[m][sc]:+.3f}" if sc in by_scene[m] else "n/a"
                                                    for sc in scenes) + " |")
         md.append("")
+        a_m, b_m = JUDGED
+        h_by, h_pairs = {}, 0
+        for s in scenes:
+            for seed in grid["seeds"]:
+                a, b = have.get((s, b_m, seed)), have.get((s, a_m, seed))
+                if a is None or b is None:
+                    continue
+                both = held(a) | held(b)
+                h_by.setdefault(s, []).append(path_psnr(a, both) - path_psnr(b, both))
+                h_pairs += 1
+        if h_pairs:
+            head[lay] = (h_pairs, len(h_by)) + two_level_bootstrap(h_by, random.Random(f"{lay}/{b_m}-{a_m}/path"))
         if figures is not None:
             seeds = sorted({seed for (_, _, seed) in have})
             panels = [p for p in (per_view_panel(sc, have, better, [m for m in methods if m in JUDGED or
@@ -295,6 +325,7 @@ def tables(grid, out, only=None, figures=None):
                 figures[lay] = svgText(panels, f"{lay}: the final fit's PSNR at every view of the path, each "
                                                f"method minus {better} (scripts/experiments/verdict3_tables.py)")
     md += bar_section(judged, layouts)
+    md += head_section(head, layouts)
     if missing:
         md.append(f"Jobs not finished ({len(missing)}): " + ", ".join(missing))
         md.append("")
@@ -338,6 +369,22 @@ def bar_section(judged, layouts):
                   + f"; clear of zero on {len(clear)}" + (f" ({', '.join(clear)})" if clear else "")
                   + (f"; no pairs yet on {', '.join(absent)}" if absent else "")
                   + f": the bar is {'met' if met else 'not met'}.")
+    md.append("")
+    return md
+
+
+def head_section(head, layouts):
+    """JUDGED[1] minus JUDGED[0], capture type by capture type (nothing without a pair)."""
+    if not head:
+        return []
+    a_m, b_m = JUDGED
+    md = [f"## {b_m} against {a_m}", "",
+          f"Along the path, {b_m} minus {a_m}, paired by scene and trainer seed over the views neither held:", "",
+          "| capture | pairs | scenes | diff | low | high |", "|---|---:|---:|---:|---:|---:|"]
+    for lay in layouts:
+        if lay in head:
+            pairs, nsc, d, lo, hi = head[lay]
+            md.append(f"| {lay} | {pairs} | {nsc} | {fmt(d)} | {fmt(lo)} | {fmt(hi)} |")
     md.append("")
     return md
 

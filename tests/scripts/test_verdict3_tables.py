@@ -76,8 +76,9 @@ def test_pairs_are_judged_over_the_views_neither_run_held(tmp_path):
     # Paired over c and d: fisher 20 against fvs 21, in both scenes and seeds.
     row = [l for l in paired.splitlines() if l.startswith("| fisher | 4 | 2 |")][0]
     assert "| -1.000 | -1.000 | -1.000 |" in row and "below, clear of 0" in row
-    # The oracle's share: random 19, oracle 23, fvs (20+21+21)/3 -> 0.42.
-    assert [l for l in methods.splitlines() if l.startswith("| fvs | 4 |")][0].endswith("| 0.42 |")
+    # The oracle's share: random 19, oracle 23, fvs (20+21+21)/3 -> 0.42; the longest stretch
+    # of path views fvs held none of: b, c, d.
+    assert [l for l in methods.splitlines() if l.startswith("| fvs | 4 |")][0].endswith("| 0.42 | 3.0 |")
     assert "(16 finished runs, 0 missing)" in md
 
 
@@ -171,3 +172,28 @@ def test_the_per_view_figure_leaves_out_the_views_either_run_held(tmp_path):
     assert panel["marks"] == [3]
     assert dict(panel["strips"])["adaptive"] == {0: 1.0, 2: 0.5, 3: 0.5}
     assert set(figures) == {"object"} and figures["object"].startswith("<svg") and "o-s3" in figures["object"]
+
+
+def test_the_longest_unheld_stretch_counts_the_path_ends_and_no_wrap():
+    views = [f"v{i}" for i in range(10)]
+    # Held: v0 (initial), v3, v4: the stretches are v1-v2 (2) and v5-v9 (5).
+    assert v3.longest_unheld_stretch(run(views, ["v3", "v4"], [20] * 10, initial=["v0"])) == 5
+    # Held v9 only: v0..v8 is one stretch of 9 (no wrap to v9's far side).
+    assert v3.longest_unheld_stretch(run(views, ["v9"], [20] * 10)) == 9
+    assert v3.longest_unheld_stretch(run(views, views, [20] * 10)) == 0
+
+
+def test_path_variance_against_adaptive_is_paired_over_views_neither_held(tmp_path):
+    # path-variance 0.4 dB above adaptive in every scene and seed on the views both left out;
+    # on the view only adaptive held (b), path-variance's 10 dB more must not count.
+    views = ["i", "a", "b", "c"]
+    jobs = {}
+    for s in ("o-s2", "o-s3"):
+        for seed in (0, 1):
+            jobs[f"{s}__fvs__default__s{seed}"] = run(views, ["a"], [30, 30, 25, 25], initial=["i"])
+            jobs[f"{s}__adaptive__default__s{seed}"] = run(views, ["b"], [30, 25, 30, 25], initial=["i"])
+            jobs[f"{s}__path-variance__default__s{seed}"] = run(views, ["a"], [30, 30, 40, 25.4], initial=["i"])
+    grid = write_grid(str(tmp_path), ["fvs", "adaptive", "path-variance"], jobs)
+    md, _ = v3.tables(grid, str(tmp_path))
+    head = md.split("## path-variance against adaptive")[1]
+    assert "| object | 4 | 2 | 0.400 | 0.400 | 0.400 |" in head
