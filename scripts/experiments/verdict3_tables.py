@@ -197,7 +197,7 @@ def tables(grid, out, only=None, figures=None):
     per-view figures."""
     runs, missing = load_runs(grid, out, only)
     judged = {}  # (capture, method): (pairs, scenes, diff, low, high)
-    head = {}  # capture: (pairs, scenes, diff, low, high) of JUDGED[1] minus JUDGED[0]
+    head = {}  # capture: (pairs, scenes, diff, low, high, scene means) of JUDGED[1] minus JUDGED[0]
     layouts = list(dict.fromkeys(sc["layout"] for sc in grid["scenes"]))
     methods = [label for label, _, _ in labels(grid)]
     method_of = {label: m for label, m, _ in labels(grid)}
@@ -315,7 +315,8 @@ def tables(grid, out, only=None, figures=None):
                 h_by.setdefault(s, []).append(path_psnr(a, both) - path_psnr(b, both))
                 h_pairs += 1
         if h_pairs:
-            head[lay] = (h_pairs, len(h_by)) + two_level_bootstrap(h_by, random.Random(f"{lay}/{b_m}-{a_m}/path"))
+            head[lay] = ((h_pairs, len(h_by)) + two_level_bootstrap(h_by, random.Random(f"{lay}/{b_m}-{a_m}/path"))
+                         + (", ".join(f"{sum(h_by[s]) / len(h_by[s]):+.2f}" for s in scenes if s in h_by),))
         if figures is not None:
             seeds = sorted({seed for (_, _, seed) in have})
             panels = [p for p in (per_view_panel(sc, have, better, [m for m in methods if m in JUDGED or
@@ -379,12 +380,13 @@ def head_section(head, layouts):
         return []
     a_m, b_m = JUDGED
     md = [f"## {b_m} against {a_m}", "",
-          f"Along the path, {b_m} minus {a_m}, paired by scene and trainer seed over the views neither held:", "",
-          "| capture | pairs | scenes | diff | low | high |", "|---|---:|---:|---:|---:|---:|"]
+          f"Along the path, {b_m} minus {a_m}, paired by scene and trainer seed over the views neither held "
+          "(scene by scene: each scene's mean over trainer seeds, the scenes in the order above):", "",
+          "| capture | pairs | scenes | diff | low | high | scene by scene |", "|---|---:|---:|---:|---:|---:|---|"]
     for lay in layouts:
         if lay in head:
-            pairs, nsc, d, lo, hi = head[lay]
-            md.append(f"| {lay} | {pairs} | {nsc} | {fmt(d)} | {fmt(lo)} | {fmt(hi)} |")
+            pairs, nsc, d, lo, hi, per_scene = head[lay]
+            md.append(f"| {lay} | {pairs} | {nsc} | {fmt(d)} | {fmt(lo)} | {fmt(hi)} | {per_scene} |")
     md.append("")
     return md
 

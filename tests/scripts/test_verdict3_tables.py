@@ -196,4 +196,4 @@ def test_path_variance_against_adaptive_is_paired_over_views_neither_held(tmp_pa
     grid = write_grid(str(tmp_path), ["fvs", "adaptive", "path-variance"], jobs)
     md, _ = v3.tables(grid, str(tmp_path))
     head = md.split("## path-variance against adaptive")[1]
-    assert "| object | 4 | 2 | 0.400 | 0.400 | 0.400 |" in head
+    assert "| object | 4 | 2 | 0.400 | 0.400 | 0.400 | +0.40, +0.40 |" in head
