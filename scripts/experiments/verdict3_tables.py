@@ -369,7 +369,7 @@ def bar_section(judged, layouts):
                   + (f" (not on {', '.join(low_fail)})" if low_fail else "")
                   + f"; clear of zero on {len(clear)}" + (f" ({', '.join(clear)})" if clear else "")
                   + (f"; no pairs yet on {', '.join(absent)}" if absent else "")
-                  + f": the bar is {'met' if met else 'not met'}.")
+                  + f": the bar is {'met' if met else 'not met'} on this grid's {len(layouts)} capture types.")
     md.append("")
     return md
 

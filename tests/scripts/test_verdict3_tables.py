@@ -146,7 +146,7 @@ def test_the_bar_names_the_capture_types_that_fail_it(tmp_path):
     assert "| adaptive | room | 4 | 2 | -0.250 | -0.500 | 0.000 | no | no |" in bar
     line = [l for l in bar.splitlines() if l.startswith("- **adaptive**")][0]
     assert "above -0.1 on 1 of 2 capture types (not on room)" in line and "clear of zero on 1 (object)" in line
-    assert line.endswith("the bar is not met.")
+    assert line.endswith("the bar is not met on this grid's 2 capture types.")
 
 
 def test_the_per_view_figure_leaves_out_the_views_either_run_held(tmp_path):
