@@ -139,6 +139,22 @@ def two_level_bootstrap(by_scene, rng):
     return point, draws[int(0.025 * DRAWS)], draws[int(0.975 * DRAWS) - 1]
 
 
+def paired_diffs(have, scenes, seeds, m, base):
+    """m minus base per scene, over the trainer seeds both ran: ({scene: [along-path
+    differences over the views neither held]}, {scene: [test-view PSNR differences]}, pairs)."""
+    path_by, test_by, pairs = {}, {}, 0
+    for s in scenes:
+        for seed in seeds:
+            a, b = have.get((s, m, seed)), have.get((s, base, seed))
+            if a is None or b is None:
+                continue
+            both = held(a) | held(b)
+            path_by.setdefault(s, []).append(path_psnr(a, both) - path_psnr(b, both))
+            test_by.setdefault(s, []).append(a["final_fit"]["psnr"] - b["final_fit"]["psnr"])
+            pairs += 1
+    return path_by, test_by, pairs
+
+
 def fmt(x, digits=3):
     return "n/a" if x != x else f"{x:.{digits}f}"
 
@@ -201,6 +217,10 @@ def tables(grid, out, only=None, figures=None, title="Verdict 3", command="pytho
     layouts = list(dict.fromkeys(sc["layout"] for sc in grid["scenes"]))
     methods = [label for label, _, _ in labels(grid)]
     method_of = {label: m for label, m, _ in labels(grid)}
+
+    def seeds_of(label):
+        return grid.get("method_seeds", {}).get(method_of.get(label, label), grid["seeds"])
+
     md, rows = [], []
     md.append(f"# {title}: selectors judged across scenes")
     md.append("")
@@ -253,16 +273,7 @@ def tables(grid, out, only=None, figures=None, title="Verdict 3", command="pytho
         for m in methods:
             if m == better:
                 continue
-            path_by, test_by, pairs = {}, {}, 0
-            for s in scenes:
-                for seed in grid.get("method_seeds", {}).get(method_of[m], grid["seeds"]):
-                    a, b = have.get((s, m, seed)), have.get((s, better, seed))
-                    if a is None or b is None:
-                        continue
-                    both = held(a) | held(b)
-                    path_by.setdefault(s, []).append(path_psnr(a, both) - path_psnr(b, both))
-                    test_by.setdefault(s, []).append(a["final_fit"]["psnr"] - b["final_fit"]["psnr"])
-                    pairs += 1
+            path_by, test_by, pairs = paired_diffs(have, scenes, seeds_of(m), m, better)
             if not pairs:
                 continue
             # One generator per table cell, seeded by its name: a cell's interval does not
@@ -305,15 +316,7 @@ def tables(grid, out, only=None, figures=None, title="Verdict 3", command="pytho
                                                    for sc in scenes) + " |")
         md.append("")
         a_m, b_m = JUDGED
-        h_by, h_pairs = {}, 0
-        for s in scenes:
-            for seed in grid["seeds"]:
-                a, b = have.get((s, b_m, seed)), have.get((s, a_m, seed))
-                if a is None or b is None:
-                    continue
-                both = held(a) | held(b)
-                h_by.setdefault(s, []).append(path_psnr(a, both) - path_psnr(b, both))
-                h_pairs += 1
+        h_by, _, h_pairs = paired_diffs(have, scenes, seeds_of(b_m), b_m, a_m)
         if h_pairs:
             head[lay] = ((h_pairs, len(h_by)) + two_level_bootstrap(h_by, random.Random(f"{lay}/{b_m}-{a_m}/path"))
                          + (", ".join(f"{sum(h_by[s]) / len(h_by[s]):+.2f}" for s in scenes if s in h_by),))
