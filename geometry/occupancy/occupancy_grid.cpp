@@ -1,8 +1,5 @@
-// The only file that includes OpenVDB (its headers cost ~2 s per translation unit).
+// The grids' geometry and checks; their trees are VdbMasks (the OpenVDB module).
 #include "geometry/occupancy/occupancy_grid.h"
-
-#include <openvdb/openvdb.h>
-#include <openvdb/tools/Morphology.h>
 
 #include <algorithm>
 #include <cmath>
@@ -14,61 +11,6 @@
 namespace saresgs {
 
 namespace {
-
-using openvdb::Coord;
-using openvdb::CoordBBox;
-using MaskTree = openvdb::MaskTree;  // the tree of openvdb::MaskGrid: topology only
-
-Coord toCoord(const Voxel& v) { return Coord(v[0], v[1], v[2]); }
-Voxel toVoxel(const Coord& c) { return {c.x(), c.y(), c.z()}; }
-
-// Calls f(Coord) for every active voxel, active tiles included (expanded voxel by
-// voxel), so that the result does not depend on how OpenVDB chose to store the topology.
-template <typename TreeT, typename F>
-void forEachActiveVoxel(const TreeT& tree, F&& f) {
-  for (auto it = tree.cbeginValueOn(); it; ++it) {
-    if (it.isVoxelValue()) {
-      f(it.getCoord());
-    } else {
-      CoordBBox b;
-      it.getBoundingBox(b);
-      for (auto c = b.begin(); c; ++c) f(*c);
-    }
-  }
-}
-
-// Sorted keys of the active voxels of a mask; voxels outside the key range are dropped.
-VoxelSet keysOf(const MaskTree& tree) {
-  std::vector<VoxelKey> keys;
-  keys.reserve(tree.activeVoxelCount());
-  forEachActiveVoxel(tree, [&](const Coord& c) {
-    const Voxel v = toVoxel(c);
-    if (voxelRepresentable(v)) keys.push_back(packVoxel(v));
-  });
-  // Tree iteration order (by child index inside each internal node) is not key order.
-  std::sort(keys.begin(), keys.end());
-  return VoxelSet::fromSortedKeys(std::move(keys));
-}
-
-openvdb::tools::NearestNeighbors neighbours(DilationShape s) {
-  switch (s) {
-    case DilationShape::Cube:
-      return openvdb::tools::NN_FACE_EDGE_VERTEX;
-    case DilationShape::FaceEdge:
-      return openvdb::tools::NN_FACE_EDGE;
-    case DilationShape::Octahedron:
-      return openvdb::tools::NN_FACE;
-  }
-  return openvdb::tools::NN_FACE_EDGE_VERTEX;
-}
-
-void dilate(MaskTree& tree, int radius, DilationShape shape) {
-  if (radius <= 0 || tree.empty()) return;
-  // EXPAND_TILES keeps the result voxelized (no pruning into tiles); the enumeration
-  // above handles tiles anyway. OpenVDB threads this with TBB; topology union is
-  // order independent, so the result is deterministic.
-  openvdb::tools::dilateActiveValues(tree, radius, neighbours(shape), openvdb::tools::EXPAND_TILES);
-}
 
 void checkOptions(const OccupancyOptions& o) {
   const std::string file = "SfM points";
@@ -108,14 +50,14 @@ struct OccupancyGrids::Impl {
   double coarse_h = 1.0;
   double h = 1.0;
   std::size_t coarse_count = 0;
-  MaskTree scene;     // fine scene-occupied voxels
-  MaskTree observed;  // dilated observed voxels, accumulated
+  VdbMask scene;     // fine scene-occupied voxels
+  VdbMask observed;  // dilated observed voxels, accumulated
   VoxelSet scene_keys;
 };
 
 OccupancyGrids::OccupancyGrids(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 OccupancyGrids::OccupancyGrids(const OccupancyGrids& o)
-    : impl_(std::make_unique<Impl>(*o.impl_)) {}  // MaskTree's copy is deep
+    : impl_(std::make_unique<Impl>(*o.impl_)) {}  // VdbMask's copy is deep
 OccupancyGrids& OccupancyGrids::operator=(const OccupancyGrids& o) {
   if (this != &o) impl_ = std::make_unique<Impl>(*o.impl_);
   return *this;
@@ -159,39 +101,44 @@ OccupancyGrids OccupancyGrids::fromSfm(std::span<const Eigen::Vector3d> points, 
   for (int a = 0; a < 3; ++a)
     dims[a] = std::clamp(static_cast<int>(std::ceil(size[a] / impl->coarse_h)), 1, opts.resolution);
 
-  // Count SfM points per coarse voxel in a sparse Int32 tree.
-  openvdb::Int32Tree counts(0);
-  {
-    openvdb::tree::ValueAccessor<openvdb::Int32Tree> acc(counts);
-    for (const auto& p : points) {
-      if (((p - impl->box.min).array() < 0).any() || ((p - impl->box.max).array() > 0).any())
-        continue;  // trimmed outlier
-      Coord c;
-      for (int a = 0; a < 3; ++a) {
-        // Points on the max face belong to the last voxel (the box is closed).
-        const double f = std::floor((p[a] - impl->origin[a]) / impl->coarse_h);
-        c[a] = std::clamp(static_cast<int>(f), 0, dims[a] - 1);
-      }
-      acc.setValue(c, acc.getValue(c) + 1);
+  // Count SfM points per coarse voxel: sort the coarse voxels' keys and count the runs.
+  std::vector<VoxelKey> coarse;
+  coarse.reserve(points.size());
+  for (const auto& p : points) {
+    if (((p - impl->box.min).array() < 0).any() || ((p - impl->box.max).array() > 0).any())
+      continue;  // trimmed outlier
+    Voxel c;
+    for (int a = 0; a < 3; ++a) {
+      // Points on the max face belong to the last voxel (the box is closed).
+      const double f = std::floor((p[a] - impl->origin[a]) / impl->coarse_h);
+      c[a] = std::clamp(static_cast<int>(f), 0, dims[a] - 1);
     }
+    coarse.push_back(packVoxel(c));  // 0 <= c < 16384: representable
   }
+  std::sort(coarse.begin(), coarse.end());
 
-  // Occupied coarse voxel -> N^3 fine voxels.
+  // Occupied coarse voxel -> N^3 fine voxels, handed to the tree in batches.
   const int n = opts.upsample;
-  {
-    openvdb::tree::ValueAccessor<MaskTree> acc(impl->scene);
-    for (auto it = counts.cbeginValueOn(); it; ++it) {
-      // Counts were written voxel by voxel: no tiles in this tree.
-      if (*it < opts.min_points) continue;
+  std::vector<Voxel> fine;
+  const std::size_t batch = std::size_t{1} << 16;
+  for (std::size_t i = 0; i < coarse.size();) {
+    std::size_t j = i;
+    while (j < coarse.size() && coarse[j] == coarse[i]) ++j;
+    if (j - i >= static_cast<std::size_t>(opts.min_points)) {
       ++impl->coarse_count;
-      const Coord c = it.getCoord();
-      const Coord base(c.x() * n, c.y() * n, c.z() * n);
+      const Voxel c = unpackVoxel(coarse[i]);
       for (int dx = 0; dx < n; ++dx)
         for (int dy = 0; dy < n; ++dy)
-          for (int dz = 0; dz < n; ++dz) acc.setValueOn(base.offsetBy(dx, dy, dz));
+          for (int dz = 0; dz < n; ++dz) fine.push_back({c[0] * n + dx, c[1] * n + dy, c[2] * n + dz});
+      if (fine.size() >= batch) {
+        impl->scene.setOn(fine);
+        fine.clear();
+      }
     }
+    i = j;
   }
-  impl->scene_keys = keysOf(impl->scene);
+  impl->scene.setOn(fine);
+  impl->scene_keys = impl->scene.keys();
   return OccupancyGrids(std::move(impl));
 }
 
@@ -217,17 +164,16 @@ Eigen::Vector3d OccupancyGrids::voxelCenter(const Voxel& v) const {
 
 std::size_t OccupancyGrids::sceneCount() const { return impl_->scene_keys.size(); }
 const VoxelSet& OccupancyGrids::sceneVoxels() const { return impl_->scene_keys; }
-bool OccupancyGrids::isSceneOccupied(const Voxel& v) const { return impl_->scene.isValueOn(toCoord(v)); }
+bool OccupancyGrids::isSceneOccupied(const Voxel& v) const { return impl_->scene.isOn(v); }
 std::size_t OccupancyGrids::coarseCount() const { return impl_->coarse_count; }
 
 AABB OccupancyGrids::sceneVoxelBounds() const {
   AABB b;
-  if (impl_->scene.empty()) return b;
-  CoordBBox cb;
-  impl_->scene.evalActiveVoxelBoundingBox(cb);
+  Voxel lo, hi;
+  if (!impl_->scene.bounds(lo, hi)) return b;
   for (int a = 0; a < 3; ++a) {
-    b.min[a] = impl_->origin[a] + impl_->h * cb.min()[a];
-    b.max[a] = impl_->origin[a] + impl_->h * (cb.max()[a] + 1);
+    b.min[a] = impl_->origin[a] + impl_->h * lo[a];
+    b.max[a] = impl_->origin[a] + impl_->h * (hi[a] + 1);
   }
   return b;
 }
@@ -236,39 +182,35 @@ std::size_t OccupancyGrids::addObserved(std::span<const Eigen::Vector3d> points)
   for (std::size_t i = 0; i < points.size(); ++i)
     if (!points[i].allFinite())
       throw InputError("SA-Points", "point " + std::to_string(i), "expected finite coordinates");
-  MaskTree fresh;
+  std::vector<Voxel> voxels;
+  voxels.reserve(points.size());
   std::size_t ignored = 0;
-  {
-    openvdb::tree::ValueAccessor<MaskTree> acc(fresh);
-    for (const auto& p : points) {
-      const Voxel v = voxelOf(p);
-      if (!voxelRepresentable(v)) {
-        ++ignored;
-        continue;
-      }
-      acc.setValueOn(toCoord(v));
+  for (const auto& p : points) {
+    const Voxel v = voxelOf(p);
+    if (!voxelRepresentable(v)) {
+      ++ignored;
+      continue;
     }
+    voxels.push_back(v);
   }
+  VdbMask fresh;
+  fresh.setOn(voxels);
   // Dilating only the new voxels and taking the union equals dilating everything again:
   // dilation by a kernel distributes over union.
-  dilate(fresh, impl_->opts.dilation_radius, impl_->opts.dilation_shape);
-  impl_->observed.topologyUnion(fresh);
+  fresh.dilate(impl_->opts.dilation_radius, impl_->opts.dilation_shape);
+  impl_->observed.unite(fresh);
   return ignored;
 }
 
 void OccupancyGrids::clearObserved() { impl_->observed.clear(); }
-std::size_t OccupancyGrids::observedCount() const { return impl_->observed.activeVoxelCount(); }
-bool OccupancyGrids::isObserved(const Voxel& v) const { return impl_->observed.isValueOn(toCoord(v)); }
-VoxelSet OccupancyGrids::observedVoxels() const { return keysOf(impl_->observed); }
+std::size_t OccupancyGrids::observedCount() const { return impl_->observed.activeCount(); }
+bool OccupancyGrids::isObserved(const Voxel& v) const { return impl_->observed.isOn(v); }
+VoxelSet OccupancyGrids::observedVoxels() const { return impl_->observed.keys(); }
 
 VoxelSet OccupancyGrids::observedSceneVoxels() const {
-  // Walk the scene keys (block-major, so the accessor's cached leaf is reused) and keep
-  // the observed ones: the output is sorted without a sort.
-  openvdb::tree::ValueAccessor<const MaskTree> acc(impl_->observed);
-  std::vector<VoxelKey> out;
-  for (VoxelKey k : impl_->scene_keys.keys())
-    if (acc.isValueOn(toCoord(unpackVoxel(k)))) out.push_back(k);
-  return VoxelSet::fromSortedKeys(std::move(out));
+  // The scene keys (block-major, so the module's accessor reuses its cached leaf) that
+  // are observed: sorted without a sort.
+  return impl_->observed.filter(impl_->scene_keys);
 }
 
 double OccupancyGrids::observedFraction() const {
@@ -278,8 +220,8 @@ double OccupancyGrids::observedFraction() const {
 
 GridMemory OccupancyGrids::memory() const {
   GridMemory m;
-  m.scene_vdb = static_cast<std::size_t>(impl_->scene.memUsage());
-  m.observed_vdb = static_cast<std::size_t>(impl_->observed.memUsage());
+  m.scene_vdb = impl_->scene.memUsage();
+  m.observed_vdb = impl_->observed.memUsage();
   m.scene_index = impl_->scene_keys.keys().capacity() * sizeof(VoxelKey);
   return m;
 }
@@ -287,13 +229,10 @@ GridMemory OccupancyGrids::memory() const {
 VoxelSet dilateVoxels(const VoxelSet& voxels, int radius, DilationShape shape) {
   if (radius < 0) throw InputError("dilation", "radius", "expected >= 0, got " + std::to_string(radius));
   if (radius == 0) return voxels;
-  MaskTree tree;
-  {
-    openvdb::tree::ValueAccessor<MaskTree> acc(tree);
-    for (VoxelKey k : voxels.keys()) acc.setValueOn(toCoord(unpackVoxel(k)));
-  }
-  dilate(tree, radius, shape);
-  return keysOf(tree);
+  VdbMask tree;
+  tree.setOn(voxels.voxels());
+  tree.dilate(radius, shape);
+  return tree.keys();
 }
 
 }  // namespace saresgs

@@ -4,9 +4,9 @@
 //                  5 indoor) on a coarse grid, each then split into N^3 fine voxels;
 //   observed grid  fine voxels that hold SA-Points, dilated by a radius-r kernel and
 //                  accumulated over calls (training views add points over time).
-// Both are sparse OpenVDB grids kept behind a pimpl: memory and time follow the occupied
-// voxels, never the volume of the box, and openvdb.h (~2 s to parse) stays out of every
-// file that includes this header.
+// Both are sparse OpenVDB grids (VdbMask, from the OpenVDB module that the first grid
+// loads): memory and time follow the occupied voxels, never the volume of the box, and no
+// file but the module's includes openvdb.h (~2 s to parse) or loads libopenvdb.
 //
 // Voxel geometry. The coarse grid starts at the (optionally trimmed) box minimum `origin`;
 // its voxel size is the longest box side / `resolution`. Fine voxels have size
@@ -19,18 +19,11 @@
 #include <span>
 #include <vector>
 
+#include "geometry/occupancy/vdb_mask.h"
 #include "geometry/occupancy/voxel_set.h"
 #include "geometry/scene/scene.h"
 
 namespace saresgs {
-
-// Neighbourhood of one dilation step; r steps give:
-//   Cube        26-neighbourhood (OpenVDB NN_FACE_EDGE_VERTEX): max_a |d_a| <= r, the
-//               (2r+1)^3 cube. The default: the paper's "3D kernel of radius r" with no
-//               further shape given; the cube is the kernel of a plain 3D max filter.
-//   FaceEdge    18-neighbourhood (NN_FACE_EDGE): max |d_a| <= r and |d|_1 <= 2r.
-//   Octahedron  6-neighbourhood (NN_FACE): |d|_1 <= r.
-enum class DilationShape { Cube, FaceEdge, Octahedron };
 
 struct OccupancyOptions {
   int resolution = 128;       // coarse voxels along the longest side of the box

@@ -1,13 +1,16 @@
 // Scene and observed grids: thresholds, upsampling, trimming, dilation vs brute force.
 #include <gtest/gtest.h>
+#include <link.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <functional>
 #include <map>
 #include <random>
 #include <set>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -358,4 +361,22 @@ TEST(OccupancyGrids, ObservedVoxelsAreDilatedAndAccumulate) {
   EXPECT_EQ(g.observedFraction(), 0.0);
   // The copy kept its own observed grid (deep copy).
   EXPECT_EQ(parts.observedCount(), expect.size());
+}
+
+// The first grid loads the OpenVDB module, and with it libopenvdb (the program and this
+// test link neither: test_vdb_module.cpp checks the program's start).
+TEST(VdbModule, AGridLoadsTheModuleAndOpenVdb) {
+  const std::vector<Eigen::Vector3d> pts = {{0, 0, 0}, {1, 1, 1}, {1, 1, 1}};
+  const OccupancyGrids g = OccupancyGrids::fromSfm(pts, OccupancyOptions{.resolution = 4, .min_points = 1});
+  EXPECT_GT(g.sceneCount(), 0u);
+  EXPECT_TRUE(std::filesystem::exists(vdbModulePath())) << vdbModulePath();
+  bool openvdb = false;
+  dl_iterate_phdr(
+      [](dl_phdr_info* info, std::size_t, void* found) {
+        if (info->dlpi_name && std::string(info->dlpi_name).find("libopenvdb") != std::string::npos)
+          *static_cast<bool*>(found) = true;
+        return 0;
+      },
+      &openvdb);
+  EXPECT_TRUE(openvdb);
 }
