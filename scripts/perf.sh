@@ -14,6 +14,10 @@
 #                                         (2 rounds: new, base, base, new); writes
 #                                         results/perf/accept.jsonl and prints a table
 #                                         (about 10 minutes on the AMD EPYC VM)
+#   bash scripts/perf.sh startup [BASE]   how long `saresgs --version` takes from exec to
+#                                         exit, this tree and BASE alternated (31 runs each,
+#                                         medians), and the shared libraries each loads at
+#                                         start; writes results/perf/startup.json
 #
 # BASE defaults to b0ae65c for `table` and `accept` (the code issue 26 is judged against) and to
 # HEAD~1 for `regress`. It is built once into build-perf/<sha> (Release, the CLI only;
@@ -26,8 +30,9 @@ cd "$(dirname "$0")/.."
 mode=${1:-}
 case "$mode" in
   table|accept) base_ref=${2:-b0ae65c} ;;
+  startup) base_ref=${2:-8437562} ;;
   regress) base_ref=${2:-HEAD~1} ;;
-  *) echo "usage: bash scripts/perf.sh table|regress|accept [BASE-COMMIT]" >&2; exit 2 ;;
+  *) echo "usage: bash scripts/perf.sh table|regress|accept|startup [BASE-COMMIT]" >&2; exit 2 ;;
 esac
 new=./build/apps/saresgs
 [ -x "$new" ] || { echo "perf.sh: $new is missing: run bash scripts/build.sh first" >&2; exit 2; }
@@ -69,6 +74,39 @@ if n > 1.10 * b:
     sys.exit(1)
 EOF
   echo "load after: $(load)" >&2
+  exit 0
+fi
+
+if [ "$mode" = startup ]; then
+  mkdir -p results/perf
+  /usr/bin/python3 - "$new" "$base" "$(git rev-parse --short=7 HEAD)$(git diff --quiet || echo '+changes')" "$sha" "$machine" <<'EOF'
+import json, os, statistics, subprocess, sys, time
+new, base, head, base_sha, machine = sys.argv[1:6]
+load = lambda: " ".join(open("/proc/loadavg").read().split()[:3])
+def libraries(binary):  # what the loader maps at start (what ldd lists)
+    out = subprocess.run([binary], env={**os.environ, "LD_TRACE_LOADED_OBJECTS": "1"}, capture_output=True, text=True).stdout
+    return sum(1 for line in out.splitlines() if line.strip())
+times = {"new": [], "base": []}
+load_before = load()
+for _ in range(31):
+    for who, binary in (("new", new), ("base", base)):
+        t0 = time.perf_counter()
+        subprocess.run([binary, "--version"], stdout=subprocess.DEVNULL, check=True)
+        times[who].append(time.perf_counter() - t0)
+med = {who: statistics.median(v) * 1000 for who, v in times.items()}
+record = {"command": "saresgs --version", "this_tree": head, "base": base_sha, "machine": machine,
+          "load_before": load_before, "load_after": load(), "runs_each": 31,
+          "median_ms": med, "ratio": med["new"] / med["base"],
+          "libraries_at_start": {"new": libraries(new), "base": libraries(base)}}
+tmp = "results/perf/startup.json.tmp"
+with open(tmp, "w") as f:
+    json.dump(record, f, indent=1)
+    f.write("\n")
+os.replace(tmp, "results/perf/startup.json")
+print(f"saresgs --version: this tree {head} {med['new']:.1f} ms, {base_sha} {med['base']:.1f} ms (medians of 31 alternated), "
+      f"ratio {record['ratio']:.3f}; libraries at start {record['libraries_at_start']['new']} vs "
+      f"{record['libraries_at_start']['base']}; {machine}; load {load_before} before")
+EOF
   exit 0
 fi
 
