@@ -11,11 +11,12 @@
 #include <cstdint>
 #include <vector>
 
+#include "geometry/occupancy/dilation_shape.h"
 #include "geometry/occupancy/voxel_set.h"
 
 namespace saresgs::vdb_module {
 
-inline constexpr int kAbi = 1;
+inline constexpr int kAbi = 2;
 
 struct Backend {
   int abi;
@@ -24,16 +25,16 @@ struct Backend {
   void (*destroy)(void* tree);
   void (*setOn)(void* tree, const Voxel* voxels, std::size_t n);
   bool (*isOn)(const void* tree, const Voxel& v);
-  // Which of `voxels` are on (out[i] = 0 or 1), through one accessor.
-  void (*testOn)(const void* tree, const Voxel* voxels, std::size_t n, std::uint8_t* out);
-  // `radius` steps of the neighbourhood: 0 face+edge+vertex (26), 1 face+edge (18), 2 face (6).
-  void (*dilate)(void* tree, int radius, int neighbourhood);
+  // The keys whose voxels are on, in the given order, through one accessor.
+  void (*filterKeys)(const void* tree, const VoxelKey* keys, std::size_t n, std::vector<VoxelKey>& out);
+  void (*dilate)(void* tree, int radius, saresgs::DilationShape shape);
   void (*unite)(void* tree, const void* other);  // topology union
   void (*clear)(void* tree);
   bool (*empty)(const void* tree);
   std::size_t (*activeCount)(const void* tree);
-  // Every active voxel, active tiles expanded voxel by voxel, in the tree's order.
-  void (*activeVoxels)(const void* tree, std::vector<Voxel>& out);
+  // The keys of every representable active voxel, active tiles expanded voxel by voxel, in
+  // the tree's order (not key order).
+  void (*activeKeys)(const void* tree, std::vector<VoxelKey>& out);
   // Inclusive bounds of the active voxels; false for an empty tree.
   bool (*bounds)(const void* tree, Voxel& lo, Voxel& hi);
   std::size_t (*memUsage)(const void* tree);

@@ -99,31 +99,20 @@ void VdbMask::setOn(std::span<const Voxel> voxels) { ops_->setOn(tree_, voxels.d
 bool VdbMask::isOn(const Voxel& v) const { return ops_->isOn(tree_, v); }
 
 VoxelSet VdbMask::filter(const VoxelSet& set) const {
-  const std::vector<Voxel> voxels = set.voxels();
-  std::vector<std::uint8_t> on(voxels.size());
-  ops_->testOn(tree_, voxels.data(), voxels.size(), on.data());
   std::vector<VoxelKey> out;
-  for (std::size_t i = 0; i < voxels.size(); ++i)
-    if (on[i]) out.push_back(set.keys()[i]);
-  return VoxelSet::fromSortedKeys(std::move(out));
+  ops_->filterKeys(tree_, set.keys().data(), set.size(), out);
+  return VoxelSet::fromSortedKeys(std::move(out));  // a subsequence of sorted keys
 }
 
-void VdbMask::dilate(int radius, DilationShape shape) {
-  const int n = shape == DilationShape::FaceEdge ? 1 : shape == DilationShape::Octahedron ? 2 : 0;
-  ops_->dilate(tree_, radius, n);
-}
+void VdbMask::dilate(int radius, DilationShape shape) { ops_->dilate(tree_, radius, shape); }
 void VdbMask::unite(const VdbMask& o) { ops_->unite(tree_, o.tree_); }
 void VdbMask::clear() { ops_->clear(tree_); }
 bool VdbMask::empty() const { return ops_->empty(tree_); }
 std::size_t VdbMask::activeCount() const { return ops_->activeCount(tree_); }
 
 VoxelSet VdbMask::keys() const {
-  std::vector<Voxel> voxels;
-  ops_->activeVoxels(tree_, voxels);
   std::vector<VoxelKey> keys;
-  keys.reserve(voxels.size());
-  for (const Voxel& v : voxels)
-    if (voxelRepresentable(v)) keys.push_back(packVoxel(v));
+  ops_->activeKeys(tree_, keys);
   // Tree iteration order (by child index inside each internal node) is not key order.
   std::sort(keys.begin(), keys.end());
   return VoxelSet::fromSortedKeys(std::move(keys));

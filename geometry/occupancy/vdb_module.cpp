@@ -15,15 +15,16 @@ MaskTree& tree(void* t) { return *static_cast<MaskTree*>(t); }
 const MaskTree& tree(const void* t) { return *static_cast<const MaskTree*>(t); }
 Coord toCoord(const saresgs::Voxel& v) { return Coord(v[0], v[1], v[2]); }
 
-openvdb::tools::NearestNeighbors neighbours(int n) {
-  switch (n) {
-    case 1:
+openvdb::tools::NearestNeighbors neighbours(saresgs::DilationShape s) {
+  switch (s) {
+    case saresgs::DilationShape::FaceEdge:
       return openvdb::tools::NN_FACE_EDGE;
-    case 2:
+    case saresgs::DilationShape::Octahedron:
       return openvdb::tools::NN_FACE;
-    default:
-      return openvdb::tools::NN_FACE_EDGE_VERTEX;
+    case saresgs::DilationShape::Cube:
+      break;
   }
+  return openvdb::tools::NN_FACE_EDGE_VERTEX;
 }
 
 void* create() { return new MaskTree(); }
@@ -37,17 +38,19 @@ void setOn(void* t, const saresgs::Voxel* v, std::size_t n) {
 
 bool isOn(const void* t, const saresgs::Voxel& v) { return tree(t).isValueOn(toCoord(v)); }
 
-void testOn(const void* t, const saresgs::Voxel* v, std::size_t n, std::uint8_t* out) {
+void filterKeys(const void* t, const saresgs::VoxelKey* keys, std::size_t n, std::vector<saresgs::VoxelKey>& out) {
+  out.clear();
   openvdb::tree::ValueAccessor<const MaskTree> acc(tree(t));
-  for (std::size_t i = 0; i < n; ++i) out[i] = acc.isValueOn(toCoord(v[i])) ? 1 : 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (acc.isValueOn(toCoord(saresgs::unpackVoxel(keys[i])))) out.push_back(keys[i]);
 }
 
-void dilate(void* t, int radius, int neighbourhood) {
+void dilate(void* t, int radius, saresgs::DilationShape shape) {
   if (radius <= 0 || tree(t).empty()) return;
-  // EXPAND_TILES keeps the result voxelized (no pruning into tiles); activeVoxels expands
+  // EXPAND_TILES keeps the result voxelized (no pruning into tiles); activeKeys expands
   // tiles anyway. OpenVDB threads this with TBB; topology union is order independent, so
   // the result is deterministic.
-  openvdb::tools::dilateActiveValues(tree(t), radius, neighbours(neighbourhood), openvdb::tools::EXPAND_TILES);
+  openvdb::tools::dilateActiveValues(tree(t), radius, neighbours(shape), openvdb::tools::EXPAND_TILES);
 }
 
 void unite(void* t, const void* other) { tree(t).topologyUnion(tree(other)); }
@@ -55,10 +58,13 @@ void clear(void* t) { tree(t).clear(); }
 bool empty(const void* t) { return tree(t).empty(); }
 std::size_t activeCount(const void* t) { return static_cast<std::size_t>(tree(t).activeVoxelCount()); }
 
-void activeVoxels(const void* t, std::vector<saresgs::Voxel>& out) {
+void activeKeys(const void* t, std::vector<saresgs::VoxelKey>& out) {
   out.clear();
   out.reserve(static_cast<std::size_t>(tree(t).activeVoxelCount()));
-  auto add = [&](const Coord& c) { out.push_back({c.x(), c.y(), c.z()}); };
+  auto add = [&](const Coord& c) {
+    const saresgs::Voxel v{c.x(), c.y(), c.z()};
+    if (saresgs::voxelRepresentable(v)) out.push_back(saresgs::packVoxel(v));
+  };
   for (auto it = tree(t).cbeginValueOn(); it; ++it) {
     if (it.isVoxelValue()) {
       add(it.getCoord());
@@ -82,8 +88,8 @@ bool bounds(const void* t, saresgs::Voxel& lo, saresgs::Voxel& hi) {
 std::size_t memUsage(const void* t) { return static_cast<std::size_t>(tree(t).memUsage()); }
 
 constexpr saresgs::vdb_module::Backend kBackend{
-    saresgs::vdb_module::kAbi, create, copy, destroy, setOn, isOn, testOn, dilate, unite, clear, empty, activeCount,
-    activeVoxels, bounds, memUsage};
+    saresgs::vdb_module::kAbi, create, copy, destroy, setOn, isOn, filterKeys, dilate, unite, clear, empty, activeCount,
+    activeKeys, bounds, memUsage};
 
 }  // namespace
 
